@@ -1,0 +1,351 @@
+//! Distance transforms: the exact Euclidean one (Meijster et al. 2000) and CARMEN's chamfer baseline.
+//!
+//! [`exact_edt`] is the kernel behind every obstacle distance map. Phase 1 computes, for each
+//! cell, the distance in cells to the nearest obstacle in its column with two sweeps that run
+//! row after row over whole rows (contiguous memory, auto-vectorised). Phase 2 takes, in each
+//! row, the lower envelope of the parabolas `(x - i)^2 + g(i)^2` with Meijster's integer
+//! separator, in parallel over rows. The result is exact: it equals the brute-force minimum of
+//! Euclidean distances between cell centres (tested on random grids).
+//!
+//! [`chamfer_3x3`] is the two-pass 3x3 chamfer (weights 1 and sqrt 2) CARMEN uses, kept as the
+//! "straightforward way" the benchmarks compare against. It overestimates distances by up to
+//! about 8 %.
+
+use rayon::prelude::*;
+
+/// Distance, in cells, standing for "no obstacle in this column". Its square fits in i64 with
+/// room to spare and is larger than any distance inside a grid of up to 2^20 cells a side.
+const FAR: u32 = 1 << 21;
+
+/// Reusable buffers of [`exact_edt`] so recomputing a map allocates nothing.
+#[derive(Default, Debug)]
+pub struct EdtScratch {
+    column_distance: Vec<u32>,
+}
+
+/// Exact Euclidean distance transform.
+///
+/// `is_obstacle(i)` tells whether cell `i` (row-major, `width` x `height`) is an obstacle. Writes
+/// into `out_m[i]` the distance in metres from the centre of cell `i` to the centre of the nearest
+/// obstacle cell, capped at `max_distance_m` (also the value everywhere when there is no obstacle).
+///
+/// # Panics
+/// If `out_m.len() != width * height` (a programming error, not an input error).
+pub fn exact_edt(
+    width: usize,
+    height: usize,
+    resolution_m: f32,
+    max_distance_m: f32,
+    is_obstacle: impl Fn(usize) -> bool + Sync,
+    scratch: &mut EdtScratch,
+    out_m: &mut [f32],
+) {
+    assert_eq!(out_m.len(), width * height, "exact_edt: output size");
+    let g = &mut scratch.column_distance;
+    g.clear();
+    g.resize(width * height, FAR);
+
+    // Phase 1: distance along each column, two sweeps over whole rows.
+    for (i, gi) in g[..width].iter_mut().enumerate() {
+        *gi = if is_obstacle(i) { 0 } else { FAR };
+    }
+    for y in 1..height {
+        let (done, rest) = g.split_at_mut(y * width);
+        let prev = &done[(y - 1) * width..];
+        let row = &mut rest[..width];
+        let base = y * width;
+        for x in 0..width {
+            row[x] = if is_obstacle(base + x) {
+                0
+            } else {
+                (prev[x] + 1).min(FAR)
+            };
+        }
+    }
+    for y in (0..height.saturating_sub(1)).rev() {
+        let (head, tail) = g.split_at_mut((y + 1) * width);
+        let row = &mut head[y * width..];
+        let next = &tail[..width];
+        for x in 0..width {
+            row[x] = row[x].min(next[x] + 1);
+        }
+    }
+
+    // Phase 2: lower envelope of parabolas along each row.
+    let g = &*g;
+    let cap_cells2 = {
+        let c = (max_distance_m / resolution_m) as f64;
+        (c * c).ceil() as i64
+    };
+    out_m.par_chunks_mut(width).enumerate().for_each_init(
+        || (vec![0usize; width], vec![0usize; width]),
+        |(s, t), (y, out_row)| {
+            let row = &g[y * width..(y + 1) * width];
+            row_envelope(row, s, t, |x, d2| {
+                out_row[x] = if d2 >= cap_cells2 {
+                    max_distance_m
+                } else {
+                    ((d2 as f32).sqrt() * resolution_m).min(max_distance_m)
+                };
+            });
+        },
+    );
+}
+
+/// Meijster's phase 2 on one row of column distances `g`; calls `emit(x, squared distance)`.
+#[inline]
+fn row_envelope(g: &[u32], s: &mut [usize], t: &mut [usize], mut emit: impl FnMut(usize, i64)) {
+    let m = g.len();
+    let g2 = |i: usize| {
+        let v = g[i] as i64;
+        v * v
+    };
+    let f = |x: usize, i: usize| {
+        let d = x as i64 - i as i64;
+        d * d + g2(i)
+    };
+    // Separator: the first x at which the parabola of u is not above the one of i (i < u).
+    let sep = |i: usize, u: usize| {
+        let (ii, uu) = (i as i64, u as i64);
+        (uu * uu - ii * ii + g2(u) - g2(i)).div_euclid(2 * (uu - ii))
+    };
+    let mut q: isize = 0;
+    s[0] = 0;
+    t[0] = 0;
+    for u in 1..m {
+        while q >= 0 && f(t[q as usize], s[q as usize]) > f(t[q as usize], u) {
+            q -= 1;
+        }
+        if q < 0 {
+            q = 0;
+            s[0] = u;
+        } else {
+            let w = 1 + sep(s[q as usize], u);
+            if w < m as i64 {
+                q += 1;
+                s[q as usize] = u;
+                t[q as usize] = w as usize;
+            }
+        }
+    }
+    for u in (0..m).rev() {
+        emit(u, f(u, s[q as usize]));
+        if u == t[q as usize] {
+            q -= 1;
+        }
+    }
+}
+
+/// Two-pass 3x3 chamfer distance transform (weights 1 and sqrt 2), CARMEN's way.
+///
+/// Same inputs and output as [`exact_edt`]; approximate (it overestimates off-axis distances).
+pub fn chamfer_3x3(
+    width: usize,
+    height: usize,
+    resolution_m: f32,
+    max_distance_m: f32,
+    is_obstacle: impl Fn(usize) -> bool,
+    out_m: &mut [f32],
+) {
+    assert_eq!(out_m.len(), width * height, "chamfer_3x3: output size");
+    let far = max_distance_m / resolution_m + 2.0;
+    let diag = std::f32::consts::SQRT_2;
+    let d = out_m;
+    for (i, v) in d.iter_mut().enumerate() {
+        *v = if is_obstacle(i) { 0.0 } else { far };
+    }
+    for y in 0..height {
+        for x in 0..width {
+            let i = y * width + x;
+            let mut v = d[i];
+            if x > 0 {
+                v = v.min(d[i - 1] + 1.0);
+            }
+            if y > 0 {
+                let up = i - width;
+                v = v.min(d[up] + 1.0);
+                if x > 0 {
+                    v = v.min(d[up - 1] + diag);
+                }
+                if x + 1 < width {
+                    v = v.min(d[up + 1] + diag);
+                }
+            }
+            d[i] = v;
+        }
+    }
+    for y in (0..height).rev() {
+        for x in (0..width).rev() {
+            let i = y * width + x;
+            let mut v = d[i];
+            if x + 1 < width {
+                v = v.min(d[i + 1] + 1.0);
+            }
+            if y + 1 < height {
+                let down = i + width;
+                v = v.min(d[down] + 1.0);
+                if x + 1 < width {
+                    v = v.min(d[down + 1] + diag);
+                }
+                if x > 0 {
+                    v = v.min(d[down - 1] + diag);
+                }
+            }
+            d[i] = v;
+        }
+    }
+    for v in d.iter_mut() {
+        *v = (*v * resolution_m).min(max_distance_m);
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Brute force: the minimum over all obstacle cells of the Euclidean distance between centres.
+    pub(crate) fn brute_force(
+        width: usize,
+        height: usize,
+        res: f32,
+        cap: f32,
+        mask: &[bool],
+    ) -> Vec<f32> {
+        let obstacles: Vec<(i64, i64)> = (0..mask.len())
+            .filter(|&i| mask[i])
+            .map(|i| ((i % width) as i64, (i / width) as i64))
+            .collect();
+        (0..width * height)
+            .map(|i| {
+                let (x, y) = ((i % width) as i64, (i / width) as i64);
+                let d2 = obstacles
+                    .iter()
+                    .map(|&(ox, oy)| (ox - x).pow(2) + (oy - y).pow(2))
+                    .min();
+                d2.map_or(cap, |d2| ((d2 as f32).sqrt() * res).min(cap))
+            })
+            .collect()
+    }
+
+    fn run_exact(width: usize, height: usize, res: f32, cap: f32, mask: &[bool]) -> Vec<f32> {
+        let mut out = vec![0.0; width * height];
+        exact_edt(
+            width,
+            height,
+            res,
+            cap,
+            |i| mask[i],
+            &mut EdtScratch::default(),
+            &mut out,
+        );
+        out
+    }
+
+    /// Parses an ASCII grid: `#` obstacle, `.` free; the first text line is the top row (highest y).
+    pub(crate) fn ascii(rows: &str) -> (usize, usize, Vec<bool>) {
+        let lines: Vec<&str> = rows
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty())
+            .collect();
+        let (w, h) = (lines[0].len(), lines.len());
+        let mut mask = vec![false; w * h];
+        for (r, line) in lines.iter().enumerate() {
+            assert_eq!(line.len(), w, "ragged ASCII grid");
+            for (x, ch) in line.chars().enumerate() {
+                mask[(h - 1 - r) * w + x] = ch == '#';
+            }
+        }
+        (w, h, mask)
+    }
+
+    #[test]
+    fn ascii_fixture_single_obstacle_gives_euclidean_rings() {
+        let (w, h, mask) = ascii(
+            "
+            .....
+            .....
+            ..#..
+            .....
+            .....",
+        );
+        let d = run_exact(w, h, 1.0, 100.0, &mask);
+        let at = |x: usize, y: usize| d[y * w + x];
+        assert_eq!(at(2, 2), 0.0);
+        assert_eq!(at(3, 2), 1.0);
+        assert_eq!(at(2, 4), 2.0);
+        assert!((at(4, 4) - 8f32.sqrt()).abs() < 1e-6);
+        assert!((at(0, 3) - 5f32.sqrt()).abs() < 1e-6);
+    }
+
+    #[test]
+    fn ascii_fixture_wall_and_cap() {
+        let (w, h, mask) = ascii(
+            "
+            #.......
+            #.......
+            #.......",
+        );
+        let d = run_exact(w, h, 0.2, 1.0, &mask);
+        for y in 0..h {
+            for x in 0..w {
+                let expected = (x as f32 * 0.2).min(1.0);
+                assert!(
+                    (d[y * w + x] - expected).abs() < 1e-6,
+                    "({x},{y}) {} vs {expected}",
+                    d[y * w + x]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn no_obstacle_is_the_cap_everywhere() {
+        let d = run_exact(7, 3, 0.2, 5.0, &[false; 21]);
+        assert!(d.iter().all(|&v| v == 5.0));
+    }
+
+    #[test]
+    fn chamfer_overestimates_but_never_underestimates() {
+        let (w, h, mask) = ascii(
+            "
+            .........
+            .........
+            ....#....
+            .........
+            .........",
+        );
+        let exact = run_exact(w, h, 1.0, 100.0, &mask);
+        let mut chamfer = vec![0.0; w * h];
+        chamfer_3x3(w, h, 1.0, 100.0, |i| mask[i], &mut chamfer);
+        for (e, c) in exact.iter().zip(&chamfer) {
+            assert!(
+                *c >= e - 1e-5 && *c <= e * 1.09 + 1e-5,
+                "exact {e} chamfer {c}"
+            );
+        }
+        // (2, 1) cells away: exact sqrt 5 = 2.236, chamfer 1 + sqrt 2 = 2.414.
+        assert!((chamfer[3 * w + 6] - (1.0 + std::f32::consts::SQRT_2)).abs() < 1e-5);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        #[test]
+        fn exact_edt_equals_brute_force(
+            width in 1usize..40, height in 1usize..40, density in 0.0f64..0.3, seed in any::<u64>(),
+        ) {
+            // A cheap seeded generator keeps the case small to shrink and reproducible.
+            let mut state = seed | 1;
+            let mask: Vec<bool> = (0..width * height).map(|_| {
+                state ^= state << 13; state ^= state >> 7; state ^= state << 17;
+                (state % 10_000) as f64 / 10_000.0 < density
+            }).collect();
+            let exact = run_exact(width, height, 0.2, 3.0, &mask);
+            let brute = brute_force(width, height, 0.2, 3.0, &mask);
+            for i in 0..width * height {
+                prop_assert!((exact[i] - brute[i]).abs() < 1e-5, "cell {} exact {} brute {}", i, exact[i], brute[i]);
+            }
+        }
+    }
+}
