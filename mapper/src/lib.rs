@@ -8,18 +8,36 @@
 //! - [`levels`]: heights of interest, cumulative or banded.
 //! - [`edt`], [`odm`]: exact Euclidean distance transform and per-level obstacle distance maps.
 //! - [`collision`]: circle models and pose / trajectory checks.
+//! - [`scan`], [`occupancy`]: the LiDAR revolution as input and the obstacle test.
+//! - [`map`]: `MultiHeightMap`, the local window: insertion, offline/online merge, re-centring.
+//! - [`blocks`]: the map block file format and the directory store.
+//! - [`remission`]: per-cell intensity statistics.
+//! - [`export`]: ROS map_server PGM/YAML, PNG and NumPy `.npy` files.
+//! - [`synthetic`]: analytic scenes and a synthetic HDL-32E for tests and benchmarks.
 
+pub mod blocks;
 pub mod collision;
 pub mod edt;
 pub mod error;
+pub mod export;
 pub mod grid;
 pub mod levels;
+pub mod map;
+pub mod occupancy;
 pub mod odm;
+pub mod remission;
+pub mod scan;
+pub mod synthetic;
 
+pub use blocks::{Block, BlockIndex, BlockSpec, BlockStore};
 pub use collision::{
     BoundingCircle, Circle, CollisionChecker, CollisionModel, PoseCheck, TrajectoryCheck,
 };
 pub use error::{MapError, Result};
 pub use grid::{Cell, Grid, GridGeometry};
 pub use levels::{HeightClass, LevelMode, Levels};
+pub use map::{InsertStats, MapConfig, MergeMode, MultiHeightMap};
+pub use occupancy::{ObstacleTestParams, OccupancyParams};
 pub use odm::{DistanceMap, DistanceMaps};
+pub use remission::RemissionCell;
+pub use scan::{Return, Scan, ScanColumn};

@@ -1,0 +1,327 @@
+//! Map blocks on disk: the documented binary format, atomic writes, and a directory store.
+//!
+//! A map is tiled into square blocks (70 m, 350 x 350 cells by default). Each block file holds
+//! every level's log-odds and the remission statistics of its cells. Format version 1, all
+//! numbers little-endian:
+//!
+//! | offset | size | field |
+//! | --- | --- | --- |
+//! | 0 | 8 | magic `TAXIBLK\0` |
+//! | 8 | 4 | format version (u32, = 1) |
+//! | 12 | 4 | number of levels N (u32) |
+//! | 16 | 4 | level mode (u32: 0 cumulative, 1 banded) |
+//! | 20 | 4 | cells per block side S (u32) |
+//! | 24 | 8 | resolution, metres (f64) |
+//! | 32 | 8 | block index x (i64; the block covers x in [ix*S*res, (ix+1)*S*res)) |
+//! | 40 | 8 | block index y (i64) |
+//! | 48 | 8N | height of interest of each level, metres (f64) |
+//! | 48+8N | 4*S*S*N | log-odds of every cell, level after level, row 0 = lowest y (f32; NaN = unknown) |
+//! | ... | 12*S*S | remission per cell: sum (f32), sum of squares (f32), count (u32) |
+//! | end-4 | 4 | CRC-32 (IEEE) of every byte before it |
+//!
+//! A file is written to a temporary file in the same directory and renamed over the target, so
+//! a reader never sees half a block. Reading checks the size, magic, version, that the header
+//! matches the map being loaded into, and the checksum; any mismatch is an error naming the file
+//! and the field.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::error::{MapError, Result};
+use crate::levels::{LevelMode, Levels};
+use crate::remission::RemissionCell;
+
+const MAGIC: &[u8; 8] = b"TAXIBLK\0";
+/// Version of the block format this crate writes and reads.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Index of a block in the world's tiling.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct BlockIndex {
+    /// Along world x.
+    pub x: i64,
+    /// Along world y.
+    pub y: i64,
+}
+
+/// What a block must look like to belong to a map: side, resolution and levels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlockSpec {
+    /// Cells per side.
+    pub side: usize,
+    /// Metres per cell.
+    pub resolution_m: f64,
+    /// Levels of the map.
+    pub levels: Levels,
+}
+
+impl BlockSpec {
+    /// Side of a block in metres.
+    pub fn side_m(&self) -> f64 {
+        self.side as f64 * self.resolution_m
+    }
+    fn header_len(&self) -> usize {
+        48 + 8 * self.levels.count()
+    }
+    fn file_len(&self) -> usize {
+        let cells = self.side * self.side;
+        self.header_len() + 4 * cells * self.levels.count() + 12 * cells + 4
+    }
+}
+
+/// The content of one block.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block {
+    /// Where it lies.
+    pub index: BlockIndex,
+    /// Log-odds per level, `side * side` each, row 0 = lowest y; NaN = unknown.
+    pub levels: Vec<Vec<f32>>,
+    /// Remission statistics, `side * side`.
+    pub remission: Vec<RemissionCell>,
+}
+
+impl Block {
+    /// A block where every cell is unknown.
+    pub fn unknown(spec: &BlockSpec, index: BlockIndex) -> Self {
+        let cells = spec.side * spec.side;
+        Block {
+            index,
+            levels: vec![vec![f32::NAN; cells]; spec.levels.count()],
+            remission: vec![RemissionCell::default(); cells],
+        }
+    }
+    /// True when no cell holds any information.
+    pub fn is_unknown(&self) -> bool {
+        self.levels.iter().all(|l| l.iter().all(|v| v.is_nan()))
+            && self.remission.iter().all(|r| r.count == 0)
+    }
+}
+
+/// Serialises a block (format above) into bytes.
+pub fn encode_block(spec: &BlockSpec, block: &Block) -> Vec<u8> {
+    let mut out = Vec::with_capacity(spec.file_len());
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&(spec.levels.count() as u32).to_le_bytes());
+    out.extend_from_slice(&mode_code(spec.levels.mode()).to_le_bytes());
+    out.extend_from_slice(&(spec.side as u32).to_le_bytes());
+    out.extend_from_slice(&spec.resolution_m.to_le_bytes());
+    out.extend_from_slice(&block.index.x.to_le_bytes());
+    out.extend_from_slice(&block.index.y.to_le_bytes());
+    for h in spec.levels.heights_m() {
+        out.extend_from_slice(&h.to_le_bytes());
+    }
+    for level in &block.levels {
+        for v in level {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    for r in &block.remission {
+        out.extend_from_slice(&r.sum.to_le_bytes());
+        out.extend_from_slice(&r.sum_sq.to_le_bytes());
+        out.extend_from_slice(&r.count.to_le_bytes());
+    }
+    let crc = crc32fast::hash(&out);
+    out.extend_from_slice(&crc.to_le_bytes());
+    out
+}
+
+fn mode_code(mode: LevelMode) -> u32 {
+    match mode {
+        LevelMode::Cumulative => 0,
+        LevelMode::Banded => 1,
+    }
+}
+
+/// Parses a block file's bytes, checking them against `spec`; `path` names the file in errors.
+pub fn decode_block(spec: &BlockSpec, bytes: &[u8], path: &Path) -> Result<Block> {
+    let bad = |why: String| MapError::bad_file(path, why);
+    if bytes.len() < 48 || &bytes[..8] != MAGIC {
+        return Err(bad(format!(
+            "not a taxi-sim map block (bad magic or {} bytes only)",
+            bytes.len()
+        )));
+    }
+    let u32_at =
+        |o: usize| u32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]);
+    let u64_at = |o: usize| {
+        let mut b = [0u8; 8];
+        b.copy_from_slice(&bytes[o..o + 8]);
+        u64::from_le_bytes(b)
+    };
+    let version = u32_at(8);
+    if version != FORMAT_VERSION {
+        return Err(bad(format!(
+            "format version {version}, this build reads version {FORMAT_VERSION}"
+        )));
+    }
+    let expected_len = spec.file_len();
+    if bytes.len() != expected_len {
+        return Err(bad(format!(
+            "truncated or padded: {} bytes, a block of this map has {expected_len}",
+            bytes.len()
+        )));
+    }
+    let stored_crc = u32_at(expected_len - 4);
+    let crc = crc32fast::hash(&bytes[..expected_len - 4]);
+    if crc != stored_crc {
+        return Err(bad(format!(
+            "checksum mismatch (stored {stored_crc:#010x}, computed {crc:#010x}): the file is corrupted"
+        )));
+    }
+    let n = u32_at(12) as usize;
+    if n != spec.levels.count() {
+        return Err(bad(format!(
+            "field `levels` = {n}, the map has {}",
+            spec.levels.count()
+        )));
+    }
+    if u32_at(16) != mode_code(spec.levels.mode()) {
+        return Err(bad(format!(
+            "field `mode` = {}, the map is {:?}",
+            u32_at(16),
+            spec.levels.mode()
+        )));
+    }
+    if u32_at(20) as usize != spec.side {
+        return Err(bad(format!(
+            "field `side` = {}, the map's blocks have {} cells a side",
+            u32_at(20),
+            spec.side
+        )));
+    }
+    let res = f64::from_bits(u64_at(24));
+    if res != spec.resolution_m {
+        return Err(bad(format!(
+            "field `resolution` = {res} m, the map has {} m",
+            spec.resolution_m
+        )));
+    }
+    let index = BlockIndex {
+        x: u64_at(32) as i64,
+        y: u64_at(40) as i64,
+    };
+    for (k, h) in spec.levels.heights_m().iter().enumerate() {
+        let stored = f64::from_bits(u64_at(48 + 8 * k));
+        if stored != *h {
+            return Err(bad(format!(
+                "field `heights[{k}]` = {stored} m, the map's level {k} is at {h} m"
+            )));
+        }
+    }
+    let cells = spec.side * spec.side;
+    let mut o = spec.header_len();
+    let mut levels = Vec::with_capacity(n);
+    for _ in 0..n {
+        let level: Vec<f32> = bytes[o..o + 4 * cells]
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        o += 4 * cells;
+        levels.push(level);
+    }
+    let remission = bytes[o..o + 12 * cells]
+        .chunks_exact(12)
+        .map(|b| RemissionCell {
+            sum: f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            sum_sq: f32::from_le_bytes([b[4], b[5], b[6], b[7]]),
+            count: u32::from_le_bytes([b[8], b[9], b[10], b[11]]),
+        })
+        .collect();
+    Ok(Block {
+        index,
+        levels,
+        remission,
+    })
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same directory, synced, then renamed.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| MapError::io(dir, e))?;
+    tmp.write_all(bytes)
+        .map_err(|e| MapError::io(tmp.path(), e))?;
+    tmp.as_file()
+        .sync_all()
+        .map_err(|e| MapError::io(tmp.path(), e))?;
+    tmp.persist(path).map_err(|e| MapError::io(path, e.error))?;
+    Ok(())
+}
+
+/// A directory of block files, `block_<x>_<y>.tsmb`.
+#[derive(Clone, Debug)]
+pub struct BlockStore {
+    dir: PathBuf,
+    spec: BlockSpec,
+}
+
+impl BlockStore {
+    /// A store in `dir` (created if missing) for blocks of `spec`.
+    pub fn open(dir: impl Into<PathBuf>, spec: BlockSpec) -> Result<Self> {
+        let dir = dir.into();
+        std::fs::create_dir_all(&dir).map_err(|e| MapError::io(&dir, e))?;
+        Ok(BlockStore { dir, spec })
+    }
+    /// The directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+    /// What the store's blocks look like.
+    pub fn spec(&self) -> &BlockSpec {
+        &self.spec
+    }
+    /// The file of a block.
+    pub fn path(&self, index: BlockIndex) -> PathBuf {
+        self.dir.join(format!("block_{}_{}.tsmb", index.x, index.y))
+    }
+    /// Loads a block; `Ok(None)` when it was never saved (no file), an error when the file is bad.
+    pub fn load(&self, index: BlockIndex) -> Result<Option<Block>> {
+        let path = self.path(index);
+        let bytes = match std::fs::read(&path) {
+            Ok(b) => b,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(MapError::io(path, e)),
+        };
+        let block = decode_block(&self.spec, &bytes, &path)?;
+        if block.index != index {
+            return Err(MapError::bad_file(
+                &path,
+                format!("holds block {:?}, expected {index:?}", block.index),
+            ));
+        }
+        Ok(Some(block))
+    }
+    /// Saves a block atomically.
+    pub fn save(&self, block: &Block) -> Result<()> {
+        write_atomically(&self.path(block.index), &encode_block(&self.spec, block))
+    }
+    /// Indices of every block file in the store, sorted.
+    pub fn list(&self) -> Result<Vec<BlockIndex>> {
+        let mut out = Vec::new();
+        let entries = std::fs::read_dir(&self.dir).map_err(|e| MapError::io(&self.dir, e))?;
+        for entry in entries {
+            let entry = entry.map_err(|e| MapError::io(&self.dir, e))?;
+            let name = entry.file_name();
+            let Some(rest) = name
+                .to_str()
+                .and_then(|n| n.strip_prefix("block_"))
+                .and_then(|n| n.strip_suffix(".tsmb"))
+            else {
+                continue;
+            };
+            let mut parts = rest.split('_');
+            if let (Some(Ok(x)), Some(Ok(y)), None) = (
+                parts.next().map(str::parse),
+                parts.next().map(str::parse),
+                parts.next(),
+            ) {
+                out.push(BlockIndex { x, y });
+            }
+        }
+        out.sort();
+        Ok(out)
+    }
+}

@@ -1,0 +1,850 @@
+//! `MultiHeightMap`: the local window of per-level occupancy grids, its scan insertion, the
+//! offline/online merge, re-centring with blocks on disk, and the per-level distance maps.
+//!
+//! The window is `window_blocks` x `window_blocks` blocks (3 x 3 blocks of 70 m: 210 m, 1050 x
+//! 1050 cells by default) and re-centres, block by block, so the vehicle stays in the middle one.
+//! Each level keeps two log-odds grids: the *prior* (the offline map, read from a block store)
+//! and the *live* map (built from this run's scans only). Their merge is what the distance maps
+//! see: a cell the live map has not observed takes the prior's value (CARMEN's online map);
+//! with [`MergeMode::Decay`] a cell both know is `(10 p_live + p_prior) / 11`. Blocks leaving the
+//! window are written to the live store and read back when they re-enter, so memory is bounded
+//! by the window whatever the route length.
+//!
+//! Scan insertion, per level (levels run in parallel):
+//! 1. every return is classified once: dropped (no echo, beyond `max_range_m`, or a self-hit
+//!    within `self_hit_margin_m` of a vehicle circle), and given its obstacle probability from the
+//!    test against the beam below it ([`crate::occupancy::obstacle_probability`]);
+//! 2. for the level, a return below h_k is flat ground, one above the level's range is ignored,
+//!    one inside it is an obstacle hit when its probability is above 0.5;
+//! 3. hits add `l_occ` to their cell, the nearest hit of each column `2 l_occ`;
+//! 4. then, per column, one straight cell walk (Bresenham) from the sensor to the farthest
+//!    return the level considers adds `l_free`, leaving the last `free_space_stop_cells` cells
+//!    of the line (the endpoint's cell included) untouched and stopping at the first live cell
+//!    with p >= 0.5. The beams of a column share its vertical plane, so one walk per column
+//!    covers each of its beams' 2D traces once.
+
+use nalgebra::Point2;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::blocks::{Block, BlockIndex, BlockSpec, BlockStore};
+use crate::collision::CollisionModel;
+use crate::edt::EdtScratch;
+use crate::error::{MapError, Result, positive};
+use crate::grid::{Grid, GridGeometry};
+use crate::levels::{HeightClass, Levels};
+use crate::occupancy::{ObstacleTestParams, OccupancyParams, obstacle_probability, probability};
+use crate::odm::{DistanceMap, DistanceMaps};
+use crate::remission::RemissionCell;
+use crate::scan::Scan;
+
+/// How the live map and the offline prior combine.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MergeMode {
+    /// Live value where the live map knows the cell, prior value elsewhere (CARMEN's default).
+    #[default]
+    Fallback,
+    /// Where both know the cell: `(10 p_live + p_prior) / 11`; otherwise as `Fallback`.
+    Decay,
+}
+
+/// Everything tunable about a map. Defaults are CARMEN's multi-height ones (FACTS.md).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MapConfig {
+    /// Cell side, metres. Default 0.2.
+    pub resolution_m: f64,
+    /// Cells per block side. Default 350 (70 m blocks).
+    pub block_cells: usize,
+    /// Blocks per window side, odd. Default 3 (a 210 m window).
+    pub window_blocks: usize,
+    /// Log-odds update.
+    pub occupancy: OccupancyParams,
+    /// Obstacle test.
+    pub obstacle_test: ObstacleTestParams,
+    /// Cells left untouched at the end of each free-space walk (the endpoint's cell included). Default 2.
+    pub free_space_stop_cells: usize,
+    /// Returns within a circle's radius plus this margin are self-hits and dropped, metres. Default 0.8.
+    pub self_hit_margin_m: f64,
+    /// A cell is an obstacle for the distance map when its probability is above this. Default 0.5.
+    pub obstacle_threshold: f32,
+    /// Distances are capped here, metres. Default 30 (more than a jet's bounding radius, so the
+    /// early out of the collision check can answer far from obstacles).
+    pub max_distance_m: f32,
+    /// Live / prior merge.
+    pub merge: MergeMode,
+}
+
+impl Default for MapConfig {
+    fn default() -> Self {
+        MapConfig {
+            resolution_m: 0.2,
+            block_cells: 350,
+            window_blocks: 3,
+            occupancy: OccupancyParams::default(),
+            obstacle_test: ObstacleTestParams::default(),
+            free_space_stop_cells: 2,
+            self_hit_margin_m: 0.8,
+            obstacle_threshold: 0.5,
+            max_distance_m: 30.0,
+            merge: MergeMode::Fallback,
+        }
+    }
+}
+
+impl MapConfig {
+    /// Checks every field, naming the first wrong one.
+    pub fn validate(&self) -> Result<()> {
+        positive("resolution_m", self.resolution_m)?;
+        if self.block_cells == 0 {
+            return Err(MapError::invalid("block_cells", "must be > 0"));
+        }
+        if self.window_blocks == 0 || self.window_blocks % 2 == 0 {
+            return Err(MapError::invalid(
+                "window_blocks",
+                format!("{}: must be odd", self.window_blocks),
+            ));
+        }
+        let o = &self.occupancy;
+        if !(o.l_occ.is_finite() && o.l_occ > 0.0) {
+            return Err(MapError::invalid(
+                "occupancy.l_occ",
+                format!("{}: must be > 0", o.l_occ),
+            ));
+        }
+        if !(o.l_free.is_finite() && o.l_free < 0.0) {
+            return Err(MapError::invalid(
+                "occupancy.l_free",
+                format!("{}: must be < 0", o.l_free),
+            ));
+        }
+        positive("occupancy.l_max", o.l_max as f64)?;
+        positive("obstacle_test.sigma", self.obstacle_test.sigma)?;
+        positive("obstacle_test.max_range_m", self.obstacle_test.max_range_m)?;
+        crate::error::finite(
+            "obstacle_test.ground_height_m",
+            self.obstacle_test.ground_height_m,
+        )?;
+        if let Some(h) = self.obstacle_test.unsafe_height_above_ground_m {
+            positive("obstacle_test.unsafe_height_above_ground_m", h)?;
+        }
+        if !(self.self_hit_margin_m.is_finite() && self.self_hit_margin_m >= 0.0) {
+            return Err(MapError::invalid(
+                "self_hit_margin_m",
+                format!("{}: must be >= 0", self.self_hit_margin_m),
+            ));
+        }
+        if !(self.obstacle_threshold > 0.0 && self.obstacle_threshold < 1.0) {
+            return Err(MapError::invalid(
+                "obstacle_threshold",
+                format!("{}: must be in (0, 1)", self.obstacle_threshold),
+            ));
+        }
+        positive("max_distance_m", self.max_distance_m as f64)?;
+        Ok(())
+    }
+
+    /// Side of a block in metres.
+    pub fn block_m(&self) -> f64 {
+        self.block_cells as f64 * self.resolution_m
+    }
+}
+
+/// What one scan insertion did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct InsertStats {
+    /// Returns with an echo.
+    pub returns: usize,
+    /// Dropped as self-hits.
+    pub self_hits: usize,
+    /// Dropped beyond the maximum range or outside the window.
+    pub out_of_range: usize,
+    /// Obstacle hits per level.
+    pub hits: Vec<usize>,
+    /// Cells updated as free per level.
+    pub free_cells: Vec<usize>,
+}
+
+/// One return, classified once for every level.
+#[derive(Clone, Copy, Debug, Default)]
+struct Classified {
+    /// Cell index in the window, `u32::MAX` when dropped.
+    cell: u32,
+    height_m: f32,
+    range_xy_m: f32,
+    obstacle: bool,
+}
+
+const DROPPED: u32 = u32::MAX;
+
+/// The local window of a quantized multi-height occupancy grid map.
+#[derive(Debug)]
+pub struct MultiHeightMap {
+    config: MapConfig,
+    levels: Levels,
+    spec: BlockSpec,
+    geometry: GridGeometry,
+    /// Block index of the window's lower-left block.
+    window_lo: BlockIndex,
+    live: Vec<Grid<f32>>,
+    prior: Vec<Grid<f32>>,
+    live_remission: Grid<RemissionCell>,
+    prior_remission: Grid<RemissionCell>,
+    odm: DistanceMaps,
+    odm_dirty: Vec<bool>,
+    prior_store: Option<BlockStore>,
+    live_store: Option<BlockStore>,
+    classified: Vec<Classified>,
+    edt_scratch: EdtScratch,
+}
+
+impl MultiHeightMap {
+    /// An empty map (no prior, no stores) whose window is centred on the block holding `center`.
+    pub fn new(config: MapConfig, levels: Levels, center: Point2<f64>) -> Result<Self> {
+        Self::with_stores(config, levels, center, None, None)
+    }
+
+    /// A map over an offline prior (`prior_dir`, read only) whose live blocks leaving the window
+    /// go to `live_dir` (dropped when `None`). Blocks of the first window are loaded now.
+    pub fn with_stores(
+        config: MapConfig,
+        levels: Levels,
+        center: Point2<f64>,
+        prior_dir: Option<&std::path::Path>,
+        live_dir: Option<&std::path::Path>,
+    ) -> Result<Self> {
+        config.validate()?;
+        crate::error::finite("center.x", center.x)?;
+        crate::error::finite("center.y", center.y)?;
+        let spec = BlockSpec {
+            side: config.block_cells,
+            resolution_m: config.resolution_m,
+            levels: levels.clone(),
+        };
+        let prior_store = prior_dir
+            .map(|d| BlockStore::open(d, spec.clone()))
+            .transpose()?;
+        let live_store = live_dir
+            .map(|d| BlockStore::open(d, spec.clone()))
+            .transpose()?;
+        let side = config.block_cells * config.window_blocks;
+        let window_lo = Self::window_lo_for(&config, center);
+        let origin = Point2::new(
+            window_lo.x as f64 * config.block_m(),
+            window_lo.y as f64 * config.block_m(),
+        );
+        let geometry = GridGeometry::new(origin, config.resolution_m, side, side)?;
+        let n = levels.count();
+        let odm = DistanceMaps::new(
+            levels.mode(),
+            vec![DistanceMap::empty(geometry, config.max_distance_m); n],
+        )
+        .ok_or_else(|| MapError::invalid("levels", "no level"))?;
+        let mut map = MultiHeightMap {
+            config,
+            spec,
+            geometry,
+            window_lo,
+            live: vec![Grid::filled(geometry, f32::NAN); n],
+            prior: vec![Grid::filled(geometry, f32::NAN); n],
+            live_remission: Grid::filled(geometry, RemissionCell::default()),
+            prior_remission: Grid::filled(geometry, RemissionCell::default()),
+            odm,
+            odm_dirty: vec![true; n],
+            prior_store,
+            live_store,
+            classified: Vec::new(),
+            edt_scratch: EdtScratch::default(),
+            levels,
+        };
+        for index in map.window_blocks(window_lo) {
+            map.load_into_window(index)?;
+        }
+        Ok(map)
+    }
+
+    fn window_lo_for(config: &MapConfig, p: Point2<f64>) -> BlockIndex {
+        let half = (config.window_blocks / 2) as i64;
+        let b = config.block_m();
+        BlockIndex {
+            x: (p.x / b).floor() as i64 - half,
+            y: (p.y / b).floor() as i64 - half,
+        }
+    }
+
+    fn window_blocks(&self, lo: BlockIndex) -> Vec<BlockIndex> {
+        let n = self.config.window_blocks as i64;
+        (0..n)
+            .flat_map(|dy| {
+                (0..n).map(move |dx| BlockIndex {
+                    x: lo.x + dx,
+                    y: lo.y + dy,
+                })
+            })
+            .collect()
+    }
+
+    fn in_window(&self, lo: BlockIndex, index: BlockIndex) -> bool {
+        let n = self.config.window_blocks as i64;
+        (lo.x..lo.x + n).contains(&index.x) && (lo.y..lo.y + n).contains(&index.y)
+    }
+
+    /// The map's configuration.
+    pub fn config(&self) -> &MapConfig {
+        &self.config
+    }
+    /// The levels.
+    pub fn levels(&self) -> &Levels {
+        &self.levels
+    }
+    /// Geometry of the window (every level's grid and distance map).
+    pub fn geometry(&self) -> &GridGeometry {
+        &self.geometry
+    }
+    /// The window's lower-left block.
+    pub fn window_origin_block(&self) -> BlockIndex {
+        self.window_lo
+    }
+    /// What a block of this map looks like.
+    pub fn block_spec(&self) -> &BlockSpec {
+        &self.spec
+    }
+
+    /// Re-centres the window on the block holding `position` if it left the middle block.
+    /// Returns whether the window moved. On error (a bad block file) the map is unchanged.
+    pub fn recenter(&mut self, position: Point2<f64>) -> Result<bool> {
+        crate::error::finite("position.x", position.x)?;
+        crate::error::finite("position.y", position.y)?;
+        let new_lo = Self::window_lo_for(&self.config, position);
+        if new_lo == self.window_lo {
+            return Ok(false);
+        }
+        let old_lo = self.window_lo;
+        let entering: Vec<BlockIndex> = self
+            .window_blocks(new_lo)
+            .into_iter()
+            .filter(|i| !self.in_window(old_lo, *i))
+            .collect();
+        let leaving: Vec<BlockIndex> = self
+            .window_blocks(old_lo)
+            .into_iter()
+            .filter(|i| !self.in_window(new_lo, *i))
+            .collect();
+        // Read everything first so a bad file leaves the map as it was.
+        let mut loaded = Vec::with_capacity(entering.len());
+        for &index in &entering {
+            loaded.push((index, self.read_stores(index)?));
+        }
+        if let Some(store) = &self.live_store {
+            for &index in &leaving {
+                let block = self.extract_live(index);
+                if !block.is_unknown() {
+                    store.save(&block)?;
+                }
+            }
+        }
+        let (dx, dy) = (
+            (new_lo.x - old_lo.x) * self.config.block_cells as i64,
+            (new_lo.y - old_lo.y) * self.config.block_cells as i64,
+        );
+        for g in self.live.iter_mut().chain(self.prior.iter_mut()) {
+            shift(g, dx, dy, f32::NAN);
+        }
+        shift(&mut self.live_remission, dx, dy, RemissionCell::default());
+        shift(&mut self.prior_remission, dx, dy, RemissionCell::default());
+        self.window_lo = new_lo;
+        let origin = Point2::new(
+            new_lo.x as f64 * self.config.block_m(),
+            new_lo.y as f64 * self.config.block_m(),
+        );
+        self.geometry = self.geometry.with_origin(origin);
+        for g in self.live.iter_mut().chain(self.prior.iter_mut()) {
+            g.set_origin(origin);
+        }
+        self.live_remission.set_origin(origin);
+        self.prior_remission.set_origin(origin);
+        for m in self.odm.levels_mut() {
+            m.set_origin(origin);
+        }
+        for (index, (prior, live)) in loaded {
+            self.put_blocks(index, prior.as_ref(), live.as_ref());
+        }
+        self.odm_dirty.iter_mut().for_each(|d| *d = true);
+        Ok(true)
+    }
+
+    fn read_stores(&self, index: BlockIndex) -> Result<(Option<Block>, Option<Block>)> {
+        let prior = match &self.prior_store {
+            Some(s) => s.load(index)?,
+            None => None,
+        };
+        let live = match &self.live_store {
+            Some(s) => s.load(index)?,
+            None => None,
+        };
+        Ok((prior, live))
+    }
+
+    fn load_into_window(&mut self, index: BlockIndex) -> Result<()> {
+        let (prior, live) = self.read_stores(index)?;
+        self.put_blocks(index, prior.as_ref(), live.as_ref());
+        Ok(())
+    }
+
+    /// Cell offset of a block's lower-left cell in the window.
+    fn block_offset(&self, index: BlockIndex) -> (usize, usize) {
+        let s = self.config.block_cells;
+        (
+            ((index.x - self.window_lo.x) as usize) * s,
+            ((index.y - self.window_lo.y) as usize) * s,
+        )
+    }
+
+    fn put_blocks(&mut self, index: BlockIndex, prior: Option<&Block>, live: Option<&Block>) {
+        let (ox, oy) = self.block_offset(index);
+        let (s, w) = (self.config.block_cells, self.geometry.width());
+        let copy_in = |dst: &mut [f32], src: &[f32]| {
+            for r in 0..s {
+                dst[(oy + r) * w + ox..][..s].copy_from_slice(&src[r * s..(r + 1) * s]);
+            }
+        };
+        for (grids, rem, block) in [
+            (&mut self.prior, &mut self.prior_remission, prior),
+            (&mut self.live, &mut self.live_remission, live),
+        ] {
+            let Some(block) = block else { continue };
+            for (g, src) in grids.iter_mut().zip(&block.levels) {
+                copy_in(g.data_mut(), src);
+            }
+            let d = rem.data_mut();
+            for r in 0..s {
+                d[(oy + r) * w + ox..][..s].copy_from_slice(&block.remission[r * s..(r + 1) * s]);
+            }
+        }
+    }
+
+    fn extract(&self, index: BlockIndex, grids: &[Grid<f32>], rem: &Grid<RemissionCell>) -> Block {
+        let (ox, oy) = self.block_offset(index);
+        let (s, w) = (self.config.block_cells, self.geometry.width());
+        let rows = |data: &[f32]| -> Vec<f32> {
+            (0..s)
+                .flat_map(|r| data[(oy + r) * w + ox..][..s].iter().copied())
+                .collect()
+        };
+        Block {
+            index,
+            levels: grids.iter().map(|g| rows(g.data())).collect(),
+            remission: (0..s)
+                .flat_map(|r| rem.data()[(oy + r) * w + ox..][..s].iter().copied())
+                .collect(),
+        }
+    }
+
+    fn extract_live(&self, index: BlockIndex) -> Block {
+        self.extract(index, &self.live, &self.live_remission)
+    }
+
+    /// The live blocks of the window (what a mapping drive saves as the next offline map),
+    /// skipping blocks that hold no information.
+    pub fn live_blocks(&self) -> Vec<Block> {
+        self.window_blocks(self.window_lo)
+            .into_iter()
+            .map(|i| self.extract_live(i))
+            .filter(|b| !b.is_unknown())
+            .collect()
+    }
+
+    /// Writes every informative live block of the window to `store` (e.g. at the end of a mapping drive).
+    pub fn save_live(&self, store: &BlockStore) -> Result<usize> {
+        if store.spec() != &self.spec {
+            return Err(MapError::invalid(
+                "block store",
+                format!(
+                    "{} holds blocks of another map layout",
+                    store.dir().display()
+                ),
+            ));
+        }
+        let blocks = self.live_blocks();
+        for b in &blocks {
+            store.save(b)?;
+        }
+        Ok(blocks.len())
+    }
+
+    /// Flushes the live window to the live store, if there is one. Returns the blocks written.
+    pub fn flush(&self) -> Result<usize> {
+        match &self.live_store {
+            Some(store) => self.save_live(store),
+            None => Ok(0),
+        }
+    }
+
+    /// Inserts one revolution. `vehicle` (its circles) drives the self-hit filter; `None` keeps every return.
+    pub fn insert_scan(
+        &mut self,
+        scan: &Scan,
+        vehicle: Option<&CollisionModel>,
+    ) -> Result<InsertStats> {
+        let beams = scan.beams();
+        let mut stats = InsertStats {
+            hits: vec![0; self.levels.count()],
+            free_cells: vec![0; self.levels.count()],
+            ..Default::default()
+        };
+        self.classify(scan, vehicle, &mut stats);
+
+        let config = self.config;
+        let levels = &self.levels;
+        let classified = &self.classified;
+        let geometry = self.geometry;
+        let results: Vec<(usize, usize)> = self
+            .live
+            .par_iter_mut()
+            .enumerate()
+            .map(|(k, grid)| {
+                insert_level(k, grid, levels, classified, scan, beams, &geometry, &config)
+            })
+            .collect();
+        for (k, (hits, free)) in results.into_iter().enumerate() {
+            stats.hits[k] = hits;
+            stats.free_cells[k] = free;
+            if hits + free > 0 {
+                self.odm_dirty[k] = true;
+            }
+        }
+        // Remission from the returns that are ground for level 0.
+        let rem = self.live_remission.data_mut();
+        for (c, r) in self.classified.iter().zip(scan.returns()) {
+            if let (Some(r), false, true) = (r, c.obstacle, c.cell != DROPPED) {
+                rem[c.cell as usize].add(r.intensity);
+            }
+        }
+        Ok(stats)
+    }
+
+    /// Step 1 of the insertion: drop and classify every return once.
+    fn classify(&mut self, scan: &Scan, vehicle: Option<&CollisionModel>, stats: &mut InsertStats) {
+        let beams = scan.beams();
+        let params = self.config.obstacle_test;
+        let margin = self.config.self_hit_margin_m;
+        let geometry = self.geometry;
+        self.classified.clear();
+        self.classified
+            .resize(scan.returns().len(), Classified::default());
+        let counts: (usize, usize, usize) = self
+            .classified
+            .par_chunks_mut(beams)
+            .zip(scan.returns().par_chunks(beams))
+            .zip(scan.columns().par_iter())
+            .map(|((out, returns), column)| {
+                let sensor = Point2::from(column.world_from_sensor.translation.vector.xy());
+                let sensor3 = nalgebra::Point3::from(column.world_from_sensor.translation.vector);
+                let vehicle_from_world = column.world_from_vehicle.inverse();
+                let (mut n, mut self_hits, mut far) = (0, 0, 0);
+                for b in 0..beams {
+                    out[b] = Classified {
+                        cell: DROPPED,
+                        ..Default::default()
+                    };
+                    let Some(r) = returns[b] else { continue };
+                    n += 1;
+                    let p = r.point_in_world;
+                    let xy = Point2::new(p.x, p.y);
+                    let range_xy = (xy - sensor).norm();
+                    let height = p.z - params.ground_height_m;
+                    let Some(cell) = geometry
+                        .index_of(&xy)
+                        .filter(|_| range_xy <= params.max_range_m)
+                    else {
+                        far += 1;
+                        continue;
+                    };
+                    if let Some(model) = vehicle
+                        && model.is_self_hit(&(vehicle_from_world * xy), height, margin)
+                    {
+                        self_hits += 1;
+                        continue;
+                    }
+                    let obstacle = match b.checked_sub(1).and_then(|lb| returns[lb]) {
+                        Some(lower) => {
+                            obstacle_probability(&sensor3, &lower.point_in_world, &p, &params)
+                                .is_some_and(|pr| pr > 0.5)
+                        }
+                        None => params
+                            .unsafe_height_above_ground_m
+                            .is_some_and(|h| height >= h),
+                    };
+                    out[b] = Classified {
+                        cell: cell as u32,
+                        height_m: height as f32,
+                        range_xy_m: range_xy as f32,
+                        obstacle,
+                    };
+                }
+                (n, self_hits, far)
+            })
+            .reduce(|| (0, 0, 0), |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2));
+        stats.returns = counts.0;
+        stats.self_hits = counts.1;
+        stats.out_of_range = counts.2;
+    }
+
+    /// Recomputes the distance maps of the levels that changed since the last call. Returns how many.
+    pub fn update_distance_maps(&mut self) -> usize {
+        let threshold = self.config.obstacle_threshold;
+        let l_threshold = (threshold / (1.0 - threshold)).ln();
+        let merge = self.config.merge;
+        let mut recomputed = 0;
+        for k in 0..self.levels.count() {
+            if !self.odm_dirty[k] {
+                continue;
+            }
+            let live = self.live[k].data();
+            let prior = self.prior[k].data();
+            let is_obstacle = |i: usize| match merge {
+                MergeMode::Fallback => {
+                    let l = if live[i].is_nan() { prior[i] } else { live[i] };
+                    l > l_threshold
+                }
+                MergeMode::Decay => {
+                    merge_log_odds(live[i], prior[i], merge).is_some_and(|l| l > l_threshold)
+                }
+            };
+            self.odm.levels_mut()[k].recompute(is_obstacle, &mut self.edt_scratch);
+            self.odm_dirty[k] = false;
+            recomputed += 1;
+        }
+        recomputed
+    }
+
+    /// The distance maps (call [`Self::update_distance_maps`] after inserting scans).
+    pub fn distance_maps(&self) -> &DistanceMaps {
+        &self.odm
+    }
+
+    /// Merged log-odds of a level at a world position; `None` when unknown or outside the window.
+    pub fn log_odds_at(&self, level: usize, point: &Point2<f64>) -> Option<f32> {
+        let i = self.geometry.index_of(point)?;
+        merge_log_odds(
+            self.live.get(level)?.data()[i],
+            self.prior[level].data()[i],
+            self.config.merge,
+        )
+    }
+
+    /// Merged occupancy probability of a level at a world position; `None` when unknown or outside.
+    pub fn probability_at(&self, level: usize, point: &Point2<f64>) -> Option<f32> {
+        self.log_odds_at(level, point).map(probability)
+    }
+
+    /// The merged occupancy of a level as probabilities, -1 for unknown (CARMEN's convention);
+    /// `None` past the last level.
+    pub fn probability_grid(&self, level: usize) -> Option<Grid<f32>> {
+        let live = self.live.get(level)?.data();
+        let prior = self.prior[level].data();
+        let merge = self.config.merge;
+        let data = live
+            .iter()
+            .zip(prior)
+            .map(|(l, p)| merge_log_odds(*l, *p, merge).map_or(-1.0, probability))
+            .collect();
+        Grid::from_vec(self.geometry, data).ok()
+    }
+
+    /// The live log-odds of a level (NaN = unknown).
+    pub fn live_log_odds(&self, level: usize) -> Option<&Grid<f32>> {
+        self.live.get(level)
+    }
+    /// The prior (offline) log-odds of a level (NaN = unknown).
+    pub fn prior_log_odds(&self, level: usize) -> Option<&Grid<f32>> {
+        self.prior.get(level)
+    }
+
+    /// Remission statistics of a cell: offline and live samples together.
+    pub fn remission_at(&self, point: &Point2<f64>) -> Option<RemissionCell> {
+        let i = self.geometry.index_of(point)?;
+        Some(self.live_remission.data()[i].merged(&self.prior_remission.data()[i]))
+    }
+    /// The remission layer of the window, offline and live samples together.
+    pub fn remission_grid(&self) -> Grid<RemissionCell> {
+        let data = self
+            .live_remission
+            .data()
+            .iter()
+            .zip(self.prior_remission.data())
+            .map(|(l, p)| l.merged(p))
+            .collect();
+        Grid::from_vec(self.geometry, data)
+            .unwrap_or_else(|_| Grid::filled(self.geometry, RemissionCell::default()))
+    }
+}
+
+/// Merged log-odds of a live and a prior value (NaN = unknown); `None` when both are unknown.
+#[inline]
+pub fn merge_log_odds(live: f32, prior: f32, mode: MergeMode) -> Option<f32> {
+    match (live.is_nan(), prior.is_nan()) {
+        (true, true) => None,
+        (false, true) => Some(live),
+        (true, false) => Some(prior),
+        (false, false) => match mode {
+            MergeMode::Fallback => Some(live),
+            MergeMode::Decay => {
+                let p = (10.0 * probability(live) + probability(prior)) / 11.0;
+                Some((p / (1.0 - p)).ln())
+            }
+        },
+    }
+}
+
+/// Moves a grid's content by (-dx, -dy) cells (the window moved by (dx, dy)); uncovered cells get `fill`.
+fn shift<T: Copy>(grid: &mut Grid<T>, dx: i64, dy: i64, fill: T) {
+    let (w, h) = (
+        grid.geometry().width() as i64,
+        grid.geometry().height() as i64,
+    );
+    let old = grid.data().to_vec();
+    let data = grid.data_mut();
+    data.fill(fill);
+    for y in 0..h {
+        let sy = y + dy;
+        if !(0..h).contains(&sy) {
+            continue;
+        }
+        let (x0, x1) = ((-dx).max(0), (w - dx).min(w));
+        if x0 >= x1 {
+            continue;
+        }
+        let dst = (y * w + x0) as usize..(y * w + x1) as usize;
+        let src = (sy * w + x0 + dx) as usize..(sy * w + x1 + dx) as usize;
+        data[dst].copy_from_slice(&old[src]);
+    }
+}
+
+/// Steps 2-4 of the insertion for one level. Returns (obstacle hits, free cells updated).
+#[allow(clippy::too_many_arguments)]
+fn insert_level(
+    k: usize,
+    grid: &mut Grid<f32>,
+    levels: &Levels,
+    classified: &[Classified],
+    scan: &Scan,
+    beams: usize,
+    geometry: &GridGeometry,
+    config: &MapConfig,
+) -> (usize, usize) {
+    let occ = config.occupancy;
+    let h_lo = levels.heights_m()[k] as f32;
+    let h_hi = levels.upper_m(k) as f32;
+    let class = |c: &Classified| {
+        if c.height_m < h_lo {
+            HeightClass::Below
+        } else if c.height_m < h_hi {
+            HeightClass::Inside
+        } else {
+            HeightClass::Above
+        }
+    };
+    let data = grid.data_mut();
+    let add = |v: &mut f32, delta: f32| {
+        let cur = if v.is_nan() { 0.0 } else { *v };
+        *v = (cur + delta).clamp(-occ.l_max, occ.l_max);
+    };
+    // Hits first, so this scan's obstacles already stop this scan's free-space walks.
+    let mut hits = 0;
+    for column in classified.chunks_exact(beams) {
+        let nearest = column
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.cell != DROPPED && c.obstacle && class(c) == HeightClass::Inside)
+            .min_by(|a, b| a.1.range_xy_m.total_cmp(&b.1.range_xy_m))
+            .map(|(b, _)| b);
+        let Some(nearest) = nearest else { continue };
+        for (b, c) in column.iter().enumerate() {
+            if c.cell != DROPPED && c.obstacle && class(c) == HeightClass::Inside {
+                add(
+                    &mut data[c.cell as usize],
+                    if b == nearest {
+                        2.0 * occ.l_occ
+                    } else {
+                        occ.l_occ
+                    },
+                );
+                hits += 1;
+            }
+        }
+    }
+    // One free-space walk per column, to the farthest return this level considers.
+    let mut free = 0;
+    let (w, h) = (geometry.width() as i64, geometry.height() as i64);
+    for (ci, column) in classified.chunks_exact(beams).enumerate() {
+        let far = column
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.cell != DROPPED && class(c) != HeightClass::Above)
+            .max_by(|a, b| a.1.range_xy_m.total_cmp(&b.1.range_xy_m));
+        let Some((b, _)) = far else { continue };
+        let sensor = scan.columns()[ci].world_from_sensor.translation.vector;
+        let Some(end) = scan.returns()[ci * beams + b] else {
+            continue;
+        };
+        let (x0, y0) = geometry.cell_coords(&Point2::new(sensor.x, sensor.y));
+        let (x1, y1) =
+            geometry.cell_coords(&Point2::new(end.point_in_world.x, end.point_in_world.y));
+        free += walk_free(
+            data,
+            w,
+            h,
+            (x0, y0),
+            (x1, y1),
+            config.free_space_stop_cells,
+            occ.l_free,
+            occ.l_max,
+        );
+    }
+    (hits, free)
+}
+
+/// Bresenham walk from `a` to `b` adding `l_free` to each cell but the last `stop_short` ones,
+/// stopping at the first known cell with p >= 0.5 or at the window's edge. Returns the cells updated.
+#[allow(clippy::too_many_arguments)]
+fn walk_free(
+    data: &mut [f32],
+    w: i64,
+    h: i64,
+    a: (i64, i64),
+    b: (i64, i64),
+    stop_short: usize,
+    l_free: f32,
+    l_max: f32,
+) -> usize {
+    let (dx, dy) = ((b.0 - a.0).abs(), -(b.1 - a.1).abs());
+    let (sx, sy) = ((b.0 - a.0).signum(), (b.1 - a.1).signum());
+    let cells = dx.max(-dy) + 1;
+    let steps = (cells - stop_short as i64).max(0);
+    let (mut x, mut y, mut err) = (a.0, a.1, dx + dy);
+    let mut updated = 0;
+    for _ in 0..steps {
+        if x < 0 || y < 0 || x >= w || y >= h {
+            break;
+        }
+        let v = &mut data[(y * w + x) as usize];
+        if *v >= 0.0 {
+            break; // p >= 0.5 (NaN, unknown, compares false)
+        }
+        let cur = if v.is_nan() { 0.0 } else { *v };
+        *v = (cur + l_free).max(-l_max);
+        updated += 1;
+        let e2 = 2 * err;
+        if e2 >= dy {
+            err += dy;
+            x += sx;
+        }
+        if e2 <= dx {
+            err += dx;
+            y += sy;
+        }
+    }
+    updated
+}

@@ -1,0 +1,120 @@
+//! One LiDAR revolution as the mapper takes it: columns (azimuth) x beams (vertical order).
+//!
+//! The obstacle test compares each beam with the one below it in the same column, so the
+//! organisation matters: `returns[column * beams + beam]`, beam 0 the lowest. Each column carries
+//! the sensor pose at its firing time (so motion during the sweep is representable) and the
+//! vehicle pose (for the self-hit filter). A beam with no echo is `None`.
+
+use nalgebra::{Isometry2, Isometry3, Point3};
+
+use crate::error::{MapError, Result};
+
+/// One echo of one beam.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Return {
+    /// The hit point in the world frame.
+    pub point_in_world: Point3<f64>,
+    /// Range along the beam, metres.
+    pub range_m: f32,
+    /// Calibrated intensity (remission), 0..1 by convention.
+    pub intensity: f32,
+}
+
+/// The poses of one column at its firing time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScanColumn {
+    /// Pose of the sensor in the world.
+    pub world_from_sensor: Isometry3<f64>,
+    /// Planar pose of the vehicle (rear axle centre) in the world.
+    pub world_from_vehicle: Isometry2<f64>,
+}
+
+/// One revolution, organised as columns x beams.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Scan {
+    beams: usize,
+    columns: Vec<ScanColumn>,
+    returns: Vec<Option<Return>>,
+}
+
+impl Scan {
+    /// A scan of `columns.len()` columns of `beams` returns each (`returns[column * beams + beam]`,
+    /// beam 0 lowest). Every number must be finite and ranges >= 0.
+    pub fn new(
+        beams: usize,
+        columns: Vec<ScanColumn>,
+        returns: Vec<Option<Return>>,
+    ) -> Result<Self> {
+        if beams == 0 {
+            return Err(MapError::invalid("scan", "0 beams per column"));
+        }
+        if returns.len() != beams * columns.len() {
+            return Err(MapError::invalid(
+                "scan",
+                format!(
+                    "{} returns for {} columns x {beams} beams",
+                    returns.len(),
+                    columns.len()
+                ),
+            ));
+        }
+        for (c, col) in columns.iter().enumerate() {
+            let t = col.world_from_sensor.translation.vector;
+            let v = col.world_from_vehicle.translation.vector;
+            if !(t.iter().all(|x| x.is_finite())
+                && v.iter().all(|x| x.is_finite())
+                && col.world_from_vehicle.rotation.angle().is_finite())
+            {
+                return Err(MapError::invalid(
+                    "scan column pose",
+                    format!("column {c}: pose is not finite"),
+                ));
+            }
+        }
+        for (i, r) in returns.iter().enumerate() {
+            if let Some(r) = r {
+                let ok = r.point_in_world.iter().all(|x| x.is_finite())
+                    && r.range_m.is_finite()
+                    && r.range_m >= 0.0
+                    && r.intensity.is_finite();
+                if !ok {
+                    return Err(MapError::invalid(
+                        "scan return",
+                        format!(
+                            "column {} beam {}: {r:?} has a non-finite value or a negative range",
+                            i / beams,
+                            i % beams
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(Scan {
+            beams,
+            columns,
+            returns,
+        })
+    }
+
+    /// Beams per column.
+    pub fn beams(&self) -> usize {
+        self.beams
+    }
+    /// Number of columns.
+    pub fn column_count(&self) -> usize {
+        self.columns.len()
+    }
+    /// The columns' poses.
+    pub fn columns(&self) -> &[ScanColumn] {
+        &self.columns
+    }
+    /// All returns, column after column.
+    pub fn returns(&self) -> &[Option<Return>] {
+        &self.returns
+    }
+    /// One column: its poses and its returns, lowest beam first.
+    pub fn column(&self, c: usize) -> Option<(&ScanColumn, &[Option<Return>])> {
+        let col = self.columns.get(c)?;
+        Some((col, &self.returns[c * self.beams..(c + 1) * self.beams]))
+    }
+}

@@ -1,0 +1,438 @@
+//! Scan insertion, levels, merge, window and block files, checked on analytic scenes.
+
+use mapper::synthetic::{Lidar, Scene, Solid, car_sensor_mount};
+use mapper::{Circle, CollisionModel, LevelMode, Levels, MapConfig, MergeMode, MultiHeightMap};
+use nalgebra::{Isometry2, Point2, Vector2};
+use rand::RngExt;
+use rand::SeedableRng;
+use rand::distr::Distribution;
+
+fn scene(solids: Vec<Solid>) -> Scene {
+    Scene {
+        solids,
+        ground_intensity: 0.3,
+        solid_intensity: 0.8,
+    }
+}
+
+fn scan_from(scene: &Scene, x: f64, y: f64) -> mapper::Scan {
+    Lidar::hdl32e()
+        .scan(
+            scene,
+            &Isometry2::new(Vector2::new(x, y), 0.0),
+            &car_sensor_mount(),
+            |_, _| 0.0,
+        )
+        .unwrap()
+}
+
+fn map_with(levels: Levels) -> MultiHeightMap {
+    MultiHeightMap::new(MapConfig::default(), levels, Point2::origin()).unwrap()
+}
+
+fn p(level: &MultiHeightMap, k: usize, x: f64, y: f64) -> Option<f32> {
+    level.probability_at(k, &Point2::new(x, y))
+}
+
+/// The highest known probability of a level within `r` metres of (x, y): obstacles are mapped
+/// on their faces, so presence is tested around an object, not at its centre.
+fn max_p_near(map: &MultiHeightMap, k: usize, x: f64, y: f64, r: f64) -> Option<f32> {
+    let steps = (r / 0.1).ceil() as i64;
+    let mut best: Option<f32> = None;
+    for i in -steps..=steps {
+        for j in -steps..=steps {
+            let (dx, dy) = (i as f64 * 0.1, j as f64 * 0.1);
+            if dx * dx + dy * dy <= r * r
+                && let Some(v) = p(map, k, x + dx, y + dy)
+            {
+                best = Some(best.map_or(v, |b: f32| b.max(v)));
+            }
+        }
+    }
+    best
+}
+
+fn insert(map: &mut MultiHeightMap, scene: &Scene, times: usize) {
+    let scan = scan_from(scene, 0.0, 0.0);
+    for _ in 0..times {
+        map.insert_scan(&scan, None).unwrap();
+    }
+}
+
+#[test]
+fn a_wall_at_3_m_is_occupied_with_free_space_before_it_and_unknown_behind() {
+    let scene = scene(vec![Solid::Box {
+        min: [3.0, -10.0, 0.0].into(),
+        max: [3.2, 10.0, 3.0].into(),
+    }]);
+    let mut map = map_with(Levels::cumulative(vec![0.0, 0.7]).unwrap());
+    insert(&mut map, &scene, 1);
+    for k in 0..2 {
+        for y in [-1.5, -0.5, 0.0, 0.7, 1.3] {
+            assert!(
+                p(&map, k, 3.1, y).unwrap() > 0.9,
+                "level {k}: wall at y={y}"
+            );
+            assert!(
+                p(&map, k, 2.0, y).unwrap() < 0.1,
+                "level {k}: free before the wall at y={y}"
+            );
+            assert_eq!(
+                p(&map, k, 6.0, y),
+                None,
+                "level {k}: behind the wall is unknown"
+            );
+        }
+    }
+    // The free walk stops 2 cells short of the hit: the cell just before the wall face is untouched.
+    assert_eq!(p(&map, 0, 2.9, 0.1), None);
+}
+
+#[test]
+fn a_cone_is_in_level_0_only_and_a_container_in_both() {
+    let cone = Solid::post(6.0, 0.0, 0.2, 0.45);
+    let container = Solid::standing_box(6.0, 5.0, 0.8, 0.6, 1.1);
+    let scene = scene(vec![cone, container]);
+    let mut map = map_with(Levels::cumulative(vec![0.0, 0.7]).unwrap());
+    insert(&mut map, &scene, 3);
+    map.update_distance_maps();
+    let odm = map.distance_maps();
+    let d = |k: usize, x: f64, y: f64| odm.level(k).unwrap().distance_at(&Point2::new(x, y));
+    assert!(d(0, 6.0, 0.0) < 0.3, "cone in level 0: {}", d(0, 6.0, 0.0));
+    assert!(
+        d(1, 6.0, 0.0) > 2.0,
+        "cone not in level 1: {}",
+        d(1, 6.0, 0.0)
+    );
+    assert!(
+        d(0, 5.65, 5.0) < 0.3,
+        "container in level 0: {}",
+        d(0, 5.65, 5.0)
+    );
+    assert!(
+        d(1, 5.65, 5.0) < 0.3,
+        "container in level 1: {}",
+        d(1, 5.65, 5.0)
+    );
+    // Level 1 saw the cone's cells as flat ground: they are free there, not unknown.
+    assert!(p(&map, 1, 6.0, 0.0).is_some_and(|v| v < 0.5));
+}
+
+#[test]
+fn banded_levels_put_a_hanging_bar_only_in_its_band() {
+    let bar = Solid::Box {
+        min: [8.0, -3.0, 2.2].into(),
+        max: [8.4, 3.0, 2.8].into(),
+    };
+    let scene = scene(vec![bar]);
+    let levels = Levels::new(vec![0.0, 2.0, 3.0], LevelMode::Banded, Some(6.0)).unwrap();
+    let mut map = map_with(levels);
+    insert(&mut map, &scene, 2);
+    assert!(p(&map, 1, 8.1, 0.0).unwrap() > 0.9, "bar in band [2, 3)");
+    assert!(
+        p(&map, 0, 8.1, 0.0).is_none_or(|v| v < 0.5),
+        "bar not in band [0, 2)"
+    );
+    assert!(
+        p(&map, 2, 8.1, 0.0).is_none_or(|v| v < 0.5),
+        "bar not in band [3, 6)"
+    );
+    // Cumulative from 0 would hold it in level 0: the difference between the interpretations.
+    let mut cumulative = map_with(Levels::cumulative(vec![0.0, 2.0, 3.0]).unwrap());
+    insert(&mut cumulative, &scene, 2);
+    assert!(p(&cumulative, 0, 8.1, 0.0).unwrap() > 0.9);
+}
+
+#[test]
+fn flat_ground_with_range_noise_produces_no_obstacle_at_any_range() {
+    let lidar = Lidar::hdl32e();
+    let mut map = map_with(Levels::cumulative(vec![0.0, 0.7]).unwrap());
+    let normal = rand_distr_normal();
+    for seed in 0..3u64 {
+        // Seeded 2 cm Gaussian range noise (the HDL-32E's accuracy), a fresh draw per ray.
+        let noise: Vec<f64> = {
+            let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+            (0..lidar.columns * 32)
+                .map(|_| normal.sample(&mut rng))
+                .collect()
+        };
+        let scan = lidar
+            .scan(
+                &scene(vec![]),
+                &Isometry2::new(Vector2::new(0.0, 0.0), 0.3),
+                &car_sensor_mount(),
+                |c, b| noise[c * 32 + b],
+            )
+            .unwrap();
+        let stats = map.insert_scan(&scan, None).unwrap();
+        assert_eq!(stats.hits, vec![0, 0], "seed {seed}");
+        assert!(stats.free_cells[0] > 100_000);
+    }
+    map.update_distance_maps();
+    for k in 0..2 {
+        let grid = map.probability_grid(k).unwrap();
+        assert!(
+            grid.data().iter().all(|&v| v < 0.5),
+            "level {k} has an obstacle cell"
+        );
+        assert!(
+            grid.data().iter().filter(|&&v| v >= 0.0).count() > 30_000,
+            "level {k}: ground seen as free"
+        );
+    }
+}
+
+/// N(0, 0.02) with rand only: Box-Muller over two uniforms.
+fn rand_distr_normal() -> impl Distribution<f64> {
+    struct Normal;
+    impl Distribution<f64> for Normal {
+        fn sample<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> f64 {
+            let (u1, u2): (f64, f64) = (rng.random_range(1e-12..1.0), rng.random());
+            0.02 * (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+        }
+    }
+    Normal
+}
+
+#[test]
+fn self_hits_are_dropped_only_for_the_parts_that_can_make_them() {
+    // A "wing" board at 0.9-1.0 m, 1-2 m left of the sensor, and a cone under it.
+    let wing = Solid::Box {
+        min: [0.5, 1.0, 0.9].into(),
+        max: [1.5, 2.0, 1.0].into(),
+    };
+    let cone = Solid::post(1.0, 1.5, 0.1, 0.45);
+    let scene = scene(vec![wing, cone]);
+    let model = CollisionModel::new(
+        vec![
+            Circle {
+                x_m: 0.0,
+                y_m: 0.0,
+                radius_m: 0.5,
+                level: 0,
+            },
+            Circle {
+                x_m: 1.0,
+                y_m: 1.5,
+                radius_m: 0.7,
+                level: 1,
+            },
+        ],
+        vec![0.0, 0.7],
+    )
+    .unwrap();
+    let config = MapConfig {
+        self_hit_margin_m: 0.0,
+        ..Default::default()
+    };
+    let mut map = MultiHeightMap::new(
+        config,
+        Levels::cumulative(vec![0.0, 0.7]).unwrap(),
+        Point2::origin(),
+    )
+    .unwrap();
+    let scan = scan_from(&scene, 0.0, 0.0);
+    let stats = map.insert_scan(&scan, Some(&model)).unwrap();
+    assert!(stats.self_hits > 0);
+    assert!(
+        p(&map, 1, 1.0, 1.5).is_none_or(|v| v < 0.5),
+        "the wing is not mapped as an obstacle"
+    );
+    // Under the wing, the cone (below the wing's level height) is still seen.
+    let mut without = MultiHeightMap::new(
+        config,
+        Levels::cumulative(vec![0.0, 0.7]).unwrap(),
+        Point2::origin(),
+    )
+    .unwrap();
+    without.insert_scan(&scan, None).unwrap();
+    assert!(
+        p(&without, 1, 1.2, 1.2).unwrap() > 0.5,
+        "without the filter the wing is an obstacle"
+    );
+}
+
+#[test]
+fn the_online_map_takes_unknown_cells_from_the_offline_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let levels = Levels::cumulative(vec![0.0, 0.7]).unwrap();
+    // Mapping drive: a parked box at (10, 0) and a pillar at (0, 10).
+    let offline_scene = scene(vec![
+        Solid::standing_box(10.0, 0.0, 1.0, 1.0, 1.5),
+        Solid::post(0.0, 10.0, 0.3, 3.0),
+    ]);
+    let mut mapping = map_with(levels.clone());
+    insert(&mut mapping, &offline_scene, 2);
+    let store = mapper::BlockStore::open(dir.path(), mapping.block_spec().clone()).unwrap();
+    assert!(mapping.save_live(&store).unwrap() > 0);
+
+    // Online: the parked box left, a cone appeared at (5, 0); the pillar is hidden behind a wall.
+    let online_scene = scene(vec![
+        Solid::post(5.0, -3.0, 0.2, 0.45),
+        Solid::Box {
+            min: [-3.0, 5.0, 0.0].into(),
+            max: [3.0, 5.2, 3.0].into(),
+        },
+    ]);
+    let mut online = MultiHeightMap::with_stores(
+        MapConfig::default(),
+        levels,
+        Point2::origin(),
+        Some(dir.path()),
+        None,
+    )
+    .unwrap();
+    assert!(
+        max_p_near(&online, 0, 10.0, 0.0, 0.7).unwrap() > 0.9,
+        "before any scan the prior shows the parked box"
+    );
+    insert(&mut online, &online_scene, 2);
+    assert!(
+        max_p_near(&online, 0, 5.0, -3.0, 0.4).unwrap() > 0.9,
+        "the new cone is in the online map"
+    );
+    assert!(
+        max_p_near(&online, 0, 10.0, 0.0, 0.7).unwrap() < 0.5,
+        "the box that left is seen free again"
+    );
+    assert!(
+        max_p_near(&online, 0, 0.0, 10.0, 0.5).unwrap() > 0.9,
+        "the hidden pillar comes from the offline map"
+    );
+    assert!(
+        online
+            .live_log_odds(0)
+            .unwrap()
+            .at(&Point2::new(0.0, 9.75))
+            .unwrap()
+            .is_nan(),
+        "the live map never saw the pillar"
+    );
+
+    // Decay blend: a cell both know mixes 10:1 in probability.
+    let mut decay = MultiHeightMap::with_stores(
+        MapConfig {
+            merge: MergeMode::Decay,
+            ..Default::default()
+        },
+        Levels::cumulative(vec![0.0, 0.7]).unwrap(),
+        Point2::origin(),
+        Some(dir.path()),
+        None,
+    )
+    .unwrap();
+    insert(&mut decay, &online_scene, 2);
+    let pb = max_p_near(&decay, 0, 10.0, 0.0, 0.7).unwrap();
+    assert!(
+        pb > 0.05 && pb < 0.5,
+        "decay keeps a trace of the prior: {pb}"
+    );
+}
+
+#[test]
+fn recentring_saves_and_reloads_blocks_with_their_cells() {
+    let live_dir = tempfile::tempdir().unwrap();
+    let levels = Levels::cumulative(vec![0.0, 0.7]).unwrap();
+    let mut map = MultiHeightMap::with_stores(
+        MapConfig::default(),
+        levels,
+        Point2::origin(),
+        None,
+        Some(live_dir.path()),
+    )
+    .unwrap();
+    insert(
+        &mut map,
+        &scene(vec![Solid::standing_box(8.0, 3.0, 1.0, 1.0, 1.2)]),
+        2,
+    );
+    let before = map.probability_grid(0).unwrap();
+    let at = Point2::new(7.5, 3.0); // on the box's near face
+    let p_before = map.probability_at(0, &at).unwrap();
+
+    // One block east: the window moves by 70 m, cells move with their world positions.
+    assert!(map.recenter(Point2::new(75.0, 0.0)).unwrap());
+    assert_eq!(map.probability_at(0, &at), Some(p_before));
+    // Far away: the whole window goes to disk.
+    assert!(map.recenter(Point2::new(1000.0, 1000.0)).unwrap());
+    assert_eq!(map.probability_at(0, &at), None);
+    assert!(
+        !map.recenter(Point2::new(1001.0, 1001.0)).unwrap(),
+        "same middle block: no move"
+    );
+    // Back: every cell as it was.
+    assert!(map.recenter(Point2::origin()).unwrap());
+    assert_eq!(map.probability_grid(0).unwrap().data(), before.data());
+}
+
+#[test]
+fn bad_block_files_are_errors_that_name_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let levels = Levels::cumulative(vec![0.0, 0.7]).unwrap();
+    let mut map = map_with(levels.clone());
+    insert(&mut map, &scene(vec![Solid::post(4.0, 4.0, 0.3, 1.0)]), 1);
+    let store = mapper::BlockStore::open(dir.path(), map.block_spec().clone()).unwrap();
+    map.save_live(&store).unwrap();
+    let index = mapper::BlockIndex { x: 0, y: 0 };
+    let path = store.path(index);
+    let good = std::fs::read(&path).unwrap();
+    let loaded = store.load(index).unwrap().unwrap();
+    let original = map
+        .live_blocks()
+        .into_iter()
+        .find(|b| b.index == index)
+        .unwrap();
+    let bits = |b: &mapper::Block| {
+        b.levels
+            .iter()
+            .flatten()
+            .map(|v| v.to_bits())
+            .collect::<Vec<_>>()
+    };
+    assert!(
+        bits(&loaded) == bits(&original) && loaded.remission == original.remission,
+        "block round trip changed cells"
+    );
+
+    let open = |bytes: &[u8]| {
+        std::fs::write(&path, bytes).unwrap();
+        let err = MultiHeightMap::with_stores(
+            MapConfig::default(),
+            levels.clone(),
+            Point2::origin(),
+            Some(dir.path()),
+            None,
+        )
+        .unwrap_err();
+        err.to_string()
+    };
+    let mut flipped = good.clone();
+    flipped[good.len() / 2] ^= 0x40;
+    let e = open(&flipped);
+    assert!(
+        e.contains("block_0_0.tsmb") && e.contains("checksum"),
+        "{e}"
+    );
+    let e = open(&good[..good.len() - 100]);
+    assert!(
+        e.contains("block_0_0.tsmb") && e.contains("truncated"),
+        "{e}"
+    );
+    let e = open(&good[..20]);
+    assert!(e.contains("block_0_0.tsmb"), "{e}");
+    let e = open(b"");
+    assert!(e.contains("block_0_0.tsmb") && e.contains("magic"), "{e}");
+    // A block of a map with other levels is refused by field name.
+    std::fs::write(&path, &good).unwrap();
+    let other = Levels::cumulative(vec![0.0, 0.5]).unwrap();
+    let err = MultiHeightMap::with_stores(
+        MapConfig::default(),
+        other,
+        Point2::origin(),
+        Some(dir.path()),
+        None,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("heights[1]"), "{err}");
+}
