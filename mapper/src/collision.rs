@@ -6,9 +6,10 @@
 //! `obstacle_avoider_multi_height`). In banded mode a part is checked against every band from
 //! its own level up. The check reports the *margin* `d - (r + safety)`: negative means collision.
 //!
-//! Far from everything a pose costs one lookup: if the distance at the centre of the bounding
-//! circle exceeds its radius plus the safety distance plus one cell diagonal (the slack of the
-//! cell-lookup), no circle can be closer than its own radius plus the safety distance.
+//! Far from everything a pose costs one lookup: if the bounding circle lies inside the map and
+//! the distance at its centre exceeds its radius plus the safety distance plus one cell diagonal
+//! (the slack of the cell lookup), no circle can be closer than its own radius plus the safety
+//! distance (the distance map is 1-Lipschitz).
 
 use nalgebra::{Isometry2, Point2};
 use serde::{Deserialize, Serialize};
@@ -212,7 +213,19 @@ impl CollisionChecker<'_> {
                 .map(|m| m.distance_at(&centre))
                 .fold(f32::INFINITY, f32::min),
         };
-        if d > bound {
+        // Outside the map reads 0, so the bound only holds when the bounding circle is inside it.
+        let g = self.maps.geometry();
+        let reach = b.radius_m + g.resolution_m();
+        let (lo, hi) = (
+            g.origin_m(),
+            g.origin_m()
+                + nalgebra::Vector2::new(g.width() as f64, g.height() as f64) * g.resolution_m(),
+        );
+        let inside = centre.x - reach >= lo.x
+            && centre.x + reach < hi.x
+            && centre.y - reach >= lo.y
+            && centre.y + reach < hi.y;
+        if inside && d > bound {
             return PoseCheck {
                 margin_m: d - bound,
                 nearest_circle: None,

@@ -2,7 +2,8 @@
 //!
 //! ROS maps follow `map_saver`'s trinary convention so Nav2 and RViz load them as they are:
 //! binary PGM (`P5`), rows written top (highest y) first, 254 free, 0 occupied, 205 unknown;
-//! the YAML's `origin` is the world position of the lower-left pixel. `.npy` arrays are float32,
+//! the YAML's `origin` is the world position of the lower-left pixel, and its thresholds are
+//! map_saver's (0.65 / 0.196) so 205 reads back as unknown. `.npy` arrays are float32,
 //! shape (rows, columns), row 0 = lowest y (so `array[iy, ix]` matches the grid's cells).
 //! Every file is written atomically.
 
@@ -146,8 +147,11 @@ pub fn write_ros_map(
         resolution: g.resolution_m(),
         origin: [g.origin_m().x, g.origin_m().y, 0.0],
         negate: 0,
-        occupied_thresh: thresholds.occupied as f64,
-        free_thresh: thresholds.free as f64,
+        // The thresholds the *reader* applies to pixels (map_saver's): 254 -> 0.004 free,
+        // 0 -> 1.0 occupied, 205 -> 0.196, not below 0.196, so unknown. A 0.25 here would
+        // turn every unknown pixel into free space on reload.
+        occupied_thresh: 0.65,
+        free_thresh: 0.196,
         mode: Some("trinary".into()),
     };
     let text = serde_yaml_ng::to_string(&yaml)
