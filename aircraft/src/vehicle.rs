@@ -1,0 +1,109 @@
+//! A vehicle: its sidecar spec plus its collision parts in the vehicle frame; the shipped
+//! vehicles, and loading one by name or by sidecar path.
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::fit::{FitOptions, FittedModel, fit_parts};
+use crate::shapes::Part;
+use crate::spec::VehicleSpec;
+
+/// Names of the vehicles shipped in `aircraft/vehicles/`.
+pub const SHIPPED_VEHICLES: [&str; 3] = ["praetor600", "iara_car", "iara_car_fake_wing"];
+
+macro_rules! shipped {
+    ($name:literal) => {
+        (
+            $name,
+            concat!(env!("CARGO_MANIFEST_DIR"), "/vehicles/", $name, ".toml"),
+            include_str!(concat!("../vehicles/", $name, ".toml")),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/vehicles/", $name, ".urdf"),
+            include_str!(concat!("../vehicles/", $name, ".urdf")),
+        )
+    };
+}
+
+/// (name, sidecar path, sidecar text, URDF path, URDF text) of each shipped vehicle.
+const SHIPPED: [(&str, &str, &str, &str, &str); 3] = [
+    shipped!("praetor600"),
+    shipped!("iara_car"),
+    shipped!("iara_car_fake_wing"),
+];
+
+/// A described vehicle.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Vehicle {
+    /// What the sidecar says.
+    pub spec: VehicleSpec,
+    /// Every collision primitive, in the vehicle frame.
+    pub parts: Vec<Part>,
+}
+
+impl Vehicle {
+    /// A vehicle from sidecar and URDF texts; the file names label errors.
+    pub fn from_strs(
+        spec_toml: &str,
+        spec_file: &str,
+        urdf: &str,
+        urdf_file: &str,
+    ) -> Result<Self> {
+        let spec = VehicleSpec::from_str(spec_toml, spec_file)?;
+        let parts = crate::urdf::parts_from_str(urdf, urdf_file)?;
+        Ok(Vehicle { spec, parts })
+    }
+
+    /// Reads a sidecar file and the URDF it names (relative to the sidecar's directory).
+    pub fn from_file(spec_path: &Path) -> Result<Self> {
+        let read = |path: &Path| {
+            std::fs::read_to_string(path).map_err(|source| Error::Io {
+                path: path.to_path_buf(),
+                source,
+            })
+        };
+        let spec_text = read(spec_path)?;
+        let spec_file = spec_path.display().to_string();
+        let spec = VehicleSpec::from_str(&spec_text, &spec_file)?;
+        let urdf_path = spec_path
+            .parent()
+            .unwrap_or_else(|| Path::new("."))
+            .join(&spec.urdf);
+        let urdf_text = read(&urdf_path)?;
+        let parts = crate::urdf::parts_from_str(&urdf_text, &urdf_path.display().to_string())?;
+        Ok(Vehicle { spec, parts })
+    }
+
+    /// A shipped vehicle by name (compiled in: works wherever the binary runs).
+    pub fn shipped(name: &str) -> Result<Self> {
+        let (_, spec_file, spec_text, urdf_file, urdf_text) = SHIPPED
+            .iter()
+            .find(|s| s.0 == name)
+            .ok_or_else(|| Error::UnknownVehicle {
+                name: name.to_string(),
+                known: SHIPPED_VEHICLES.join(", "),
+            })?;
+        Vehicle::from_strs(spec_text, spec_file, urdf_text, urdf_file)
+    }
+
+    /// A shipped vehicle name, or else a path to a sidecar file.
+    pub fn load(name_or_path: &str) -> Result<Self> {
+        if SHIPPED_VEHICLES.contains(&name_or_path) {
+            Vehicle::shipped(name_or_path)
+        } else {
+            Vehicle::from_file(Path::new(name_or_path))
+        }
+    }
+
+    /// Fits the circle model with the spec's heights of interest and fit options.
+    pub fn fit(&self) -> Result<FittedModel> {
+        fit_parts(
+            &self.parts,
+            &self.spec.heights_of_interest_m,
+            &self.spec.fit,
+        )
+    }
+
+    /// Fits the circle model with other heights or options.
+    pub fn fit_with(&self, heights_m: &[f64], options: &FitOptions) -> Result<FittedModel> {
+        fit_parts(&self.parts, heights_m, options)
+    }
+}
