@@ -8,9 +8,9 @@ use crate::error::{Error, Result};
 
 /// Reads a CARMEN collision file (thin wrapper over [`from_carmen_str`]).
 pub fn from_carmen_file(path: &Path, level_heights_m: &[f64]) -> Result<mapper::CollisionModel> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+    let text = std::fs::read_to_string(path).map_err(|error| Error::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     from_carmen_str(&text, &path.display().to_string(), level_heights_m)
 }
@@ -96,9 +96,9 @@ pub fn from_carmen_str(
             format!("declares {count} circle(s) but {} follow", circles.len()),
         ));
     }
-    mapper::CollisionModel::new(circles, level_heights_m.to_vec()).map_err(|source| Error::Model {
+    mapper::CollisionModel::new(circles, level_heights_m.to_vec()).map_err(|error| Error::Model {
         context: file.to_string(),
-        source,
+        error,
     })
 }
 

@@ -11,12 +11,12 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// A file could not be read or written.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
-        /// The underlying error.
-        source: std::io::Error,
+        /// The underlying error (in the message, not repeated as a source).
+        error: std::io::Error,
     },
     /// urdf-rs rejected the XML.
     #[error("{file}: invalid URDF: {message}")]
@@ -126,12 +126,12 @@ pub enum Error {
         known: String,
     },
     /// The collision model type rejected the circles or heights.
-    #[error("{context}: {source}")]
+    #[error("{context}: {error}")]
     Model {
         /// Where the model was being built.
         context: String,
-        /// The mapper error.
-        source: mapper::MapError,
+        /// The mapper error (in the message, not repeated as a source).
+        error: mapper::MapError,
     },
 }
 

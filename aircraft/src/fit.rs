@@ -379,12 +379,11 @@ pub fn fit_parts(parts: &[Part], heights_m: &[f64], options: &FitOptions) -> Res
             });
         }
     }
-    let model = mapper::CollisionModel::new(circles, heights_m.to_vec()).map_err(|source| {
-        Error::Model {
+    let model =
+        mapper::CollisionModel::new(circles, heights_m.to_vec()).map_err(|error| Error::Model {
             context: "fitted model".into(),
-            source,
-        }
-    })?;
+            error,
+        })?;
     Ok(FittedModel {
         model,
         levels,

@@ -16,9 +16,9 @@ use crate::shapes::{Part, Shape};
 
 /// Reads a URDF file into vehicle-frame parts (a thin wrapper over [`parts_from_str`]).
 pub fn parts_from_file(path: &Path) -> Result<Vec<Part>> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+    let text = std::fs::read_to_string(path).map_err(|error| Error::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     parts_from_str(&text, &path.display().to_string())
 }

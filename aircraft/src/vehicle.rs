@@ -55,9 +55,9 @@ impl Vehicle {
     /// Reads a sidecar file and the URDF it names (relative to the sidecar's directory).
     pub fn from_file(spec_path: &Path) -> Result<Self> {
         let read = |path: &Path| {
-            std::fs::read_to_string(path).map_err(|source| Error::Io {
+            std::fs::read_to_string(path).map_err(|error| Error::Io {
                 path: path.to_path_buf(),
-                source,
+                error,
             })
         };
         let spec_text = read(spec_path)?;
