@@ -48,7 +48,7 @@ impl GridGeometry {
         }
         if width
             .checked_mul(height)
-            .is_none_or(|n| n > (u32::MAX as usize))
+            .is_none_or(|n| n > (i32::MAX as usize))
         {
             return Err(MapError::invalid(
                 "grid size",

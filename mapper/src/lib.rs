@@ -14,6 +14,7 @@
 //! - [`remission`]: per-cell intensity statistics.
 //! - [`export`]: ROS map_server PGM/YAML, PNG and NumPy `.npy` files.
 //! - [`synthetic`]: analytic scenes and a synthetic HDL-32E for tests and benchmarks.
+//! - [`workloads`]: the inputs of the headline benchmarks.
 
 pub mod blocks;
 pub mod collision;
@@ -28,6 +29,7 @@ pub mod odm;
 pub mod remission;
 pub mod scan;
 pub mod synthetic;
+pub mod workloads;
 
 pub use blocks::{Block, BlockIndex, BlockSpec, BlockStore};
 pub use collision::{
