@@ -22,7 +22,7 @@ impl Disc {
     }
 }
 
-/// A convex polygon, vertices counter-clockwise, no repeated or collinear vertices, at least 3.
+/// A convex polygon, vertices counter-clockwise, no repeated vertices, at least 3.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ConvexPolygon {
     vertices: Vec<Point2<f64>>,
@@ -45,7 +45,8 @@ fn cross(a: &Vector2<f64>, b: &Vector2<f64>) -> f64 {
     a.x * b.y - a.y * b.x
 }
 
-/// The convex hull of `points`, counter-clockwise, collinear points dropped (Andrew's monotone chain).
+/// The convex hull of `points`, counter-clockwise, exactly collinear and coincident (within
+/// `EPS_M`) points dropped (Andrew's monotone chain).
 pub fn convex_hull(points: &[Point2<f64>]) -> Vec<Point2<f64>> {
     let mut pts: Vec<Point2<f64>> = points
         .iter()
@@ -69,7 +70,9 @@ pub fn convex_hull(points: &[Point2<f64>]) -> Vec<Point2<f64>> {
             while hull.len() >= start + 2 {
                 let a = hull[hull.len() - 2];
                 let b = hull[hull.len() - 1];
-                if cross(&(b - a), &(p - a)) <= EPS_M * (b - a).norm().max(1.0) {
+                // Exact turn test: a tolerance here would let a nearly-degenerate point set
+                // (a lying cylinder's flattened rims) lose hull points.
+                if cross(&(b - a), &(p - a)) <= 0.0 {
                     hull.pop();
                 } else {
                     break;

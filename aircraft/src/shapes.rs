@@ -7,7 +7,7 @@ use crate::footprint::{ConvexPolygon, Disc, Footprint};
 
 /// Sides of the polygon that circumscribes a circular rim when a tilted cylinder or capsule is
 /// projected (the projection of a circumscribed polygon contains the projection of the circle).
-const RIM_SIDES: usize = 32;
+const RIM_SIDES: usize = 64;
 
 /// A collision primitive in its own frame (centred on the origin).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -100,16 +100,26 @@ impl Part {
         let c3 = self.center_in_vehicle();
         let c = Point2::new(c3.x, c3.y);
         let axis = self.axis_in_vehicle();
-        let upright = axis.z.abs() >= 1.0 - 1e-12;
+        // Horizontal part of the axis: the sine of its tilt, exact even for tiny tilts.
+        let tilt = axis.x.hypot(axis.y);
+        let upright = tilt <= 1e-9;
         match self.shape {
             Shape::Sphere { radius_m } => Footprint::Disc(Disc {
                 center: c,
                 radius_m,
             }),
-            Shape::Cylinder { radius_m, .. } | Shape::Capsule { radius_m, .. } if upright => {
+            Shape::Cylinder {
+                radius_m,
+                half_length_m,
+            }
+            | Shape::Capsule {
+                radius_m,
+                half_length_m,
+            } if upright => {
+                // Upright to within 1e-9 rad: a disc, grown by the (nanometre) shift of the ends.
                 Footprint::Disc(Disc {
                     center: c,
-                    radius_m,
+                    radius_m: radius_m + half_length_m * tilt,
                 })
             }
             Shape::Box { half_extents_m: h } => {
@@ -130,11 +140,14 @@ impl Part {
                 half_length_m,
             } => {
                 let a = Vector3::new(axis.x, axis.y, 0.0);
-                if axis.z.abs() <= 1e-12 {
-                    // Lying: an exact rectangle.
+                if axis.z.abs() <= 1e-9 {
+                    // Lying (to within 1e-9 rad, e.g. a pitch of 1.5707963268 written in a URDF):
+                    // a rectangle, exact up to a few nanometres.
                     let u = a.normalize();
                     let (u2, v2) = (
-                        nalgebra::Vector2::new(u.x, u.y) * half_length_m,
+                        // Grown by the rims' (nanometre) reach along the axis for a tiny tilt.
+                        nalgebra::Vector2::new(u.x, u.y)
+                            * (half_length_m * tilt + radius_m * axis.z.abs()),
                         nalgebra::Vector2::new(-u.y, u.x) * radius_m,
                     );
                     let pts = [c + u2 + v2, c + u2 - v2, c - u2 + v2, c - u2 - v2];
@@ -244,6 +257,40 @@ mod tests {
         assert!(p.underside_m().abs() < 1e-12);
         let f = p.footprint();
         assert!((f.area_m2() - 0.56 * 0.2).abs() < 1e-9);
+    }
+
+    #[test]
+    fn cylinder_pitched_by_rounded_half_pi_is_a_rectangle() {
+        // Regression: a fuselage pitched by 1.5707963268 (pi/2 rounded) came out as a sheared
+        // quadrilateral that missed part of the fuselage, because the hull's collinearity
+        // tolerance dropped points of the nearly flat rims.
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        // pi/2 as written 1.5707963268, 1.57079632 and 1.5707.
+        for pitch in [half_pi + 2.05e-11, half_pi - 6.79e-9, half_pi - 9.63e-5] {
+            let p = part(
+                Shape::Cylinder {
+                    radius_m: 1.15,
+                    half_length_m: 6.0,
+                },
+                [2.5, 0.0, 1.75],
+                [0.0, pitch, 0.0],
+            );
+            let f = p.footprint();
+            let (lo, hi) = f.bounds();
+            assert!(
+                (hi.y - lo.y - 2.3).abs() < 0.01,
+                "pitch {pitch}: width {}",
+                hi.y - lo.y
+            );
+            assert!(
+                (f.area_m2() - 2.3 * 12.0).abs() < 0.1,
+                "pitch {pitch}: {}",
+                f.area_m2()
+            );
+            for (x, y) in [(-3.49, 1.14), (-3.49, -1.14), (8.49, 1.14), (8.49, -1.14)] {
+                assert!(f.contains(&Point2::new(x, y)), "pitch {pitch}: ({x}, {y})");
+            }
+        }
     }
 
     #[test]

@@ -35,6 +35,28 @@ fn level_pose() -> impl Strategy<Value = Isometry3<f64>> {
     })
 }
 
+fn snapped_pose() -> impl Strategy<Value = Isometry3<f64>> {
+    // Angles at multiples of pi/2 give or take a rounding error (URDF files write 1.5708 or
+    // 1.5707963268 for pi/2): nearly degenerate projections, the hull's hardest case.
+    let noise = prop_oneof![Just(0.0), -1e-9..1e-9f64, -1e-4..1e-4f64];
+    let angle = (-2i32..=2, noise)
+        .prop_map(|(k, noise)| f64::from(k) * std::f64::consts::FRAC_PI_2 + noise);
+    (
+        -5.0..5.0f64,
+        -5.0..5.0f64,
+        0.0..3.0f64,
+        angle.clone(),
+        angle.clone(),
+        angle,
+    )
+        .prop_map(|(x, y, z, roll, pitch, yaw)| {
+            Isometry3::from_parts(
+                Translation3::new(x, y, z),
+                UnitQuaternion::from_euler_angles(roll, pitch, yaw),
+            )
+        })
+}
+
 fn shape() -> impl Strategy<Value = Shape> {
     prop_oneof![
         3 => (0.02..6.0f64, 0.02..3.0f64, 0.02..1.0f64).prop_map(|(a, b, c)| Shape::Box {
@@ -53,12 +75,14 @@ fn shape() -> impl Strategy<Value = Shape> {
 }
 
 fn part() -> impl Strategy<Value = Part> {
-    (shape(), prop_oneof![pose(), level_pose()]).prop_map(|(shape, vehicle_from_part)| Part {
-        link: "p".into(),
-        collision_index: 0,
-        shape,
-        vehicle_from_part,
-    })
+    (shape(), prop_oneof![pose(), level_pose(), snapped_pose()]).prop_map(
+        |(shape, vehicle_from_part)| Part {
+            link: "p".into(),
+            collision_index: 0,
+            shape,
+            vehicle_from_part,
+        },
+    )
 }
 
 fn options() -> impl Strategy<Value = FitOptions> {
