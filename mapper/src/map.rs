@@ -100,7 +100,7 @@ impl MapConfig {
         if self.block_cells == 0 {
             return Err(MapError::invalid("block_cells", "must be > 0"));
         }
-        if self.window_blocks == 0 || self.window_blocks % 2 == 0 {
+        if self.window_blocks == 0 || self.window_blocks.is_multiple_of(2) {
             return Err(MapError::invalid(
                 "window_blocks",
                 format!("{}: must be odd", self.window_blocks),

@@ -41,8 +41,8 @@ impl XorShift {
     }
 }
 
-/// A parking lot of about 300 objects within 60 m: rows of parked cars, lamp posts, cones and
-/// wheeled containers, the vehicle in the middle of an aisle.
+/// A parking lot of about 200 objects within 60 m: rows of parked cars, lamp posts, scattered cones
+/// and wheeled containers, and two cones and two containers placed beside the aisle at y = -3.
 pub fn parking_lot_scene() -> Scene {
     let mut rng = XorShift::new(7);
     let mut solids = Vec::new();
@@ -73,6 +73,14 @@ pub fn parking_lot_scene() -> Scene {
             });
         }
     }
+    // The thesis' test obstacles beside the aisle the demo drives (y = -3): short cones a wing
+    // passes over and tall wheeled containers it must not.
+    solids.extend([
+        Solid::post(-40.0, -6.0, 0.18, 0.45),
+        Solid::post(-32.0, 0.0, 0.18, 0.45),
+        Solid::standing_box(-36.0, 0.0, 0.8, 0.6, 1.1),
+        Solid::standing_box(-28.0, -6.0, 0.8, 0.6, 1.1),
+    ]);
     Scene {
         solids,
         ground_intensity: 0.3,

@@ -1,2 +1,168 @@
-//! Placeholder
-fn main() {}
+//! The `taxi-sim` command line: benchmarks, the mapping demo, vehicle model fitting.
+//!
+//! The only place that knows the terminal: progress bars, tables, exit codes (0 success,
+//! 2 bad input or failure; clap's own usage errors also exit 2).
+
+mod model_cli;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+
+#[derive(Parser)]
+#[command(
+    name = "taxi-sim",
+    version,
+    about = "Closed-loop taxi simulator around a quantized multi-height occupancy grid map"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Build a two-level map of a synthetic parking lot with the fake-wing car and export every level.
+    Demo {
+        /// Output directory.
+        #[arg(long, default_value = "out/demo")]
+        out: PathBuf,
+        /// Scans along the 90 m drive.
+        #[arg(long, default_value_t = 180)]
+        scans: usize,
+        /// Seed of the range noise.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+    /// Measure the headline performance figures on this machine.
+    Bench {
+        /// What to measure.
+        what: BenchTarget,
+        /// One JSON object per figure on stdout instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Timed batches per figure (the median is reported).
+        #[arg(long, default_value_t = 15)]
+        samples: usize,
+    },
+    /// Vehicle collision models.
+    #[command(subcommand)]
+    Model(ModelCommand),
+}
+
+#[derive(Subcommand)]
+enum ModelCommand {
+    /// Fit a vehicle's height-tagged circle model and print coverage per level.
+    Fit(model_cli::ModelFitArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum BenchTarget {
+    /// Scan insertion, exact EDT vs chamfer, pose checks.
+    Mapper,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Demo { out, scans, seed } => demo(out, scans, seed),
+        Command::Bench {
+            what: BenchTarget::Mapper,
+            json,
+            samples,
+        } => bench_mapper(json, samples),
+        Command::Model(ModelCommand::Fit(args)) => model_cli::run(&args),
+    }
+}
+
+fn bar(len: u64, what: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{msg:>10} [{bar:40}] {pos}/{len} {elapsed_precise} eta {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> "),
+    );
+    bar.set_message(what.to_string());
+    bar
+}
+
+fn demo(out: PathBuf, scans: usize, seed: u64) -> anyhow::Result<()> {
+    let options = sim::demo::DemoOptions {
+        out: out.clone(),
+        scans,
+        seed,
+        range_noise_m: 0.02,
+    };
+    let progress = bar(scans as u64, "mapping");
+    let summary = sim::demo::run(&options, &mut |done, _| progress.set_position(done as u64))?;
+    progress.finish_and_clear();
+    println!(
+        "mapping drive: {} scans, {} returns, {} self-hits dropped, {} re-centrings",
+        summary.scans, summary.returns, summary.self_hits, summary.recentres
+    );
+    println!(
+        "insert + distance maps: {:.1} ms per scan (mean)",
+        summary.ms_per_scan
+    );
+    println!("{:>6} {:>10} {:>15}", "level", "height_m", "occupied_cells");
+    for (k, (h, n)) in summary.levels.iter().enumerate() {
+        println!("{k:>6} {h:>10.2} {n:>15}");
+    }
+    println!(
+        "{} block files in {}",
+        summary.blocks,
+        out.join("blocks").display()
+    );
+    println!("wrote:");
+    for f in &summary.files {
+        println!("  {}", f.display());
+    }
+    Ok(())
+}
+
+fn bench_mapper(json: bool, samples: usize) -> anyhow::Result<()> {
+    let progress = ProgressBar::new_spinner();
+    let figures = sim::bench::mapper_figures(samples, &mut |what| {
+        progress.set_message(format!("measuring {what}"))
+    });
+    progress.finish_and_clear();
+    if json {
+        for f in &figures {
+            println!("{}", serde_json::to_string(f)?);
+        }
+        return Ok(());
+    }
+    println!(
+        "{:<45} {:>12}  {:<14} vs baseline",
+        "figure", "median", "target"
+    );
+    for f in &figures {
+        let vs = match (&f.baseline, f.ratio) {
+            (Some(b), Some(r)) => format!("{r:.2}x ({b})"),
+            _ => String::new(),
+        };
+        println!(
+            "{:<45} {:>9.3} {:<2}  {:<14} {}",
+            f.name,
+            f.median,
+            f.unit,
+            f.target.unwrap_or(""),
+            vs
+        );
+    }
+    Ok(())
+}

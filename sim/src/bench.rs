@@ -1,0 +1,169 @@
+//! `taxi-sim bench`: the README's headline figures, each against its straightforward baseline.
+//!
+//! Criterion (`cargo bench -p mapper`) gives the same figures with statistics; this module lets
+//! a user measure their own machine with the release binary alone. Each figure is the median of
+//! `samples` timed batches after one warm-up batch.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use mapper::edt::{EdtScratch, chamfer_3x3, exact_edt};
+use mapper::workloads;
+use serde::Serialize;
+
+/// One measured figure.
+#[derive(Clone, Debug, Serialize)]
+pub struct Figure {
+    /// What was measured.
+    pub name: String,
+    /// Median time of one operation.
+    pub median: f64,
+    /// Unit of `median` (`ms`, `ns`).
+    pub unit: &'static str,
+    /// The figure this one is compared with, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub baseline: Option<String>,
+    /// `baseline median / this median` (> 1: this is faster).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ratio: Option<f64>,
+    /// The design target, as text.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub target: Option<&'static str>,
+}
+
+/// Median seconds per call of `f`, over `samples` batches of `batch` calls.
+pub fn median_seconds(samples: usize, batch: usize, mut f: impl FnMut()) -> f64 {
+    for _ in 0..batch {
+        f();
+    }
+    let mut times: Vec<f64> = (0..samples.max(1))
+        .map(|_| {
+            let t = Instant::now();
+            for _ in 0..batch {
+                f();
+            }
+            t.elapsed().as_secs_f64() / batch as f64
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
+}
+
+fn figure(name: &str, seconds: f64, unit: &'static str, target: Option<&'static str>) -> Figure {
+    let scale = if unit == "ms" { 1e3 } else { 1e9 };
+    Figure {
+        name: name.into(),
+        median: seconds * scale,
+        unit,
+        baseline: None,
+        ratio: None,
+        target,
+    }
+}
+
+fn against(mut f: Figure, baseline: &Figure) -> Figure {
+    f.baseline = Some(baseline.name.clone());
+    f.ratio = Some(baseline.median / f.median);
+    f
+}
+
+/// The mapper's figures: scan insertion, exact EDT vs chamfer, pose checks. `progress` is told
+/// the name of each figure before it is measured.
+pub fn mapper_figures(samples: usize, progress: &mut dyn FnMut(&str)) -> Vec<Figure> {
+    let mut out = Vec::new();
+
+    progress("insert_scan");
+    let scan = workloads::parking_lot_scan();
+    let car = workloads::fake_wing_car();
+    let mut map = workloads::two_level_map();
+    let t = median_seconds(samples, 1, || {
+        black_box(
+            map.insert_scan(&scan, Some(&car))
+                .map(|s| s.hits.len())
+                .unwrap_or(0),
+        );
+    });
+    out.push(figure(
+        "insert_scan/hdl32e_69984_returns/2_levels",
+        t,
+        "ms",
+        Some("<= 5 ms"),
+    ));
+
+    let mut output = vec![0.0f32; 1050 * 1050];
+    let mut scratch = EdtScratch::default();
+    for (label, fraction) in [("sparse_0.1pct", 0.001), ("dense_2pct", 0.02)] {
+        progress(&format!("edt {label}"));
+        let mask = workloads::obstacle_mask(fraction, 1);
+        let chamfer = median_seconds(samples, 1, || {
+            chamfer_3x3(1050, 1050, 0.2, 30.0, |i| mask[i], black_box(&mut output))
+        });
+        let chamfer = figure(
+            &format!("edt_1050x1050/chamfer_3x3/{label}"),
+            chamfer,
+            "ms",
+            None,
+        );
+        let exact = median_seconds(samples, 1, || {
+            exact_edt(
+                1050,
+                1050,
+                0.2,
+                30.0,
+                |i| mask[i],
+                &mut scratch,
+                black_box(&mut output),
+            )
+        });
+        out.push(against(
+            figure(
+                &format!("edt_1050x1050/exact/{label}"),
+                exact,
+                "ms",
+                Some("<= 10 ms"),
+            ),
+            &chamfer,
+        ));
+        out.push(chamfer);
+    }
+
+    progress("check_pose");
+    let maps = workloads::distance_maps_for_checks();
+    let jet = workloads::jet_62_circles();
+    let (far, near) = workloads::far_and_near_poses();
+    if let Ok(checker) = jet.checker(&maps) {
+        let batch = 20_000;
+        let near_t = median_seconds(samples, batch, || {
+            black_box(checker.check_pose(black_box(&near), 0.2));
+        });
+        let near_f = figure(
+            "check_pose/62_circles/near_obstacles",
+            near_t,
+            "ns",
+            Some("<= 200 ns"),
+        );
+        let far_t = median_seconds(samples, batch, || {
+            black_box(checker.check_pose(black_box(&far), 0.2));
+        });
+        let level0 = &maps.levels()[0];
+        let centre = nalgebra::Point2::new(far.translation.x, far.translation.y);
+        let lookup_t = median_seconds(samples, batch, || {
+            black_box(level0.distance_at(black_box(&centre)));
+        });
+        let lookup = figure("distance_map/one_lookup", lookup_t, "ns", None);
+        // Far from obstacles: compared with the full check (how much the early out saves) ...
+        out.push(against(
+            figure(
+                "check_pose/62_circles/far_from_obstacles",
+                far_t,
+                "ns",
+                Some("close to one lookup"),
+            ),
+            &near_f,
+        ));
+        out.push(near_f);
+        // ... and one lookup compared with it (1.0 would be exactly one lookup).
+        out.push(against(lookup, &out[out.len() - 2]));
+    }
+    out
+}

@@ -1,0 +1,8 @@
+//! taxi-sim: the closed-loop taxi simulator around the multi-height occupancy grid map.
+//!
+//! This library holds what the `taxi-sim` binary runs; the binary alone knows the terminal.
+//! - [`bench`]: the headline performance figures, measured without criterion.
+//! - [`demo`]: a mapping drive through a synthetic parking lot, exporting every level.
+
+pub mod bench;
+pub mod demo;
