@@ -15,6 +15,9 @@ fn demo(dir: &std::path::Path, seed: u64) -> sim::demo::DemoSummary {
     run(&options, &mut |_, _| {}).unwrap()
 }
 
+/// A position on the ground plane, metres.
+type Spot = (f64, f64);
+
 /// Distance in the plane from a point to a solid's footprint.
 fn footprint_distance(s: &Solid, (x, y): (f64, f64)) -> f64 {
     match *s {
@@ -30,7 +33,7 @@ fn footprint_distance(s: &Solid, (x, y): (f64, f64)) -> f64 {
 
 /// Cones (0.45 m posts) and containers (1.1 m boxes) within 15 m of the first 20 m of the drive (x in -45..-25),
 /// standing clear (1 m) of every other object.
-fn near_route() -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+fn near_route() -> (Vec<Spot>, Vec<Spot>) {
     let (mut cones, mut containers) = (Vec::new(), Vec::new());
     let solids = workloads::parking_lot_scene().solids;
     let clear = |me: &Solid, p: (f64, f64)| {
