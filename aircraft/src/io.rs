@@ -1,23 +1,20 @@
 //! Atomic file writes: a temporary file in the target's directory, then a rename over it.
 
-use std::io::Write as _;
 use std::path::Path;
 
 use crate::error::{Error, Result};
 
-/// Writes `bytes` to `path` so that readers see either the old file or the whole new one.
+/// Writes `bytes` to `path` so that readers see either the old file or the whole new one
+/// (mapper's [`mapper::write_atomically`]: temporary file, sync, rename; mode 0644).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let io = |error| Error::Io {
-        path: path.to_path_buf(),
-        error,
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
-    tmp.write_all(bytes).map_err(io)?;
-    tmp.as_file().sync_all().map_err(io)?;
-    tmp.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+    mapper::write_atomically(path, bytes).map_err(|e| match e {
+        mapper::MapError::Io { path, source } => Error::Io {
+            path,
+            error: source,
+        },
+        other => Error::Io {
+            path: path.to_path_buf(),
+            error: std::io::Error::other(other.to_string()),
+        },
+    })
 }

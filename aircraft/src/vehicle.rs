@@ -86,10 +86,14 @@ impl Vehicle {
 
     /// A shipped vehicle name, or else a path to a sidecar file.
     pub fn load(name_or_path: &str) -> Result<Self> {
+        let path = Path::new(name_or_path);
         if SHIPPED_VEHICLES.contains(&name_or_path) {
             Vehicle::shipped(name_or_path)
+        } else if !path.exists() && path.extension().is_none() {
+            // Neither a shipped name nor a file: say what the names are.
+            Vehicle::shipped(name_or_path)
         } else {
-            Vehicle::from_file(Path::new(name_or_path))
+            Vehicle::from_file(path)
         }
     }
 

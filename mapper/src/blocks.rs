@@ -241,7 +241,11 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| MapError::io(dir, e))?;
+    // tempfile creates 0600 files; a map or a picture is for others to read too.
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
+    let mut tmp = builder.tempfile_in(dir).map_err(|e| MapError::io(dir, e))?;
     tmp.write_all(bytes)
         .map_err(|e| MapError::io(tmp.path(), e))?;
     tmp.as_file()

@@ -31,7 +31,7 @@ pub mod scan;
 pub mod synthetic;
 pub mod workloads;
 
-pub use blocks::{Block, BlockIndex, BlockSpec, BlockStore};
+pub use blocks::{Block, BlockIndex, BlockSpec, BlockStore, write_atomically};
 pub use collision::{
     BoundingCircle, Circle, CollisionChecker, CollisionModel, PoseCheck, TrajectoryCheck,
 };

@@ -5,6 +5,7 @@
 
 mod model_cli;
 
+use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -64,10 +65,26 @@ enum BenchTarget {
     Mapper,
 }
 
+/// Raised by [`emit`] when stdout's reader went away (`taxi-sim ... | head`): not an error.
+#[derive(Debug, thiserror::Error)]
+#[error("stdout closed")]
+struct StdoutClosed;
+
+/// Writes to stdout; a closed pipe ends the command quietly instead of panicking like `print!`.
+pub(crate) fn emit(text: &str) -> anyhow::Result<()> {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Err(StdoutClosed.into()),
+        other => Ok(other?),
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.is::<StdoutClosed>() => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(2)
@@ -110,28 +127,36 @@ fn demo(out: PathBuf, scans: usize, seed: u64) -> anyhow::Result<()> {
     let progress = bar(scans as u64, "mapping");
     let summary = sim::demo::run(&options, &mut |done, _| progress.set_position(done as u64))?;
     progress.finish_and_clear();
-    println!(
+    let mut t = String::new();
+    writeln!(
+        t,
         "mapping drive: {} scans, {} returns, {} self-hits dropped, {} re-centrings",
         summary.scans, summary.returns, summary.self_hits, summary.recentres
-    );
-    println!(
+    )?;
+    writeln!(
+        t,
         "insert + distance maps: {:.1} ms per scan (mean)",
         summary.ms_per_scan
-    );
-    println!("{:>6} {:>10} {:>15}", "level", "height_m", "occupied_cells");
+    )?;
+    writeln!(
+        t,
+        "{:>6} {:>10} {:>15}",
+        "level", "height_m", "occupied_cells"
+    )?;
     for (k, (h, n)) in summary.levels.iter().enumerate() {
-        println!("{k:>6} {h:>10.2} {n:>15}");
+        writeln!(t, "{k:>6} {h:>10.2} {n:>15}")?;
     }
-    println!(
+    writeln!(
+        t,
         "{} block files in {}",
         summary.blocks,
         out.join("blocks").display()
-    );
-    println!("wrote:");
+    )?;
+    writeln!(t, "wrote:")?;
     for f in &summary.files {
-        println!("  {}", f.display());
+        writeln!(t, "  {}", f.display())?;
     }
-    Ok(())
+    emit(&t)
 }
 
 fn bench_mapper(json: bool, samples: usize) -> anyhow::Result<()> {
@@ -140,29 +165,32 @@ fn bench_mapper(json: bool, samples: usize) -> anyhow::Result<()> {
         progress.set_message(format!("measuring {what}"))
     });
     progress.finish_and_clear();
+    let mut t = String::new();
     if json {
         for f in &figures {
-            println!("{}", serde_json::to_string(f)?);
+            writeln!(t, "{}", serde_json::to_string(f)?)?;
         }
-        return Ok(());
+        return emit(&t);
     }
-    println!(
+    writeln!(
+        t,
         "{:<45} {:>12}  {:<14} vs baseline",
         "figure", "median", "target"
-    );
+    )?;
     for f in &figures {
         let vs = match (&f.baseline, f.ratio) {
             (Some(b), Some(r)) => format!("{r:.2}x ({b})"),
             _ => String::new(),
         };
-        println!(
+        writeln!(
+            t,
             "{:<45} {:>9.3} {:<2}  {:<14} {}",
             f.name,
             f.median,
             f.unit,
             f.target.unwrap_or(""),
             vs
-        );
+        )?;
     }
-    Ok(())
+    emit(&t)
 }

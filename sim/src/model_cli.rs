@@ -50,20 +50,20 @@ pub fn run(args: &ModelFitArgs) -> anyhow::Result<()> {
         .fit_with(&heights, &options)
         .with_context(|| format!("fitting `{}`", vehicle.spec.name))?;
     let reports = aircraft::evaluate(&fit, aircraft::report::DEFAULT_SAMPLES_PER_AXIS);
-    print!(
+    crate::emit(&format!(
         "{}",
         aircraft::report::table(&vehicle.spec.name, &fit, &reports)
-    );
+    ))?;
     if let Some(path) = &args.svg {
         let svg = aircraft::svg::to_svg(&fit, &vehicle.spec.name);
         aircraft::io::write_atomic(path, svg.as_bytes())
             .with_context(|| format!("writing the SVG {}", path.display()))?;
-        println!("wrote {}", path.display());
+        crate::emit(&format!("wrote {}\n", path.display()))?;
     }
     if let Some(path) = &args.carmen {
         aircraft::carmen::write_carmen_file(path, &fit.model)
             .with_context(|| format!("writing the CARMEN file {}", path.display()))?;
-        println!("wrote {}", path.display());
+        crate::emit(&format!("wrote {}\n", path.display()))?;
     }
     Ok(())
 }
