@@ -34,8 +34,20 @@ fn every_shipped_vehicle_loads_from_its_files_as_compiled_in() {
         assert_eq!(shipped.spec.name, name);
         assert_eq!(Vehicle::load(&path).expect("load by path"), shipped);
     }
+    // A bare name that is neither shipped nor a file: the error lists the shipped names.
+    match Vehicle::load("cessna") {
+        Err(aircraft::Error::UnknownVehicle { name, known }) => {
+            assert_eq!(name, "cessna");
+            assert!(
+                known.contains("praetor600") && known.contains("iara_car_fake_wing"),
+                "{known}"
+            );
+        }
+        other => panic!("expected UnknownVehicle, got {other:?}"),
+    }
+    // A path that does not exist: an I/O error naming it.
     assert!(matches!(
-        Vehicle::load("cessna"),
+        Vehicle::load("no/such/vehicle.toml"),
         Err(aircraft::Error::Io { .. })
     ));
     assert!(matches!(

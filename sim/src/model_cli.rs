@@ -50,10 +50,7 @@ pub fn run(args: &ModelFitArgs) -> anyhow::Result<()> {
         .fit_with(&heights, &options)
         .with_context(|| format!("fitting `{}`", vehicle.spec.name))?;
     let reports = aircraft::evaluate(&fit, aircraft::report::DEFAULT_SAMPLES_PER_AXIS);
-    crate::emit(&format!(
-        "{}",
-        aircraft::report::table(&vehicle.spec.name, &fit, &reports)
-    ))?;
+    crate::emit(&aircraft::report::table(&vehicle.spec.name, &fit, &reports))?;
     if let Some(path) = &args.svg {
         let svg = aircraft::svg::to_svg(&fit, &vehicle.spec.name);
         aircraft::io::write_atomic(path, svg.as_bytes())
