@@ -7,4 +7,7 @@
 
 pub mod bench;
 pub mod demo;
+pub mod lidar;
+pub mod motion;
 pub mod scene;
+pub mod world;
