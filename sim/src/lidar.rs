@@ -15,6 +15,7 @@
 //! thread count.
 
 use nalgebra::{Isometry2, Isometry3, Point3, Vector3};
+use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 use rapier3d::prelude::*;
 use rayon::prelude::*;
@@ -171,6 +172,8 @@ pub struct Lidar {
 struct Candidate<'a> {
     owner: Owner,
     collider: &'a Collider,
+    /// Vertical cylinders and cones are cast analytically (parry casts them by GJK iterations).
+    analytic: Option<Vertical>,
     /// Horizontal distance from the sweep origin to the collider's bounding box, metres.
     d_min: f32,
     /// Elevation window seen from the sweep origin, radians.
@@ -274,9 +277,14 @@ impl Lidar {
             let (el_top_max, _) = elev(hi.z + pad);
             let (_, el_bottom_min) = elev(lo.z - pad);
             let index = candidates.len() as u32;
+            let analytic = match owner {
+                Owner::Object(i) => world.scene().solids.get(i).and_then(Vertical::of),
+                _ => None,
+            };
             candidates.push(Candidate {
                 owner,
                 collider,
+                analytic,
                 d_min,
                 el_min: el_bottom_min.min(el_top_max) - 1e-3,
                 el_max: el_top_max + 1e-3,
@@ -365,10 +373,16 @@ impl Lidar {
                     if el < cand.el_min || el > cand.el_max {
                         continue;
                     }
-                    if let Some(t) =
-                        cand.collider
-                            .shape()
-                            .cast_ray(cand.collider.position(), &ray, t_best, true)
+                    let hit = match &cand.analytic {
+                        Some(v) => v.cast(&ray, t_best),
+                        None => cand.collider.shape().cast_ray(
+                            cand.collider.position(),
+                            &ray,
+                            t_best,
+                            true,
+                        ),
+                    };
+                    if let Some(t) = hit
                         && t < t_best
                     {
                         t_best = t;
@@ -378,7 +392,6 @@ impl Lidar {
                 out[b] = best;
             }
         })
-        .finish(world)
     }
 
     /// One revolution casting every ray with Rapier's generic query (the BVH over every
@@ -403,11 +416,11 @@ impl Lidar {
                 };
             }
         })
-        .finish(world)
     }
 
-    /// Runs `cast(column, origin, world directions, out hits)` over every column in parallel,
-    /// then applies noise, intensity and drop-off in a fixed order.
+    /// Runs, for every column in parallel, `cast(column, origin, world directions, out hits)`
+    /// (prefilled with the vehicle's self-hits) and then the column's noise, intensity and
+    /// drop-off from its own seeded generator; the columns are joined in order.
     fn assemble(
         &self,
         world: &World,
@@ -415,10 +428,11 @@ impl Lidar {
         scan_index: u64,
         seed: u64,
         cast: impl Fn(usize, Point3<f64>, &[[f32; 3]], &mut [Option<(f32, Owner)>]) + Sync,
-    ) -> Assembled<'_> {
+    ) -> LidarScan {
         let beams = self.config.channels;
         let self_hits = self.self_hits(world);
-        let columns: Vec<ColumnHits> = (0..self.config.columns)
+        let scene = world.scene();
+        let per_column: Vec<ColumnOut> = (0..self.config.columns)
             .into_par_iter()
             .map(|c| {
                 let (vehicle, sensor) = self.column_poses(sweep, c);
@@ -431,16 +445,90 @@ impl Lidar {
                     })
                     .collect();
                 let mut hits = self_hits[c * beams..(c + 1) * beams].to_vec();
-                cast(c, Point3::from(sensor.translation.vector), &dirs, &mut hits);
-                (vehicle, sensor, hits, dirs)
+                let origin = Point3::from(sensor.translation.vector);
+                cast(c, origin, &dirs, &mut hits);
+                let mut rng = Xoshiro256PlusPlus::seed_from_u64(mix(seed, scan_index, c as u64));
+                let (returns, owners) = hits
+                    .iter()
+                    .zip(&dirs)
+                    .map(|(hit, d)| self.measure(scene, &mut rng, origin, *hit, d))
+                    .unzip();
+                ColumnOut {
+                    column: mapper::ScanColumn {
+                        world_from_sensor: sensor,
+                        world_from_vehicle: vehicle,
+                    },
+                    returns,
+                    owners,
+                }
             })
             .collect();
-        Assembled {
-            lidar: self,
-            columns,
-            scan_index,
-            seed,
+        let mut columns = Vec::with_capacity(per_column.len());
+        let mut returns = Vec::with_capacity(per_column.len() * beams);
+        let mut owners = Vec::with_capacity(per_column.len() * beams);
+        for out in per_column {
+            columns.push(out.column);
+            returns.extend(out.returns);
+            owners.extend(out.owners);
         }
+        // Finite poses and points by construction; an error here would be a bug, reported as an empty scan.
+        let scan = mapper::Scan::new(beams, columns, returns).unwrap_or_default();
+        LidarScan {
+            scan,
+            owners,
+            directions_in_sensor: self.directions.clone(),
+        }
+    }
+
+    /// One ray's return: range noise, intensity, drop-off. Four draws a ray, hit or not, so the
+    /// stream does not depend on what was hit.
+    fn measure(
+        &self,
+        scene: &crate::scene::Scene,
+        rng: &mut Xoshiro256PlusPlus,
+        origin: Point3<f64>,
+        hit: Option<(f32, Owner)>,
+        d: &[f32; 3],
+    ) -> (Option<mapper::Return>, Option<Owner>) {
+        let cfg = &self.config;
+        let (u1, u2, u3, u4): (f64, f64, f64, f64) = (
+            rng.random_range(1e-12..1.0),
+            rng.random(),
+            rng.random(),
+            rng.random(),
+        );
+        let Some((t, owner)) = hit else {
+            return (None, None);
+        };
+        let noise = if cfg.noise_stddev_m > 0.0 {
+            cfg.noise_stddev_m * (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+        } else {
+            0.0
+        };
+        let range = (t as f64 + noise).max(0.0);
+        let point = origin + Vector3::new(d[0] as f64, d[1] as f64, d[2] as f64) * range;
+        let remission = match owner {
+            Owner::Ground => scene.ground_remission_at(point.x, point.y),
+            Owner::Object(i) => scene.solids.get(i).map_or(0.5, |s| s.remission),
+            Owner::VehiclePart(_) => 0.5,
+        };
+        let intensity = (remission as f64 * (-cfg.atmosphere_attenuation_rate * t as f64).exp())
+            .clamp(0.0, 1.0);
+        let drop_by_intensity = intensity < cfg.dropoff_intensity_limit
+            && u4
+                < cfg.dropoff_zero_intensity
+                    * (1.0 - intensity / cfg.dropoff_intensity_limit.max(1e-12));
+        if u3 < cfg.dropoff_general_rate || drop_by_intensity {
+            return (None, None);
+        }
+        (
+            Some(mapper::Return {
+                point_in_world: point,
+                range_m: range as f32,
+                intensity: intensity as f32,
+            }),
+            Some(owner),
+        )
     }
 
     /// Where each ray meets the vehicle itself, if it does: the sensor is rigidly mounted, so
@@ -484,88 +572,119 @@ fn sensor_yaw(vehicle_from_sensor: &Isometry3<f64>) -> f32 {
     x.y.atan2(x.x) as f32
 }
 
-type ColumnHits = (
-    Isometry2<f64>,
-    Isometry3<f64>,
-    Vec<Option<(f32, Owner)>>,
-    Vec<[f32; 3]>,
-);
-
-struct Assembled<'a> {
-    lidar: &'a Lidar,
-    columns: Vec<ColumnHits>,
-    scan_index: u64,
-    seed: u64,
+/// A vertical cylinder or cone (apex up), cast in closed form.
+#[derive(Clone, Copy, Debug)]
+struct Vertical {
+    cx: f64,
+    cy: f64,
+    radius: f64,
+    z0: f64,
+    z1: f64,
+    cone: bool,
 }
 
-impl Assembled<'_> {
-    fn finish(self, world: &World) -> LidarScan {
-        let cfg = &self.lidar.config;
-        let beams = cfg.channels;
-        let scene = world.scene();
-        let mut columns = Vec::with_capacity(self.columns.len());
-        let mut returns = Vec::with_capacity(self.columns.len() * beams);
-        let mut owners = Vec::with_capacity(self.columns.len() * beams);
-        for (c, (vehicle, sensor, hits, dirs)) in self.columns.into_iter().enumerate() {
-            let mut rng =
-                rand::rngs::StdRng::seed_from_u64(mix(self.seed, self.scan_index, c as u64));
-            let origin = Point3::from(sensor.translation.vector);
-            for (hit, d) in hits.into_iter().zip(&dirs) {
-                // Four draws a ray, hit or not, so the stream does not depend on what was hit.
-                let (u1, u2, u3, u4): (f64, f64, f64, f64) = (
-                    rng.random_range(1e-12..1.0),
-                    rng.random(),
-                    rng.random(),
-                    rng.random(),
-                );
-                let Some((t, owner)) = hit else {
-                    returns.push(None);
-                    owners.push(None);
-                    continue;
-                };
-                let noise = cfg.noise_stddev_m
-                    * (-2.0 * u1.ln()).sqrt()
-                    * (std::f64::consts::TAU * u2).cos();
-                let range = (t as f64 + noise).max(0.0);
-                let dir = Vector3::new(d[0] as f64, d[1] as f64, d[2] as f64);
-                let point = origin + dir * range;
-                let remission = match owner {
-                    Owner::Ground => scene.ground_remission_at(point.x, point.y),
-                    Owner::Object(i) => scene.solids.get(i).map_or(0.5, |s| s.remission),
-                    Owner::VehiclePart(_) => 0.5,
-                };
-                let intensity = (remission as f64
-                    * (-cfg.atmosphere_attenuation_rate * t as f64).exp())
-                .clamp(0.0, 1.0);
-                let drop_by_intensity = intensity < cfg.dropoff_intensity_limit
-                    && u4
-                        < cfg.dropoff_zero_intensity
-                            * (1.0 - intensity / cfg.dropoff_intensity_limit.max(1e-12));
-                if u3 < cfg.dropoff_general_rate || drop_by_intensity {
-                    returns.push(None);
-                    owners.push(None);
-                    continue;
-                }
-                returns.push(Some(mapper::Return {
-                    point_in_world: point,
-                    range_m: range as f32,
-                    intensity: intensity as f32,
-                }));
-                owners.push(Some(owner));
+impl Vertical {
+    fn of(s: &crate::scene::Solid) -> Option<Self> {
+        let (radius, height, cone) = match s.shape {
+            crate::scene::SolidShape::Cylinder { radius_m, height_m } => {
+                (radius_m, height_m, false)
             }
-            columns.push(mapper::ScanColumn {
-                world_from_sensor: sensor,
-                world_from_vehicle: vehicle,
-            });
-        }
-        // Finite poses and points by construction; an error here would be a bug, reported as an empty scan.
-        let scan = mapper::Scan::new(beams, columns, returns).unwrap_or_default();
-        LidarScan {
-            scan,
-            owners,
-            directions_in_sensor: self.lidar.directions.clone(),
-        }
+            crate::scene::SolidShape::Cone { radius_m, height_m } => (radius_m, height_m, true),
+            crate::scene::SolidShape::Box { .. } => return None,
+        };
+        Some(Vertical {
+            cx: s.x_m,
+            cy: s.y_m,
+            radius,
+            z0: s.z_min_m,
+            z1: s.z_min_m + height,
+            cone,
+        })
     }
+
+    /// First time of impact along the ray within `max`, solid (an origin inside gives 0).
+    fn cast(&self, ray: &Ray, max: f32) -> Option<f32> {
+        let (ox, oy, oz) = (
+            ray.origin.x as f64 - self.cx,
+            ray.origin.y as f64 - self.cy,
+            ray.origin.z as f64,
+        );
+        let (dx, dy, dz) = (ray.dir.x as f64, ray.dir.y as f64, ray.dir.z as f64);
+        let max = max as f64;
+        // Radius of the solid at height z (a cone narrows to its apex).
+        let k = if self.cone {
+            self.radius / (self.z1 - self.z0)
+        } else {
+            0.0
+        };
+        let radius_at = |z: f64| {
+            if self.cone {
+                k * (self.z1 - z)
+            } else {
+                self.radius
+            }
+        };
+        if oz >= self.z0 && oz <= self.z1 && ox * ox + oy * oy <= radius_at(oz).powi(2) {
+            return Some(0.0);
+        }
+        let mut best: Option<f64> = None;
+        let mut consider = |t: f64| {
+            if t >= 0.0 && t <= max && best.is_none_or(|b| t < b) {
+                best = Some(t);
+            }
+        };
+        // Lateral surface: x^2 + y^2 = r(z)^2 with r(z) = R (cylinder) or k (z1 - z) (cone).
+        let (a, b, c) = if self.cone {
+            let zz = self.z1 - oz;
+            (
+                dx * dx + dy * dy - k * k * dz * dz,
+                2.0 * (ox * dx + oy * dy + k * k * zz * dz),
+                ox * ox + oy * oy - k * k * zz * zz,
+            )
+        } else {
+            (
+                dx * dx + dy * dy,
+                2.0 * (ox * dx + oy * dy),
+                ox * ox + oy * oy - self.radius * self.radius,
+            )
+        };
+        if a.abs() > 1e-12 {
+            let disc = b * b - 4.0 * a * c;
+            if disc >= 0.0 {
+                // Numerically stable roots.
+                let q = -0.5 * (b + b.signum() * disc.sqrt());
+                for t in [q / a, if q != 0.0 { c / q } else { f64::NAN }] {
+                    let z = oz + t * dz;
+                    if t.is_finite() && z >= self.z0 && z <= self.z1 {
+                        consider(t);
+                    }
+                }
+            }
+        }
+        // Caps: the top disc of a cylinder, the base disc of both.
+        if dz.abs() > 1e-12 {
+            let caps: &[f64] = if self.cone {
+                &[self.z0]
+            } else {
+                &[self.z0, self.z1]
+            };
+            for &zc in caps {
+                let t = (zc - oz) / dz;
+                let (x, y) = (ox + t * dx, oy + t * dy);
+                if x * x + y * y <= self.radius * self.radius {
+                    consider(t);
+                }
+            }
+        }
+        best.map(|t| t as f32)
+    }
+}
+
+/// One column's share of a scan.
+struct ColumnOut {
+    column: mapper::ScanColumn,
+    returns: Vec<Option<mapper::Return>>,
+    owners: Vec<Option<Owner>>,
 }
 
 /// SplitMix64 over (seed, scan, column): independent streams per column.

@@ -63,6 +63,8 @@ enum ModelCommand {
 enum BenchTarget {
     /// Scan insertion, exact EDT vs chamfer, pose checks.
     Mapper,
+    /// One HDL-32E revolution: the fast cast vs Rapier's generic per-ray query.
+    Lidar,
 }
 
 /// Raised by [`emit`] when stdout's reader went away (`taxi-sim ... | head`): not an error.
@@ -96,10 +98,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Demo { out, scans, seed } => demo(out, scans, seed),
         Command::Bench {
-            what: BenchTarget::Mapper,
+            what,
             json,
             samples,
-        } => bench_mapper(json, samples),
+        } => bench(what, json, samples),
         Command::Model(ModelCommand::Fit(args)) => model_cli::run(&args),
     }
 }
@@ -159,11 +161,13 @@ fn demo(out: PathBuf, scans: usize, seed: u64) -> anyhow::Result<()> {
     emit(&t)
 }
 
-fn bench_mapper(json: bool, samples: usize) -> anyhow::Result<()> {
+fn bench(what: BenchTarget, json: bool, samples: usize) -> anyhow::Result<()> {
     let progress = ProgressBar::new_spinner();
-    let figures = sim::bench::mapper_figures(samples, &mut |what| {
-        progress.set_message(format!("measuring {what}"))
-    });
+    let mut report = |what: &str| progress.set_message(format!("measuring {what}"));
+    let figures = match what {
+        BenchTarget::Mapper => sim::bench::mapper_figures(samples, &mut report),
+        BenchTarget::Lidar => sim::bench::lidar_figures(samples, &mut report)?,
+    };
     progress.finish_and_clear();
     let mut t = String::new();
     if json {

@@ -141,6 +141,10 @@ pub struct Scene {
 impl Scene {
     /// Remission of the ground at (x, y): the last patch holding the point, else bare ground.
     pub fn ground_remission_at(&self, x: f64, y: f64) -> f32 {
-        self.patches.iter().rev().find(|p| p.contains(x, y)).map_or(self.ground_remission, |p| p.remission)
+        self.patches
+            .iter()
+            .rev()
+            .find(|p| p.contains(x, y))
+            .map_or(self.ground_remission, |p| p.remission)
     }
 }
