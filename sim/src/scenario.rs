@@ -817,6 +817,11 @@ impl Resolver<'_> {
                 obstacle.solid.x_m,
                 obstacle.solid.y_m,
             )?;
+            if let (Some(m), Some(path)) = (&obstacle.motion, &o.get_ref().path_m) {
+                for p in &m.path_m {
+                    self.inside_world(&world, &format!("{field}.path_m"), path.span(), p.x, p.y)?;
+                }
+            }
             if obstacle.appears_s <= 0.0 {
                 self.no_start_overlap(&vehicle, &obstacle.solid, &field, id_span)?;
             }

@@ -498,6 +498,13 @@ fn obstacle_timing_and_motion_are_checked() {
     );
     let text = obstacle("path_m = [[30.0, -5.0], [30.0, -5.0]]\nspeed_m_s = 1.0\n");
     assert_error(&text, "[[30.0", "obstacles[0].path_m", "are the same");
+    let text = obstacle("path_m = [[30.0, -5.0], [30.0, 50.0]]\nspeed_m_s = 1.0\n");
+    assert_error(
+        &text,
+        "[[30.0",
+        "obstacles[0].path_m",
+        "(30, 50) lies outside the world",
+    );
     let text = obstacle("y_m = 0.0\n");
     assert_error(
         &text,
