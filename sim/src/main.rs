@@ -1,9 +1,12 @@
-//! The `taxi-sim` command line: benchmarks, the mapping demo, vehicle model fitting.
+//! The `taxi-sim` command line: scenario checks and scans, benchmarks, the mapping demo, vehicle
+//! model fitting.
 //!
 //! The only place that knows the terminal: progress bars, tables, exit codes (0 success,
 //! 2 bad input or failure; clap's own usage errors also exit 2).
 
+mod check_cli;
 mod model_cli;
+mod scan_cli;
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -48,6 +51,10 @@ enum Command {
         #[arg(long, default_value_t = 15)]
         samples: usize,
     },
+    /// Validate a scenario file and print a summary.
+    Check(check_cli::CheckArgs),
+    /// Write one LiDAR revolution of a scenario's world as PLY.
+    Scan(scan_cli::ScanArgs),
     /// Vehicle collision models.
     #[command(subcommand)]
     Model(ModelCommand),
@@ -103,6 +110,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             samples,
         } => bench(what, json, samples),
         Command::Model(ModelCommand::Fit(args)) => model_cli::run(&args),
+        Command::Check(args) => check_cli::run(&args),
+        Command::Scan(args) => scan_cli::run(&args),
     }
 }
 

@@ -178,7 +178,7 @@ fn cluttered() -> Scene {
             shape,
             x,
             y,
-            next() * 6.28,
+            next() * std::f64::consts::TAU,
         ));
     }
     scene(solids)
@@ -482,4 +482,91 @@ fn driving_into_a_cone_is_a_contact_and_the_wing_passes_over_a_short_one() {
     // The front bumper meets the cone when x + front reach = 40 - 0.18 (front ~3.47 m ahead).
     assert!(contacts[0].time_s > 0.0 && !contacts[0].part.is_empty());
     assert_eq!(world.min_clearances_m()[1], 0.0);
+}
+
+#[test]
+fn a_scan_written_as_ply_reads_back_point_for_point() {
+    let v = car();
+    let pose = Isometry2::new(Vector2::new(3.0, 4.0), 0.5);
+    let world = World::new(&cluttered(), true, &v, &pose);
+    let lidar = Lidar::new(LidarConfig::default(), mount(&v)).unwrap();
+    let scan = lidar.scan(&world, &SweepPoses::still(pose), 0, 1);
+    let dir = tempfile::tempdir().unwrap();
+    for frame in [sim::ply::Frame::World, sim::ply::Frame::Sensor] {
+        let path = dir.path().join("scan.ply");
+        sim::ply::write(&scan, frame, &path).unwrap();
+        let points = sim::ply::decode(&std::fs::read(&path).unwrap()).unwrap();
+        let returns: Vec<(usize, mapper::Return)> = scan
+            .scan
+            .returns()
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| Some((i, (*r)?)))
+            .collect();
+        assert_eq!(points.len(), returns.len());
+        for (p, (i, r)) in points.iter().zip(&returns) {
+            let (c, b) = (i / 32, i % 32);
+            assert_eq!((p.column as usize, p.beam as usize), (c, b));
+            let expected = match frame {
+                sim::ply::Frame::World => r.point_in_world,
+                sim::ply::Frame::Sensor => scan.point_in_sensor(c, b).unwrap(),
+            };
+            for k in 0..3 {
+                assert!((p.xyz[k] as f64 - expected[k]).abs() < 1e-4);
+            }
+            assert_eq!(p.intensity, r.intensity);
+        }
+        // Sensor frame: the range is the distance from the origin.
+        if frame == sim::ply::Frame::Sensor {
+            let (p, (_, r)) = (points[100], returns[100]);
+            assert!(
+                ((p.xyz[0].powi(2) + p.xyz[1].powi(2) + p.xyz[2].powi(2)).sqrt() - r.range_m).abs()
+                    < 1e-3
+            );
+        }
+    }
+}
+
+#[test]
+fn the_bicycle_at_100_hz_drives_the_kinematic_body_into_a_cone() {
+    use sim::motion::{Bicycle, Command, VehicleState};
+    let v = car();
+    let cone = solid(
+        "cone",
+        ObjectKind::Cone,
+        SolidShape::Cone {
+            radius_m: 0.18,
+            height_m: 0.45,
+        },
+        25.0,
+        2.0,
+        0.0,
+    );
+    let mut world = World::new(&scene(vec![cone]), true, &v, &Isometry2::identity());
+    let bicycle = Bicycle::new(v.spec.motion.clone());
+    let mut state = VehicleState::default();
+    // Accelerate to 4 m/s, steering gently left towards the cone 2 m left of the straight line.
+    let command = Command {
+        speed_m_s: 4.0,
+        steering_rad: 0.012,
+    };
+    let dt = 0.01;
+    let mut t = 0.0;
+    while t < 15.0 && world.contacts().is_empty() {
+        bicycle.step(&mut state, &command, dt);
+        t += dt;
+        world.set_vehicle_pose(&state.world_from_vehicle(), t);
+    }
+    let contact = world
+        .contacts()
+        .first()
+        .unwrap_or_else(|| panic!("no contact; vehicle ended at {state:?}"));
+    assert_eq!(contact.object, "cone");
+    assert!(
+        (contact.time_s - t).abs() < 1e-9 && state.x_m > 20.0 && state.x_m < 25.0,
+        "contact at {} s, x = {}",
+        contact.time_s,
+        state.x_m
+    );
+    assert!(state.y_m > 0.5, "the arc bent left: y = {}", state.y_m);
 }

@@ -1,0 +1,88 @@
+//! `taxi-sim scan`: one LiDAR revolution of a scenario's world from a point of its route, as PLY.
+
+use std::path::PathBuf;
+
+use anyhow::Context as _;
+use nalgebra::{Isometry2, Vector2};
+use sim::lidar::{Lidar, LidarConfig, SweepPoses};
+use sim::ply::Frame;
+use sim::scenario::Scenario;
+use sim::world::World;
+
+/// Arguments of `taxi-sim scan`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ScanArgs {
+    /// The scenario file.
+    pub scenario: PathBuf,
+    /// Where on the route, metres along it from its first point (0 = the start pose).
+    #[arg(long, default_value_t = 0.0)]
+    pub at: f64,
+    /// Output PLY file.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Frame of the points.
+    #[arg(long, value_enum, default_value_t = Frame::World)]
+    pub frame: Frame,
+    /// Leave out the run-time obstacles (the world of the mapping drive).
+    #[arg(long)]
+    pub static_only: bool,
+}
+
+/// Runs `taxi-sim scan`.
+pub fn run(args: &ScanArgs) -> anyhow::Result<()> {
+    let scenario = Scenario::from_file(&args.scenario)?;
+    anyhow::ensure!(
+        args.at.is_finite() && args.at >= 0.0,
+        "--at {}: must be a distance >= 0 along the route",
+        args.at
+    );
+    let pose = if args.at == 0.0 {
+        scenario.vehicle.world_from_start
+    } else {
+        pose_along(&scenario, args.at)?
+    };
+    let vehicle = &scenario.vehicle.vehicle;
+    let world = World::new(
+        &scenario.scene(!args.static_only),
+        !args.static_only,
+        vehicle,
+        &pose,
+    );
+    let lidar = Lidar::new(LidarConfig::default(), vehicle.vehicle_from_lidar())
+        .map_err(anyhow::Error::msg)?;
+    let scan = lidar.scan(&world, &SweepPoses::still(pose), 0, scenario.seed);
+    sim::ply::write(&scan, args.frame, &args.out)
+        .with_context(|| format!("writing {}", args.out.display()))?;
+    let n = scan.scan.returns().iter().flatten().count();
+    crate::emit(&format!(
+        "{}: {n} of {} rays returned, vehicle at ({:.2}, {:.2}) heading {:.1} deg; wrote {}\n",
+        scenario.name,
+        lidar.rays(),
+        pose.translation.x,
+        pose.translation.y,
+        pose.rotation.angle().to_degrees(),
+        args.out.display()
+    ))
+}
+
+/// The pose `s` metres along the route's polyline, heading along its segment.
+fn pose_along(scenario: &Scenario, s: f64) -> anyhow::Result<Isometry2<f64>> {
+    let route = &scenario.route;
+    let mut points = route.waypoints_m.clone();
+    if route.closed
+        && let Some(first) = points.first().copied()
+    {
+        points.push(first);
+    }
+    let mut left = s;
+    for w in points.windows(2) {
+        let d = w[1] - w[0];
+        let len = d.norm();
+        if left <= len && len > 0.0 {
+            let p = w[0] + d * (left / len);
+            return Ok(Isometry2::new(Vector2::new(p.x, p.y), d.y.atan2(d.x)));
+        }
+        left -= len;
+    }
+    anyhow::bail!("--at {s}: the route is only {:.1} m long", route.length_m())
+}
