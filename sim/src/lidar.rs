@@ -17,6 +17,7 @@
 use nalgebra::{Isometry2, Isometry3, Point3, Vector3};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
+use rand_distr::StandardNormal;
 use rapier3d::prelude::*;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -176,9 +177,10 @@ struct Candidate<'a> {
     analytic: Option<Vertical>,
     /// Horizontal distance from the sweep origin to the collider's bounding box, metres.
     d_min: f32,
-    /// Elevation window seen from the sweep origin, radians.
-    el_min: f32,
-    el_max: f32,
+    /// Sines of the elevation window seen from the sweep origin, compared with a direction's z
+    /// (sin is monotonic): no asin a ray.
+    sin_el_min: f32,
+    sin_el_max: f32,
 }
 
 impl Lidar {
@@ -286,8 +288,10 @@ impl Lidar {
                 collider,
                 analytic,
                 d_min,
-                el_min: el_bottom_min.min(el_top_max) - 1e-3,
-                el_max: el_top_max + 1e-3,
+                sin_el_min: (el_bottom_min.min(el_top_max) - 1e-3)
+                    .max(-std::f32::consts::FRAC_PI_2)
+                    .sin(),
+                sin_el_max: (el_top_max + 1e-3).min(std::f32::consts::FRAC_PI_2).sin(),
             });
             // Azimuth window: all columns when the origin is inside (or near) the box's footprint.
             if d_min <= 0.0 {
@@ -362,15 +366,14 @@ impl Lidar {
                         best = Some((t, Owner::Ground));
                     }
                 }
-                let horizontal = dir.x.hypot(dir.y);
-                let el = dir.z.asin();
+                let horizontal = (dir.x * dir.x + dir.y * dir.y).sqrt();
                 let ray = Ray::new(o, dir);
                 for &i in &buckets[c] {
                     let cand = &candidates[i as usize];
                     if t_best * horizontal < cand.d_min {
                         break; // sorted by distance: nothing farther can be nearer than the hit
                     }
-                    if el < cand.el_min || el > cand.el_max {
+                    if dir.z < cand.sin_el_min || dir.z > cand.sin_el_max {
                         continue;
                     }
                     let hit = match &cand.analytic {
@@ -432,45 +435,51 @@ impl Lidar {
         let beams = self.config.channels;
         let self_hits = self.self_hits(world);
         let scene = world.scene();
-        let per_column: Vec<ColumnOut> = (0..self.config.columns)
-            .into_par_iter()
-            .map(|c| {
+        // Every column writes its own slices of the preallocated outputs: no per-column vectors
+        // to join afterwards.
+        let n = self.config.columns * beams;
+        let mut returns: Vec<Option<mapper::Return>> = vec![None; n];
+        let mut owners: Vec<Option<Owner>> = vec![None; n];
+        let mut columns = vec![
+            mapper::ScanColumn {
+                world_from_sensor: Isometry3::identity(),
+                world_from_vehicle: Isometry2::identity()
+            };
+            self.config.columns
+        ];
+        returns
+            .par_chunks_mut(beams)
+            .zip(owners.par_chunks_mut(beams))
+            .zip(columns.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, ((returns, owners), column))| {
                 let (vehicle, sensor) = self.column_poses(sweep, c);
-                let rot = sensor.rotation;
+                // Sensor to world rotation as an f32 matrix: 9 multiplications a ray.
+                let r = sensor
+                    .rotation
+                    .to_rotation_matrix()
+                    .matrix()
+                    .map(|v| v as f32);
                 let dirs: Vec<[f32; 3]> = self.directions[c * beams..(c + 1) * beams]
                     .iter()
                     .map(|d| {
-                        let w = rot * Vector3::new(d[0] as f64, d[1] as f64, d[2] as f64);
-                        [w.x as f32, w.y as f32, w.z as f32]
+                        let w = r * nalgebra::Vector3::new(d[0], d[1], d[2]);
+                        [w.x, w.y, w.z]
                     })
                     .collect();
                 let mut hits = self_hits[c * beams..(c + 1) * beams].to_vec();
                 let origin = Point3::from(sensor.translation.vector);
                 cast(c, origin, &dirs, &mut hits);
                 let mut rng = Xoshiro256PlusPlus::seed_from_u64(mix(seed, scan_index, c as u64));
-                let (returns, owners) = hits
-                    .iter()
-                    .zip(&dirs)
-                    .map(|(hit, d)| self.measure(scene, &mut rng, origin, *hit, d))
-                    .unzip();
-                ColumnOut {
-                    column: mapper::ScanColumn {
-                        world_from_sensor: sensor,
-                        world_from_vehicle: vehicle,
-                    },
-                    returns,
-                    owners,
+                for b in 0..beams {
+                    (returns[b], owners[b]) =
+                        self.measure(scene, &mut rng, origin, hits[b], &dirs[b]);
                 }
-            })
-            .collect();
-        let mut columns = Vec::with_capacity(per_column.len());
-        let mut returns = Vec::with_capacity(per_column.len() * beams);
-        let mut owners = Vec::with_capacity(per_column.len() * beams);
-        for out in per_column {
-            columns.push(out.column);
-            returns.extend(out.returns);
-            owners.extend(out.owners);
-        }
+                *column = mapper::ScanColumn {
+                    world_from_sensor: sensor,
+                    world_from_vehicle: vehicle,
+                };
+            });
         // Finite poses and points by construction; an error here would be a bug, reported as an empty scan.
         let scan = mapper::Scan::new(beams, columns, returns).unwrap_or_default();
         LidarScan {
@@ -480,8 +489,7 @@ impl Lidar {
         }
     }
 
-    /// One ray's return: range noise, intensity, drop-off. Four draws a ray, hit or not, so the
-    /// stream does not depend on what was hit.
+    /// One ray's return: range noise, intensity, drop-off.
     fn measure(
         &self,
         scene: &crate::scene::Scene,
@@ -491,20 +499,14 @@ impl Lidar {
         d: &[f32; 3],
     ) -> (Option<mapper::Return>, Option<Owner>) {
         let cfg = &self.config;
-        let (u1, u2, u3, u4): (f64, f64, f64, f64) = (
-            rng.random_range(1e-12..1.0),
-            rng.random(),
-            rng.random(),
-            rng.random(),
-        );
+        // Three draws a ray, hit or not, so the stream does not depend on what was hit: a standard
+        // normal (ziggurat, usually one draw) and two uniforms for the drop-off.
+        let z: f64 = rng.sample(StandardNormal);
+        let (u3, u4): (f64, f64) = (rng.random(), rng.random());
         let Some((t, owner)) = hit else {
             return (None, None);
         };
-        let noise = if cfg.noise_stddev_m > 0.0 {
-            cfg.noise_stddev_m * (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-        } else {
-            0.0
-        };
+        let noise = cfg.noise_stddev_m * z;
         let range = (t as f64 + noise).max(0.0);
         let point = origin + Vector3::new(d[0] as f64, d[1] as f64, d[2] as f64) * range;
         let remission = match owner {
@@ -678,13 +680,6 @@ impl Vertical {
         }
         best.map(|t| t as f32)
     }
-}
-
-/// One column's share of a scan.
-struct ColumnOut {
-    column: mapper::ScanColumn,
-    returns: Vec<Option<mapper::Return>>,
-    owners: Vec<Option<Owner>>,
 }
 
 /// SplitMix64 over (seed, scan, column): independent streams per column.
