@@ -97,15 +97,9 @@ impl Vehicle {
         }
     }
 
-    /// Pose of the LiDAR in the vehicle frame (the sidecar's `lidar.xyz_m` and `lidar.rpy_rad`,
-    /// roll-pitch-yaw about fixed x, y, z as in URDF).
+    /// Pose of the LiDAR in the vehicle frame (the sidecar's `lidar.xyz_m` and `lidar.rpy_rad`).
     pub fn vehicle_from_lidar(&self) -> nalgebra::Isometry3<f64> {
-        let [x, y, z] = self.spec.lidar.xyz_m;
-        let [roll, pitch, yaw] = self.spec.lidar.rpy_rad;
-        nalgebra::Isometry3::from_parts(
-            nalgebra::Translation3::new(x, y, z),
-            nalgebra::UnitQuaternion::from_euler_angles(roll, pitch, yaw),
-        )
+        self.spec.lidar.vehicle_from_lidar()
     }
 
     /// Fits the circle model with the spec's heights of interest and fit options.

@@ -20,8 +20,10 @@
 //! 4. then, per column, one straight cell walk (Bresenham) from the sensor to the farthest
 //!    return the level considers adds `l_free`, leaving the last `free_space_stop_cells` cells
 //!    of the line (the endpoint's cell included) untouched and stopping at the first live cell
-//!    with p >= 0.5. The beams of a column share its vertical plane, so one walk per column
-//!    covers each of its beams' 2D traces once.
+//!    with p >= 0.5 that this scan hit ([`FreeSpaceStop::ScanHits`], the default; older occupied
+//!    cells on the way are lowered, so moved obstacles clear) or at any such cell
+//!    ([`FreeSpaceStop::AnyOccupied`], CARMEN's rule). The beams of a column share its vertical
+//!    plane, so one walk per column covers each of its beams' 2D traces once.
 
 use nalgebra::Point2;
 use rayon::prelude::*;
@@ -74,6 +76,23 @@ pub struct MapConfig {
     pub max_distance_m: f32,
     /// Live / prior merge.
     pub merge: MergeMode,
+    /// Which occupied cells end a free-space walk.
+    pub free_space_stop: FreeSpaceStop,
+}
+
+/// Which occupied cells (p >= 0.5) end a free-space walk.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FreeSpaceStop {
+    /// Cells hit by the scan being inserted, and older occupied cells the beam passes above
+    /// the level's height plus 0.2 m (a beam over a cone is no evidence the cone left). An older
+    /// occupied cell the beam passes lower through is lowered by `l_free`, so an obstacle that
+    /// moved away (a crossing vehicle) is cleared. The default.
+    #[default]
+    ScanHits,
+    /// Any live cell with p >= 0.5 (CARMEN's rule): what was once occupied and is not hit again
+    /// is never walked through, so the cells a moving obstacle left stay occupied.
+    AnyOccupied,
 }
 
 impl Default for MapConfig {
@@ -89,6 +108,7 @@ impl Default for MapConfig {
             obstacle_threshold: 0.5,
             max_distance_m: 30.0,
             merge: MergeMode::Fallback,
+            free_space_stop: FreeSpaceStop::ScanHits,
         }
     }
 }
@@ -177,6 +197,10 @@ struct Classified {
 }
 
 const DROPPED: u32 = u32::MAX;
+
+/// With [`FreeSpaceStop::ScanHits`], a beam clears an older occupied cell only when it crosses
+/// it lower than this above the level's height, metres.
+const CLEAR_MARGIN_M: f64 = 0.2;
 
 /// The local window of a quantized multi-height occupancy grid map.
 #[derive(Debug)]
@@ -364,8 +388,13 @@ impl MultiHeightMap {
         }
         self.live_remission.set_origin(origin);
         self.prior_remission.set_origin(origin);
-        for m in self.odm.levels_mut() {
-            m.set_origin(origin);
+        // The distance maps (a region of the old window, perhaps) start over on the new window.
+        let n = self.levels.count();
+        if let Some(maps) = DistanceMaps::new(
+            self.levels.mode(),
+            vec![DistanceMap::empty(self.geometry, self.config.max_distance_m); n],
+        ) {
+            self.odm = maps;
         }
         for (index, (prior, live)) in loaded {
             self.put_blocks(index, prior.as_ref(), live.as_ref());
@@ -591,11 +620,56 @@ impl MultiHeightMap {
         stats.out_of_range = counts.2;
     }
 
-    /// Recomputes the distance maps of the levels that changed since the last call. Returns how many.
+    /// Recomputes the distance maps of the levels that changed since the last call, over the
+    /// whole window. Returns how many.
     pub fn update_distance_maps(&mut self) -> usize {
+        let (w, h) = (self.geometry.width(), self.geometry.height());
+        self.update_distance_region(0, 0, w, h)
+    }
+
+    /// Like [`Self::update_distance_maps`] but only over the square of half side `half_size_m`
+    /// around `center` (clipped to the window): what a vehicle's checks need, at a fraction of
+    /// the cost. Obstacles outside the square are not seen, so a distance is exact wherever the
+    /// nearest obstacle lies inside it - in particular everywhere the distance is smaller than
+    /// the gap to the square's edge. Moving the square recomputes every level.
+    pub fn update_distance_maps_around(&mut self, center: Point2<f64>, half_size_m: f64) -> usize {
+        let g = self.geometry;
+        let half = (half_size_m / g.resolution_m()).ceil().max(1.0) as i64;
+        let (cx, cy) = g.cell_coords(&center);
+        let (w, h) = (g.width() as i64, g.height() as i64);
+        let (x0, x1) = ((cx - half).clamp(0, w), (cx + half).clamp(0, w));
+        let (y0, y1) = ((cy - half).clamp(0, h), (cy + half).clamp(0, h));
+        if x1 <= x0 || y1 <= y0 {
+            return 0;
+        }
+        self.update_distance_region(
+            x0 as usize,
+            y0 as usize,
+            (x1 - x0) as usize,
+            (y1 - y0) as usize,
+        )
+    }
+
+    fn update_distance_region(&mut self, x0: usize, y0: usize, rw: usize, rh: usize) -> usize {
+        let g = self.geometry;
+        let origin = g.origin_m() + nalgebra::Vector2::new(x0 as f64, y0 as f64) * g.resolution_m();
+        let Ok(region) = GridGeometry::new(origin, g.resolution_m(), rw, rh) else {
+            return 0;
+        };
+        if self.odm.geometry() != &region {
+            let n = self.levels.count();
+            if let Some(maps) = DistanceMaps::new(
+                self.levels.mode(),
+                vec![DistanceMap::empty(region, self.config.max_distance_m); n],
+            ) {
+                self.odm = maps;
+            }
+            self.odm_dirty.iter_mut().for_each(|d| *d = true);
+        }
         let threshold = self.config.obstacle_threshold;
         let l_threshold = (threshold / (1.0 - threshold)).ln();
         let merge = self.config.merge;
+        let width = g.width();
         let mut recomputed = 0;
         for k in 0..self.levels.count() {
             if !self.odm_dirty[k] {
@@ -603,13 +677,16 @@ impl MultiHeightMap {
             }
             let live = self.live[k].data();
             let prior = self.prior[k].data();
-            let is_obstacle = |i: usize| match merge {
-                MergeMode::Fallback => {
-                    let l = if live[i].is_nan() { prior[i] } else { live[i] };
-                    l > l_threshold
-                }
-                MergeMode::Decay => {
-                    merge_log_odds(live[i], prior[i], merge).is_some_and(|l| l > l_threshold)
+            let is_obstacle = |i: usize| {
+                let j = (y0 + i / rw) * width + x0 + i % rw;
+                match merge {
+                    MergeMode::Fallback => {
+                        let l = if live[j].is_nan() { prior[j] } else { live[j] };
+                        l > l_threshold
+                    }
+                    MergeMode::Decay => {
+                        merge_log_odds(live[j], prior[j], merge).is_some_and(|l| l > l_threshold)
+                    }
                 }
             };
             self.odm.levels_mut()[k].recompute(is_obstacle, &mut self.edt_scratch);
@@ -753,6 +830,7 @@ fn insert_level(
     };
     // Hits first, so this scan's obstacles already stop this scan's free-space walks.
     let mut hits = 0;
+    let mut hit_cells: Vec<u32> = Vec::new();
     for column in classified.chunks_exact(beams) {
         let nearest = column
             .iter()
@@ -772,9 +850,20 @@ fn insert_level(
                     },
                 );
                 hits += 1;
+                hit_cells.push(c.cell);
             }
         }
     }
+    hit_cells.sort_unstable();
+    hit_cells.dedup();
+    // Below this height a beam crossing an older occupied cell is evidence the cell is free.
+    let clear_below = levels.heights_m()[k] + CLEAR_MARGIN_M;
+    let stops_walk = |i: usize, ray_z: f64| match config.free_space_stop {
+        FreeSpaceStop::AnyOccupied => true,
+        FreeSpaceStop::ScanHits => {
+            ray_z >= clear_below || hit_cells.binary_search(&(i as u32)).is_ok()
+        }
+    };
     // One free-space walk per column, to the farthest return this level considers.
     let mut free = 0;
     let (w, h) = (geometry.width() as i64, geometry.height() as i64);
@@ -792,22 +881,44 @@ fn insert_level(
         let (x0, y0) = geometry.cell_coords(&Point2::new(sensor.x, sensor.y));
         let (x1, y1) =
             geometry.cell_coords(&Point2::new(end.point_in_world.x, end.point_in_world.y));
+        // The lowest beam of the column crossing each distance: the nearest return beyond it.
+        let ground = config.obstacle_test.ground_height_m;
+        let sensor_z = sensor.z - ground;
+        let mut ends: Vec<(f64, f64)> = column
+            .iter()
+            .filter(|c| c.cell != DROPPED && class(c) != HeightClass::Above)
+            .map(|c| (c.range_xy_m as f64, c.height_m as f64))
+            .collect();
+        ends.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let ray_z = |r: f64| {
+            let i = ends.partition_point(|e| e.0 <= r);
+            ends.get(i).map_or(sensor_z, |&(range, z)| {
+                sensor_z + (z - sensor_z) * r / range.max(1e-6)
+            })
+        };
+        let total = (Point2::new(end.point_in_world.x, end.point_in_world.y)
+            - Point2::new(sensor.x, sensor.y))
+        .norm();
         free += walk_free(
             data,
             w,
             h,
             (x0, y0),
             (x1, y1),
+            total,
             config.free_space_stop_cells,
             occ.l_free,
             occ.l_max,
+            &|i, r| stops_walk(i, ray_z(r)),
         );
     }
     (hits, free)
 }
 
 /// Bresenham walk from `a` to `b` adding `l_free` to each cell but the last `stop_short` ones,
-/// stopping at the first known cell with p >= 0.5 or at the window's edge. Returns the cells updated.
+/// stopping at the window's edge or at the first known cell with p >= 0.5 for which
+/// `stops(index, distance from the sensor)` holds (other occupied cells are lowered and passed);
+/// the line is `length_m` long. Returns the cells updated.
 #[allow(clippy::too_many_arguments)]
 fn walk_free(
     data: &mut [f32],
@@ -815,9 +926,11 @@ fn walk_free(
     h: i64,
     a: (i64, i64),
     b: (i64, i64),
+    length_m: f64,
     stop_short: usize,
     l_free: f32,
     l_max: f32,
+    stops: &dyn Fn(usize, f64) -> bool,
 ) -> usize {
     let (dx, dy) = ((b.0 - a.0).abs(), -(b.1 - a.1).abs());
     let (sx, sy) = ((b.0 - a.0).signum(), (b.1 - a.1).signum());
@@ -825,12 +938,14 @@ fn walk_free(
     let steps = (cells - stop_short as i64).max(0);
     let (mut x, mut y, mut err) = (a.0, a.1, dx + dy);
     let mut updated = 0;
-    for _ in 0..steps {
+    let per_step = length_m / (cells - 1).max(1) as f64;
+    for step in 0..steps {
         if x < 0 || y < 0 || x >= w || y >= h {
             break;
         }
-        let v = &mut data[(y * w + x) as usize];
-        if *v >= 0.0 {
+        let i = (y * w + x) as usize;
+        let v = &mut data[i];
+        if *v >= 0.0 && stops(i, per_step * step as f64) {
             break; // p >= 0.5 (NaN, unknown, compares false)
         }
         let cur = if v.is_nan() { 0.0 } else { *v };

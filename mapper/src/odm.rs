@@ -73,9 +73,6 @@ impl DistanceMap {
     pub fn max_distance_m(&self) -> f32 {
         self.max_distance_m
     }
-    pub(crate) fn set_origin(&mut self, origin_m: Point2<f64>) {
-        self.grid.set_origin(origin_m);
-    }
 }
 
 /// The distance maps of every level of a map, on one shared geometry.

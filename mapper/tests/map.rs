@@ -436,3 +436,90 @@ fn bad_block_files_are_errors_that_name_the_file() {
     .to_string();
     assert!(err.contains("heights[1]"), "{err}");
 }
+
+#[test]
+fn distance_maps_around_the_vehicle_equal_the_full_window_inside_their_reach() {
+    let scene = scene(vec![
+        Solid::standing_box(12.0, 5.0, 2.0, 1.0, 1.5),
+        Solid::post(-6.0, -9.0, 0.3, 2.0),
+        Solid::post(30.0, 0.0, 0.3, 2.0),
+    ]);
+    let mut map = map_with(Levels::cumulative(vec![0.0, 0.7]).unwrap());
+    insert(&mut map, &scene, 2);
+    map.update_distance_maps();
+    let full: Vec<mapper::DistanceMap> = map.distance_maps().levels().to_vec();
+    assert_eq!(
+        map.update_distance_maps_around(Point2::new(1.0, 1.0), 20.0),
+        2
+    );
+    let region = map.distance_maps();
+    let g = *region.geometry();
+    assert_eq!((g.width(), g.height()), (200, 200));
+    let mut compared = 0;
+    for (k, full_k) in full.iter().enumerate() {
+        for y in (0..g.height()).step_by(7) {
+            for x in (0..g.width()).step_by(7) {
+                let p = g.center_of(mapper::Cell { x, y });
+                let d_region = region.level(k).unwrap().distance_at(&p);
+                let d_full = full_k.distance_at(&p);
+                let to_edge = (p.x - g.origin_m().x)
+                    .min(p.y - g.origin_m().y)
+                    .min(g.origin_m().x + 40.0 - p.x)
+                    .min(g.origin_m().y + 40.0 - p.y);
+                if (d_full as f64) < to_edge {
+                    assert!(
+                        (d_region - d_full).abs() < 1e-5,
+                        "level {k} at {p:?}: {d_region} vs {d_full}"
+                    );
+                    compared += 1;
+                } else {
+                    assert!(
+                        d_region >= d_full,
+                        "a region never sees an obstacle the window does not"
+                    );
+                }
+            }
+        }
+    }
+    assert!(compared > 500, "{compared}");
+    // Unchanged levels and region: nothing to recompute.
+    assert_eq!(
+        map.update_distance_maps_around(Point2::new(1.0, 1.0), 20.0),
+        0
+    );
+    // Re-centring hands back full-window maps until the next update.
+    assert!(map.recenter(Point2::new(80.0, 0.0)).unwrap());
+    assert_eq!(map.distance_maps().geometry().width(), 1050);
+}
+
+/// A crossing vehicle: with CARMEN's walk rule the cells it left stay occupied for ever; with the
+/// default rule the beams that now pass through them clear them.
+#[test]
+fn cells_an_obstacle_left_are_cleared_unless_walks_stop_at_any_occupied_cell() {
+    let with_car = scene(vec![Solid::standing_box(10.0, 0.0, 1.8, 4.5, 1.5)]);
+    let without = scene(vec![]);
+    let face = Point2::new(9.15, 0.0);
+    for (rule, cleared) in [
+        (mapper::FreeSpaceStop::ScanHits, true),
+        (mapper::FreeSpaceStop::AnyOccupied, false),
+    ] {
+        let config = MapConfig {
+            free_space_stop: rule,
+            ..Default::default()
+        };
+        let mut map = MultiHeightMap::new(
+            config,
+            Levels::cumulative(vec![0.0]).unwrap(),
+            Point2::origin(),
+        )
+        .unwrap();
+        insert(&mut map, &with_car, 3);
+        assert!(
+            map.probability_at(0, &face).unwrap() > 0.9,
+            "{rule:?}: the car is mapped"
+        );
+        insert(&mut map, &without, 40);
+        let p = map.probability_at(0, &face).unwrap();
+        assert_eq!(p < 0.5, cleared, "{rule:?}: p = {p} after the car left");
+    }
+}

@@ -6,6 +6,7 @@
 
 mod check_cli;
 mod model_cli;
+mod run_cli;
 mod scan_cli;
 
 use std::fmt::Write as _;
@@ -51,6 +52,11 @@ enum Command {
         #[arg(long, default_value_t = 15)]
         samples: usize,
     },
+    /// Run a scenario in closed loop (builds its offline map first when missing or stale).
+    /// Exit code 0 when every expectation held, 1 when one did not, 2 on bad input.
+    Run(run_cli::RunArgs),
+    /// The mapping drive: build a scenario's offline multi-height map.
+    Map(run_cli::MapArgs),
     /// Validate a scenario file and print a summary.
     Check(check_cli::CheckArgs),
     /// Write one LiDAR revolution of a scenario's world as PLY.
@@ -92,7 +98,7 @@ pub(crate) fn emit(text: &str) -> anyhow::Result<()> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) if e.is::<StdoutClosed>() => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
@@ -101,8 +107,21 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(cli: Cli) -> anyhow::Result<()> {
+fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
+        Command::Run(args) => run_cli::run_cmd(&args).map(|met| {
+            if met {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }),
+        other => run_unit(other).map(|()| ExitCode::SUCCESS),
+    }
+}
+
+fn run_unit(command: Command) -> anyhow::Result<()> {
+    match command {
         Command::Demo { out, scans, seed } => demo(out, scans, seed),
         Command::Bench {
             what,
@@ -111,6 +130,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         } => bench(what, json, samples),
         Command::Model(ModelCommand::Fit(args)) => model_cli::run(&args),
         Command::Check(args) => check_cli::run(&args),
+        Command::Map(args) => run_cli::map(&args),
+        Command::Run(_) => unreachable!("dispatched in run"),
         Command::Scan(args) => scan_cli::run(&args),
     }
 }

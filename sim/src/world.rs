@@ -290,6 +290,38 @@ impl World {
         }
     }
 
+    /// Distance from object `i` to each vehicle part at the current pose, metres (0 when
+    /// touching; empty when the object is absent or unknown).
+    pub fn distances_to(&self, i: usize) -> Vec<f64> {
+        let Some(obj) = self
+            .objects
+            .get(i)
+            .filter(|_| self.object_active(i))
+            .and_then(|h| self.physics.colliders.get(*h))
+        else {
+            return Vec::new();
+        };
+        self.parts
+            .iter()
+            .filter_map(|(h, _)| self.physics.colliders.get(*h))
+            .map(|part| {
+                parry3d::query::distance(part.position(), part.shape(), obj.position(), obj.shape())
+                    .map_or(f64::INFINITY, |d| d.distance as f64)
+            })
+            .collect()
+    }
+
+    /// The vehicle's reference point in the world (x, y).
+    pub fn vehicle_position(&self) -> nalgebra::Point2<f64> {
+        self.physics
+            .bodies
+            .get(self.vehicle)
+            .map_or(nalgebra::Point2::origin(), |b| {
+                let t = b.translation();
+                nalgebra::Point2::new(t.x as f64, t.y as f64)
+            })
+    }
+
     /// Contacts so far, in time order.
     pub fn contacts(&self) -> &[Contact] {
         &self.contacts

@@ -1,0 +1,224 @@
+//! The mapping drive: the route driven exactly (the thesis' manual drive) through the world
+//! without its run-time obstacles, building the offline multi-height map and remission map.
+//!
+//! Output directory: `blocks/` (the map blocks, the closed loop's prior), `level<k>.yaml/.pgm`
+//! (ROS map_server) and `level<k>.png` over the route's extent, and `manifest.json` whose
+//! fingerprint (scenario and vehicle files, map and LiDAR settings, format) tells `taxi-sim run`
+//! whether the map is stale.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use mapper::export::{TrinaryThresholds, write_occupancy_png, write_ros_map};
+use mapper::{BlockStore, Grid, GridGeometry, Levels, MapConfig, MultiHeightMap};
+use nalgebra::{Isometry2, Point2};
+
+use crate::autonomy::RoutePath;
+use crate::lidar::{Lidar, LidarConfig, SweepPoses};
+use crate::scenario::Scenario;
+use crate::world::World;
+
+/// Bumped when the mapping drive changes what it builds.
+const MAP_FORMAT: u32 = 1;
+
+/// What a mapping drive did.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct MapManifest {
+    /// Fingerprint of everything the map depends on (hex CRC-32).
+    pub fingerprint: String,
+    /// Scenario name.
+    pub scenario: String,
+    /// Revolutions inserted.
+    pub scans: usize,
+    /// Route length driven, metres.
+    pub route_m: f64,
+    /// Block files written.
+    pub blocks: usize,
+    /// Heights of interest of the levels, metres.
+    pub level_heights_m: Vec<f64>,
+    /// Occupied cells (p > 0.5) per level over the exported extent.
+    pub occupied_cells: Vec<usize>,
+}
+
+/// The map settings the simulator uses (the mapper's defaults).
+pub fn map_config() -> MapConfig {
+    MapConfig {
+        self_hit_margin_m: 1.5,
+        ..MapConfig::default()
+    }
+}
+
+/// Fingerprint of a scenario's offline map inputs.
+pub fn fingerprint(scenario: &Scenario) -> anyhow::Result<String> {
+    let mut h = crc32fast::Hasher::new();
+    h.update(
+        &std::fs::read(&scenario.path)
+            .with_context(|| format!("reading {}", scenario.path.display()))?,
+    );
+    h.update(format!("{:?}", scenario.vehicle.vehicle).as_bytes());
+    h.update(format!("{:?}{:?}{MAP_FORMAT}", map_config(), LidarConfig::default()).as_bytes());
+    Ok(format!("{:08x}", h.finalize()))
+}
+
+/// The manifest of the map in `dir`, if it exists and matches `scenario`.
+pub fn fresh_manifest(scenario: &Scenario, dir: &Path) -> anyhow::Result<Option<MapManifest>> {
+    let Ok(text) = std::fs::read_to_string(dir.join("manifest.json")) else {
+        return Ok(None);
+    };
+    let Ok(manifest) = serde_json::from_str::<MapManifest>(&text) else {
+        return Ok(None);
+    };
+    Ok((manifest.fingerprint == fingerprint(scenario)?).then_some(manifest))
+}
+
+/// The circles the LiDAR self-hit filter uses: every part at its own level (the banded fit keeps
+/// the parts a cumulative fit drops because they lie over a lower level's parts, such as a wing
+/// root over the fuselage), so returns off the vehicle's own wing are dropped while a cone under
+/// the wing is not.
+pub fn self_filter_model(vehicle: &aircraft::Vehicle) -> anyhow::Result<mapper::CollisionModel> {
+    let options = aircraft::FitOptions {
+        banded_maps: true,
+        ..vehicle.spec.fit.clone()
+    };
+    Ok(vehicle
+        .fit_with(&vehicle.spec.heights_of_interest_m, &options)
+        .context("fitting the self-hit filter's circles")?
+        .model)
+}
+
+/// The levels a scenario's vehicle asks for (its heights of interest, cumulative).
+pub fn levels_of(scenario: &Scenario) -> anyhow::Result<Levels> {
+    Ok(Levels::cumulative(
+        scenario.vehicle.vehicle.spec.heights_of_interest_m.clone(),
+    )?)
+}
+
+/// Drives the route once and writes the offline map into `out`. `progress(done, total)` after each scan.
+pub fn map_drive(
+    scenario: &Scenario,
+    out: &Path,
+    progress: &mut dyn FnMut(usize, usize),
+) -> anyhow::Result<MapManifest> {
+    let vehicle = &scenario.vehicle.vehicle;
+    let self_filter = self_filter_model(vehicle)?;
+    let levels = levels_of(scenario)?;
+    let blocks_dir = out.join("blocks");
+    if blocks_dir.exists() {
+        std::fs::remove_dir_all(&blocks_dir)
+            .with_context(|| format!("clearing {}", blocks_dir.display()))?;
+    }
+    let route = RoutePath::new(&scenario.route.waypoints_m, scenario.route.closed);
+    let start = scenario.vehicle.world_from_start;
+    let mut world = World::new(&scenario.scene(false), false, vehicle, &start);
+    let lidar = Lidar::new(LidarConfig::default(), vehicle.vehicle_from_lidar())
+        .map_err(anyhow::Error::msg)?;
+    let mut map = MultiHeightMap::with_stores(
+        map_config(),
+        levels.clone(),
+        Point2::from(start.translation.vector),
+        None,
+        Some(&blocks_dir),
+    )?;
+    // One revolution every 0.1 s at the route's speed.
+    let spacing = (scenario.route.speed_m_s * 0.1).max(0.05);
+    let scans = (route.length_m() / spacing).ceil() as usize + 1;
+    for k in 0..scans {
+        let s = (k as f64 * spacing).min(route.length_m());
+        let (p, heading) = route.at(s);
+        let pose = Isometry2::new(p.coords, heading);
+        world.set_vehicle_pose(&pose, k as f64 * 0.1);
+        let scan = lidar.scan(&world, &SweepPoses::still(pose), k as u64, scenario.seed);
+        map.recenter(p)?;
+        map.insert_scan(&scan.scan, Some(&self_filter))?;
+        progress(k + 1, scans);
+    }
+    map.flush()?;
+    let store = BlockStore::open(&blocks_dir, map.block_spec().clone())?;
+    let blocks = store.list()?.len();
+    let occupied_cells = export_levels(&store, &levels, &route, out)?;
+    let manifest = MapManifest {
+        fingerprint: fingerprint(scenario)?,
+        scenario: scenario.name.clone(),
+        scans,
+        route_m: route.length_m(),
+        blocks,
+        level_heights_m: levels.heights_m().to_vec(),
+        occupied_cells,
+    };
+    mapper::write_atomically(
+        &out.join("manifest.json"),
+        serde_json::to_string_pretty(&manifest)?.as_bytes(),
+    )?;
+    Ok(manifest)
+}
+
+/// Writes each level over the blocks' extent as a ROS map and a PNG; returns occupied cells per level.
+fn export_levels(
+    store: &BlockStore,
+    levels: &Levels,
+    _route: &RoutePath,
+    out: &Path,
+) -> anyhow::Result<Vec<usize>> {
+    let spec = store.spec().clone();
+    let indices = store.list()?;
+    let (Some(x0), Some(x1), Some(y0), Some(y1)) = (
+        indices.iter().map(|b| b.x).min(),
+        indices.iter().map(|b| b.x).max(),
+        indices.iter().map(|b| b.y).min(),
+        indices.iter().map(|b| b.y).max(),
+    ) else {
+        return Ok(vec![0; levels.count()]);
+    };
+    let side = spec.side;
+    let (w, h) = (
+        ((x1 - x0 + 1) as usize) * side,
+        ((y1 - y0 + 1) as usize) * side,
+    );
+    let origin = Point2::new(x0 as f64 * spec.side_m(), y0 as f64 * spec.side_m());
+    let geometry = GridGeometry::new(origin, spec.resolution_m, w, h)?;
+    let mut grids: Vec<Grid<f32>> = (0..levels.count())
+        .map(|_| Grid::filled(geometry, -1.0))
+        .collect();
+    for index in indices {
+        let Some(block) = store.load(index)? else {
+            continue;
+        };
+        let (ox, oy) = (
+            ((index.x - x0) as usize) * side,
+            ((index.y - y0) as usize) * side,
+        );
+        for (grid, level) in grids.iter_mut().zip(&block.levels) {
+            let data = grid.data_mut();
+            for r in 0..side {
+                for c in 0..side {
+                    let l = level[r * side + c];
+                    data[(oy + r) * w + ox + c] = if l.is_nan() {
+                        -1.0
+                    } else {
+                        mapper::occupancy::probability(l)
+                    };
+                }
+            }
+        }
+    }
+    let mut occupied = Vec::new();
+    for (k, grid) in grids.iter().enumerate() {
+        write_ros_map(
+            grid,
+            &out.join(format!("level{k}.yaml")),
+            TrinaryThresholds::default(),
+        )?;
+        write_occupancy_png(grid, &out.join(format!("level{k}.png")))?;
+        occupied.push(grid.data().iter().filter(|&&p| p > 0.5).count());
+    }
+    Ok(occupied)
+}
+
+/// Where a scenario's offline map lives by default: `out/maps/<scenario file stem>`.
+pub fn default_map_dir(scenario: &Scenario) -> PathBuf {
+    let stem = scenario
+        .path
+        .file_stem()
+        .map_or_else(|| "scenario".into(), |s| s.to_string_lossy().into_owned());
+    PathBuf::from("out").join("maps").join(stem)
+}

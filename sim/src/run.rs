@@ -1,0 +1,608 @@
+//! The closed loop: world, LiDAR, online multi-height mapping, planner, avoider, behaviour and
+//! follower, judged by ground truth, reported per lap and per obstacle pass.
+//!
+//! Rates: physics (vehicle motion, ground truth, moving obstacles) at `physics_hz` (100 Hz); one
+//! LiDAR revolution, map update and plan every `1 / scan_hz` (10 Hz). The autonomy gets the
+//! vehicle pose with optional Gaussian noise (a localizer comes later) and nothing else from the
+//! world. A run is a pure function of (scenario, seed, options).
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use anyhow::Context as _;
+use mapper::{CollisionModel, MultiHeightMap};
+use nalgebra::{Isometry2, Point2};
+use rand::{RngExt, SeedableRng};
+use rand_distr::StandardNormal;
+use serde::Serialize;
+
+use crate::autonomy::{AutonomyConfig, Behaviour, Plan, RoutePath, avoid, plan, pure_pursuit};
+use crate::lidar::{Lidar, LidarConfig, SweepPoses};
+use crate::motion::{Bicycle, Command, VehicleState};
+use crate::scenario::{Expectation, Scenario};
+use crate::world::{Contact, World};
+
+/// Options of a run.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// Laps (default: the scenario's).
+    pub laps: Option<u32>,
+    /// Seed (default: the scenario's).
+    pub seed: Option<u64>,
+    /// The offline map's directory (built by the mapping drive).
+    pub map_dir: std::path::PathBuf,
+    /// Physics rate, Hz. Default 100.
+    pub physics_hz: f64,
+    /// LiDAR, mapping and planning rate, Hz. Default 10.
+    pub scan_hz: f64,
+    /// Standard deviation of the pose given to the autonomy: position (m) and heading (rad). Default 0.
+    pub pose_noise: (f64, f64),
+    /// Planner, avoider and follower.
+    pub autonomy: AutonomyConfig,
+    /// Distance maps are computed over a square of this half side around the vehicle, metres.
+    /// Default 50: the planner's horizon (30 m) plus a jet's reach (12 m) plus 8 m, so every
+    /// collision decision sees the same distances as over the whole window.
+    pub distance_map_half_size_m: f64,
+    /// Set from outside (Ctrl-C) to end the run with a partial report.
+    pub stop: Arc<AtomicBool>,
+}
+
+impl RunOptions {
+    /// Defaults with the given map directory.
+    pub fn new(map_dir: std::path::PathBuf) -> Self {
+        RunOptions {
+            laps: None,
+            seed: None,
+            map_dir,
+            physics_hz: 100.0,
+            scan_hz: 10.0,
+            pose_noise: (0.0, 0.0),
+            autonomy: AutonomyConfig::default(),
+            distance_map_half_size_m: 50.0,
+            stop: Arc::new(AtomicBool::new(false)),
+        }
+    }
+}
+
+/// One pass of the vehicle by an obstacle.
+#[derive(Clone, Debug, Serialize)]
+pub struct Pass {
+    /// Lap (1-based).
+    pub lap: u32,
+    /// `passed` (no deviation, no stop), `deviated`, `stopped`, `collided`.
+    pub outcome: String,
+    /// Smallest ground-truth distance from the obstacle to the vehicle's parts of each level, metres.
+    pub min_clearance_m: Vec<f64>,
+    /// Largest lateral offset from the route near the obstacle, metres.
+    pub max_offset_m: f64,
+    /// Whether this pass met the obstacle's expectation.
+    pub met: bool,
+}
+
+/// An obstacle and what happened at each pass.
+#[derive(Clone, Debug, Serialize)]
+pub struct ObstacleReport {
+    /// Its id.
+    pub id: String,
+    /// Its kind.
+    pub kind: String,
+    /// What the scenario expects.
+    pub expected: String,
+    /// Every pass.
+    pub passes: Vec<Pass>,
+}
+
+/// A stop of the vehicle.
+#[derive(Clone, Debug, Serialize)]
+pub struct Stop {
+    /// When it stopped, seconds.
+    pub start_s: f64,
+    /// When it moved again, seconds (`None`: still stopped at the end).
+    pub end_s: Option<f64>,
+    /// Where along the route, metres.
+    pub route_s_m: f64,
+}
+
+/// What a run did.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunReport {
+    /// Scenario name.
+    pub scenario: String,
+    /// Seed used.
+    pub seed: u64,
+    /// True when every expectation held and every lap was completed.
+    pub expectations_met: bool,
+    /// Laps asked for.
+    pub laps: u32,
+    /// Laps completed.
+    pub laps_completed: u32,
+    /// Lap times, seconds.
+    pub lap_times_s: Vec<f64>,
+    /// Ground-truth contacts.
+    pub contacts: Vec<Contact>,
+    /// Per run-time obstacle.
+    pub obstacles: Vec<ObstacleReport>,
+    /// Stops.
+    pub stops: Vec<Stop>,
+    /// Smallest ground-truth clearance per level to any object, metres.
+    pub min_clearance_m: Vec<f64>,
+    /// Simulated time, seconds.
+    pub sim_time_s: f64,
+    /// Wall time, seconds.
+    pub wall_time_s: f64,
+    /// Simulated seconds per wall second.
+    pub real_time_factor: f64,
+    /// True when the run was interrupted (Ctrl-C) or timed out.
+    pub interrupted: bool,
+    /// Where the wall time went, seconds: LiDAR, mapping, distance maps, planning, physics.
+    pub time_split_s: TimeSplit,
+}
+
+/// Wall time per stage, seconds.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct TimeSplit {
+    /// Ray casting.
+    pub lidar: f64,
+    /// Scan insertion.
+    pub mapping: f64,
+    /// Distance maps.
+    pub distance_maps: f64,
+    /// Planner and avoider.
+    pub planning: f64,
+    /// Motion, ground truth, obstacles.
+    pub physics: f64,
+}
+
+/// Progress of a run, for a progress bar.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Simulated time, seconds.
+    pub sim_time_s: f64,
+    /// Laps completed.
+    pub laps_completed: u32,
+    /// Fraction of the whole run done, 0..1.
+    pub fraction: f64,
+}
+
+struct PassTracker {
+    solid_index: usize,
+    route_s: f64,
+    expect: Expectation,
+    active: bool,
+    offset: f64,
+    stopped: bool,
+    clearance: Vec<f64>,
+    contacts_before: usize,
+}
+
+/// Runs a scenario in closed loop over its offline map (which must exist: see `mapping`).
+pub fn run(
+    scenario: &Scenario,
+    options: &RunOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> anyhow::Result<RunReport> {
+    let wall = Instant::now();
+    let laps = options.laps.unwrap_or(scenario.laps).max(1);
+    let seed = options.seed.unwrap_or(scenario.seed);
+    let vehicle = &scenario.vehicle.vehicle;
+    let fitted = vehicle
+        .fit()
+        .context("fitting the vehicle's circle model")?;
+    let model: CollisionModel = fitted.model;
+    let self_filter = crate::mapping::self_filter_model(vehicle)?;
+    let heights = model.level_heights_m().to_vec();
+    let part_levels: Vec<usize> = vehicle
+        .parts
+        .iter()
+        .map(|p| aircraft::fit::level_of(p.underside_m(), &heights))
+        .collect();
+    let behaviour = match vehicle.spec.motion.steering {
+        aircraft::spec::Steering::NoseWheel => Behaviour::StopAndWait,
+        aircraft::spec::Steering::FrontWheels => Behaviour::Deviate,
+    };
+    let route = RoutePath::new(&scenario.route.waypoints_m, scenario.route.closed);
+    let start = scenario.vehicle.world_from_start;
+    let scene = scenario.scene(true);
+    let mut world = World::new(&scene, true, vehicle, &start);
+    let lidar = Lidar::new(LidarConfig::default(), vehicle.vehicle_from_lidar())
+        .map_err(anyhow::Error::msg)?;
+    let live = tempfile::tempdir().context("creating the live map's scratch directory")?;
+    let prior = options.map_dir.join("blocks");
+    let mut map = MultiHeightMap::with_stores(
+        crate::mapping::map_config(),
+        crate::mapping::levels_of(scenario)?,
+        Point2::from(start.translation.vector),
+        Some(&prior),
+        Some(live.path()),
+    )?;
+    let bicycle = Bicycle::new(vehicle.spec.motion.clone());
+    let wheelbase = vehicle.spec.motion.wheelbase_m;
+    let decel = vehicle.spec.motion.max_deceleration_m_s2;
+    let mut rng = rand::rngs::Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x005E_ED0F_u64);
+
+    let first_obstacle = scenario.objects.len();
+    let mut trackers: Vec<PassTracker> = scenario
+        .obstacles
+        .iter()
+        .enumerate()
+        .map(|(k, o)| {
+            let at = o
+                .motion
+                .as_ref()
+                .and_then(|m| closest_on_route(&route, &m.path_m))
+                .unwrap_or(Point2::new(o.solid.x_m, o.solid.y_m));
+            PassTracker {
+                solid_index: first_obstacle + k,
+                route_s: route.project(&at, 0.0, f64::INFINITY).0,
+                expect: o.expect,
+                active: false,
+                offset: 0.0,
+                stopped: false,
+                clearance: vec![f64::INFINITY; heights.len()],
+                contacts_before: 0,
+            }
+        })
+        .collect();
+    let mut reports: Vec<ObstacleReport> = scenario
+        .obstacles
+        .iter()
+        .map(|o| ObstacleReport {
+            id: o.solid.id.clone(),
+            kind: crate::scenario::kind_name(o.solid.kind).to_string(),
+            expected: o.expect.as_str().to_string(),
+            passes: Vec::new(),
+        })
+        .collect();
+
+    let dt = 1.0 / options.physics_hz;
+    let steps_per_scan = (options.physics_hz / options.scan_hz).round().max(1.0) as u64;
+    let mut state = VehicleState {
+        x_m: start.translation.x,
+        y_m: start.translation.y,
+        yaw_rad: start.rotation.angle(),
+        ..Default::default()
+    };
+    let length = route.length_m();
+    let total_m = length * laps as f64;
+    let timeout_s = 60.0 + 4.0 * total_m / scenario.route.speed_m_s;
+    let mut split = TimeSplit::default();
+    let (mut s_hint, mut s_total) = (
+        route
+            .project(&Point2::new(state.x_m, state.y_m), 0.0, f64::INFINITY)
+            .0,
+        0.0,
+    );
+    let s_start = s_hint;
+    let mut current: Option<Plan> = None;
+    let mut speed_cmd = 0.0;
+    let mut offset_prev = 0.0;
+    let mut laps_completed = 0;
+    let mut lap_times = Vec::new();
+    let mut lap_start_t = 0.0;
+    let mut stops: Vec<Stop> = Vec::new();
+    let mut min_clearance = vec![f64::INFINITY; heights.len()];
+    let mut t = 0.0;
+    let mut step: u64 = 0;
+    let mut interrupted = false;
+    world.set_vehicle_pose(&state.world_from_vehicle(), 0.0);
+    while laps_completed < laps {
+        if options.stop.load(Ordering::Relaxed) || t > timeout_s {
+            interrupted = true;
+            break;
+        }
+        let physics = Instant::now();
+        for (k, o) in scenario.obstacles.iter().enumerate() {
+            let i = first_obstacle + k;
+            match o.pose_at(t) {
+                Some((x, y, yaw)) => {
+                    if !world.object_active(i) {
+                        world.set_object_active(i, true);
+                    }
+                    if o.motion.is_some() {
+                        world.set_object_pose(i, x, y, yaw);
+                    }
+                }
+                None if world.object_active(i) => world.set_object_active(i, false),
+                None => {}
+            }
+        }
+        split.physics += physics.elapsed().as_secs_f64();
+
+        // The autonomy's view of the pose.
+        let truth = state.world_from_vehicle();
+        let estimate = if options.pose_noise.0 > 0.0 || options.pose_noise.1 > 0.0 {
+            let (nx, ny, nyaw): (f64, f64, f64) = (
+                rng.sample(StandardNormal),
+                rng.sample(StandardNormal),
+                rng.sample(StandardNormal),
+            );
+            Isometry2::new(
+                truth.translation.vector + nalgebra::Vector2::new(nx, ny) * options.pose_noise.0,
+                truth.rotation.angle() + nyaw * options.pose_noise.1,
+            )
+        } else {
+            truth
+        };
+        let (s_est, d_est) =
+            route.project(&Point2::from(estimate.translation.vector), s_hint, 30.0);
+
+        if step.is_multiple_of(steps_per_scan) {
+            let t0 = Instant::now();
+            let scan = lidar.scan(
+                &world,
+                &SweepPoses::still(truth),
+                step / steps_per_scan,
+                seed,
+            );
+            split.lidar += t0.elapsed().as_secs_f64();
+            let t1 = Instant::now();
+            let mut mapper_scan = scan.scan;
+            if estimate != truth {
+                mapper_scan = reexpress(&mapper_scan, &truth, &estimate)?;
+            }
+            map.recenter(Point2::from(estimate.translation.vector))?;
+            map.insert_scan(&mapper_scan, Some(&self_filter))?;
+            split.mapping += t1.elapsed().as_secs_f64();
+            let t2 = Instant::now();
+            map.update_distance_maps_around(
+                Point2::from(estimate.translation.vector),
+                options.distance_map_half_size_m,
+            );
+            split.distance_maps += t2.elapsed().as_secs_f64();
+            let t3 = Instant::now();
+            let checker = model.checker(map.distance_maps())?;
+            let p = plan(
+                &checker,
+                &route,
+                s_est,
+                d_est,
+                offset_prev,
+                behaviour,
+                &options.autonomy,
+            );
+            let (v, _) = avoid(
+                p.chosen(),
+                scenario.route.speed_m_s,
+                decel,
+                &options.autonomy,
+            );
+            offset_prev = p.chosen().offset_m;
+            speed_cmd = v;
+            current = Some(p);
+            split.planning += t3.elapsed().as_secs_f64();
+        }
+
+        let physics = Instant::now();
+        let steering = current.as_ref().map_or(0.0, |p| {
+            pure_pursuit(
+                &estimate,
+                p.chosen(),
+                state.speed_m_s,
+                wheelbase,
+                &options.autonomy,
+            )
+        });
+        bicycle.step(
+            &mut state,
+            &Command {
+                speed_m_s: speed_cmd,
+                steering_rad: steering,
+            },
+            dt,
+        );
+        t += dt;
+        step += 1;
+        world.set_vehicle_pose(&state.world_from_vehicle(), t);
+        split.physics += physics.elapsed().as_secs_f64();
+
+        // Progress along the route (truth, for judging).
+        let (s_now, d_now) = route.project(&Point2::new(state.x_m, state.y_m), s_hint, 30.0);
+        let mut ds = s_now - s_hint;
+        if route.closed() {
+            ds = (ds + length / 2.0).rem_euclid(length) - length / 2.0;
+        }
+        s_total += ds;
+        s_hint = s_now;
+
+        // Stops.
+        let stopped = state.speed_m_s.abs() < 0.05 && speed_cmd == 0.0;
+        let moving = state.speed_m_s.abs() > 0.3;
+        match stops.last_mut() {
+            Some(last) if last.end_s.is_none() && moving => last.end_s = Some(t),
+            Some(last) if last.end_s.is_none() => {}
+            _ if stopped && t > 1.0 => stops.push(Stop {
+                start_s: t,
+                end_s: None,
+                route_s_m: s_now,
+            }),
+            _ => {}
+        }
+
+        // Obstacle passes: a window from 25 m before to 10 m after each obstacle.
+        let lap_s = (s_start + s_total).rem_euclid(if route.closed() {
+            length
+        } else {
+            f64::INFINITY
+        });
+        for (k, tr) in trackers.iter_mut().enumerate() {
+            let rel = if route.closed() {
+                (lap_s - tr.route_s + length / 2.0).rem_euclid(length) - length / 2.0
+            } else {
+                lap_s - tr.route_s
+            };
+            let inside = (-25.0..=10.0).contains(&rel);
+            if inside && !tr.active {
+                *tr = PassTracker {
+                    active: true,
+                    offset: 0.0,
+                    stopped: false,
+                    clearance: vec![f64::INFINITY; heights.len()],
+                    contacts_before: world.contacts().len(),
+                    ..*tr
+                };
+            }
+            if tr.active {
+                tr.offset = tr.offset.max(d_now.abs());
+                tr.stopped |= stopped && rel < 0.0;
+                for (part, d) in world.distances_to(tr.solid_index).into_iter().enumerate() {
+                    let level = part_levels[part];
+                    tr.clearance[level] = tr.clearance[level].min(d);
+                }
+                if !inside {
+                    tr.active = false;
+                    let id = &scene.solids[tr.solid_index].id;
+                    let collided = world.contacts()[tr.contacts_before..]
+                        .iter()
+                        .any(|c| &c.object == id);
+                    let outcome = if collided {
+                        "collided"
+                    } else if tr.stopped {
+                        "stopped"
+                    } else if tr.offset > 0.5 {
+                        "deviated"
+                    } else {
+                        "passed"
+                    };
+                    let met = !collided
+                        && match tr.expect {
+                            Expectation::PassUnder => outcome == "passed",
+                            Expectation::Deviate => outcome == "deviated",
+                            Expectation::Stop => outcome == "stopped",
+                            Expectation::NoContact => true,
+                        };
+                    reports[k].passes.push(Pass {
+                        lap: laps_completed + 1,
+                        outcome: outcome.into(),
+                        min_clearance_m: tr.clearance.clone(),
+                        max_offset_m: tr.offset,
+                        met,
+                    });
+                }
+            }
+        }
+        for (level, d) in clearance_per_level(&world, &part_levels, heights.len())
+            .into_iter()
+            .enumerate()
+        {
+            min_clearance[level] = min_clearance[level].min(d);
+        }
+
+        // Laps.
+        let done_m = s_total;
+        if (route.closed() && done_m >= length * (laps_completed + 1) as f64)
+            || (!route.closed() && s_now >= length - 0.5)
+        {
+            laps_completed += 1;
+            lap_times.push(t - lap_start_t);
+            lap_start_t = t;
+            if !route.closed() && laps_completed < laps {
+                // An open route starts again from its start pose.
+                state = VehicleState {
+                    x_m: start.translation.x,
+                    y_m: start.translation.y,
+                    yaw_rad: start.rotation.angle(),
+                    ..Default::default()
+                };
+                (s_hint, s_total) = (s_start, 0.0);
+                world.set_vehicle_pose(&state.world_from_vehicle(), t);
+            }
+        }
+        if step.is_multiple_of(100) {
+            let fraction = if route.closed() {
+                s_total / total_m
+            } else {
+                (laps_completed as f64 * length + s_now) / total_m
+            };
+            progress(Progress {
+                sim_time_s: t,
+                laps_completed,
+                fraction: fraction.clamp(0.0, 1.0),
+            });
+        }
+    }
+    let wall_time_s = wall.elapsed().as_secs_f64();
+    let every_pass_met = reports
+        .iter()
+        .all(|r| !r.passes.is_empty() && r.passes.iter().all(|p| p.met));
+    Ok(RunReport {
+        scenario: scenario.name.clone(),
+        seed,
+        expectations_met: !interrupted
+            && laps_completed == laps
+            && every_pass_met
+            && world.contacts().is_empty(),
+        laps,
+        laps_completed,
+        lap_times_s: lap_times,
+        contacts: world.contacts().to_vec(),
+        obstacles: reports,
+        stops,
+        min_clearance_m: min_clearance,
+        sim_time_s: t,
+        wall_time_s,
+        real_time_factor: t / wall_time_s.max(1e-9),
+        interrupted,
+        time_split_s: split,
+    })
+}
+
+/// Ground-truth distance from every active object to the vehicle's parts of each level, now.
+fn clearance_per_level(world: &World, part_levels: &[usize], levels: usize) -> Vec<f64> {
+    let mut out = vec![f64::INFINITY; levels];
+    let here = world.vehicle_position();
+    for (i, solid) in world.scene().solids.iter().enumerate() {
+        if (solid.x_m - here.x).hypot(solid.y_m - here.y) > 30.0 {
+            continue;
+        }
+        for (part, d) in world.distances_to(i).into_iter().enumerate() {
+            out[part_levels[part]] = out[part_levels[part]].min(d);
+        }
+    }
+    out
+}
+
+/// The point of a path closest to the route (where a crossing vehicle crosses it).
+fn closest_on_route(route: &RoutePath, path: &[Point2<f64>]) -> Option<Point2<f64>> {
+    let mut best: Option<(f64, Point2<f64>)> = None;
+    for w in path.windows(2) {
+        for k in 0..=50 {
+            let p = w[0] + (w[1] - w[0]) * (k as f64 / 50.0);
+            let (_, d) = route.project(&p, 0.0, f64::INFINITY);
+            if best.is_none_or(|b| d.abs() < b.0) {
+                best = Some((d.abs(), p));
+            }
+        }
+    }
+    best.map(|b| b.1)
+}
+
+/// A scan's points moved from the true pose to the estimated one: where a mapper with a wrong
+/// pose would put them.
+fn reexpress(
+    scan: &mapper::Scan,
+    truth: &Isometry2<f64>,
+    estimate: &Isometry2<f64>,
+) -> anyhow::Result<mapper::Scan> {
+    let lift = crate::world::planar_to_3d;
+    let correction = lift(estimate) * lift(truth).inverse();
+    let columns = scan
+        .columns()
+        .iter()
+        .map(|c| mapper::ScanColumn {
+            world_from_sensor: correction * c.world_from_sensor,
+            world_from_vehicle: *estimate,
+        })
+        .collect();
+    let returns = scan
+        .returns()
+        .iter()
+        .map(|r| {
+            r.map(|r| mapper::Return {
+                point_in_world: correction * r.point_in_world,
+                ..r
+            })
+        })
+        .collect();
+    Ok(mapper::Scan::new(scan.beams(), columns, returns)?)
+}

@@ -1,0 +1,231 @@
+//! `taxi-sim map` and `taxi-sim run`: the mapping drive and the closed loop, with progress bars,
+//! the report table and the JSON report.
+
+use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+
+use anyhow::Context as _;
+use indicatif::{ProgressBar, ProgressStyle};
+use sim::mapping::{default_map_dir, fresh_manifest, map_drive};
+use sim::run::{RunOptions, RunReport, run};
+use sim::scenario::Scenario;
+
+/// Arguments of `taxi-sim map`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct MapArgs {
+    /// The scenario file.
+    pub scenario: PathBuf,
+    /// Output directory (default: out/maps/<scenario file name>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Arguments of `taxi-sim run`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// The scenario file.
+    pub scenario: PathBuf,
+    /// Laps (default: the scenario's).
+    #[arg(long)]
+    pub laps: Option<u32>,
+    /// Seed (default: the scenario's).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// The offline map (default: out/maps/<scenario file name>; built there when missing or stale).
+    #[arg(long)]
+    pub map_dir: Option<PathBuf>,
+    /// Standard deviation of the pose noise given to the autonomy: position in metres.
+    #[arg(long, default_value_t = 0.0)]
+    pub pose_noise_m: f64,
+    /// Standard deviation of the pose noise given to the autonomy: heading in radians.
+    #[arg(long, default_value_t = 0.0)]
+    pub pose_noise_rad: f64,
+}
+
+fn bar(len: u64, what: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{msg:>10} [{bar:40}] {pos}/{len} {elapsed_precise} eta {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> "),
+    );
+    bar.set_message(what.to_string());
+    bar
+}
+
+fn build_map(
+    scenario: &Scenario,
+    dir: &std::path::Path,
+) -> anyhow::Result<sim::mapping::MapManifest> {
+    let progress = bar(0, "mapping");
+    let manifest = map_drive(scenario, dir, &mut |done, total| {
+        progress.set_length(total as u64);
+        progress.set_position(done as u64);
+    })?;
+    progress.finish_and_clear();
+    Ok(manifest)
+}
+
+/// Runs `taxi-sim map`.
+pub fn map(args: &MapArgs) -> anyhow::Result<()> {
+    let scenario = Scenario::from_file(&args.scenario)?;
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_map_dir(&scenario));
+    let m = build_map(&scenario, &dir)?;
+    crate::emit(&format!(
+        "{}: mapped {:.0} m with {} revolutions into {} blocks; occupied cells per level {:?} (levels at {:?} m)\nwrote {}\n",
+        scenario.name,
+        m.route_m,
+        m.scans,
+        m.blocks,
+        m.occupied_cells,
+        m.level_heights_m,
+        dir.display()
+    ))
+}
+
+/// Runs `taxi-sim run`; returns whether every expectation held.
+pub fn run_cmd(args: &RunArgs) -> anyhow::Result<bool> {
+    let scenario = Scenario::from_file(&args.scenario)?;
+    anyhow::ensure!(
+        args.pose_noise_m.is_finite() && args.pose_noise_m >= 0.0,
+        "--pose-noise-m {}: must be >= 0",
+        args.pose_noise_m
+    );
+    anyhow::ensure!(
+        args.pose_noise_rad.is_finite() && args.pose_noise_rad >= 0.0,
+        "--pose-noise-rad {}: must be >= 0",
+        args.pose_noise_rad
+    );
+    let dir = args
+        .map_dir
+        .clone()
+        .unwrap_or_else(|| default_map_dir(&scenario));
+    if fresh_manifest(&scenario, &dir)?.is_none() {
+        eprintln!(
+            "offline map {} is missing or stale: building it (mapping drive)",
+            dir.display()
+        );
+        build_map(&scenario, &dir)?;
+    }
+    let mut options = RunOptions::new(dir);
+    options.laps = args.laps;
+    options.seed = args.seed;
+    options.pose_noise = (args.pose_noise_m, args.pose_noise_rad);
+    let stop = options.stop.clone();
+    // A second Ctrl-C falls through to the default handler only if this one could not be set.
+    let _ = ctrlc::set_handler(move || stop.store(true, Ordering::Relaxed));
+    let progress = bar(1000, "running");
+    let report = run(&scenario, &options, &mut |p| {
+        progress.set_position((p.fraction * 1000.0) as u64);
+        progress.set_message(format!(
+            "lap {} t={:.0}s",
+            p.laps_completed + 1,
+            p.sim_time_s
+        ));
+    })?;
+    progress.finish_and_clear();
+    if let Some(path) = &args.report {
+        mapper::write_atomically(path, serde_json::to_string_pretty(&report)?.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    crate::emit(&table(&report))?;
+    Ok(report.expectations_met)
+}
+
+/// The human summary of a run.
+pub fn table(r: &RunReport) -> String {
+    use std::fmt::Write as _;
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "{} (seed {}): {}",
+        r.scenario,
+        r.seed,
+        if r.expectations_met {
+            "every expectation held"
+        } else {
+            "EXPECTATIONS NOT MET"
+        }
+    );
+    let _ = writeln!(
+        t,
+        "laps {}/{}  lap times {:?} s  stops {}  contacts {}{}",
+        r.laps_completed,
+        r.laps,
+        r.lap_times_s
+            .iter()
+            .map(|x| (x * 10.0).round() / 10.0)
+            .collect::<Vec<_>>(),
+        r.stops.len(),
+        r.contacts.len(),
+        if r.interrupted { "  (interrupted)" } else { "" }
+    );
+    let _ = writeln!(
+        t,
+        "{:<22} {:<10} {:<11} {:>4} {:<9} {:>10} {:>22}",
+        "obstacle", "kind", "expected", "lap", "outcome", "offset_m", "min clearance per level"
+    );
+    for o in &r.obstacles {
+        if o.passes.is_empty() {
+            let _ = writeln!(
+                t,
+                "{:<22} {:<10} {:<11} {:>4} {:<9}",
+                o.id, o.kind, o.expected, "-", "not passed"
+            );
+        }
+        for p in &o.passes {
+            let clear: Vec<String> = p
+                .min_clearance_m
+                .iter()
+                .map(|c| {
+                    if c.is_finite() {
+                        format!("{c:.2}")
+                    } else {
+                        "-".into()
+                    }
+                })
+                .collect();
+            let _ = writeln!(
+                t,
+                "{:<22} {:<10} {:<11} {:>4} {:<9} {:>10.2} {:>22}{}",
+                o.id,
+                o.kind,
+                o.expected,
+                p.lap,
+                p.outcome,
+                p.max_offset_m,
+                clear.join(" / "),
+                if p.met { "" } else { "  <- not as expected" }
+            );
+        }
+    }
+    for c in &r.contacts {
+        let _ = writeln!(
+            t,
+            "contact at {:.2} s: {} ({:?}) touched by {}",
+            c.time_s, c.object, c.kind, c.part
+        );
+    }
+    let s = &r.time_split_s;
+    let _ = writeln!(
+        t,
+        "sim {:.1} s in {:.1} s wall: {:.1}x real time (lidar {:.1} s, mapping {:.1} s, distance maps {:.1} s, planning {:.1} s, physics {:.1} s)",
+        r.sim_time_s,
+        r.wall_time_s,
+        r.real_time_factor,
+        s.lidar,
+        s.mapping,
+        s.distance_maps,
+        s.planning,
+        s.physics
+    );
+    t
+}
