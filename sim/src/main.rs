@@ -136,7 +136,8 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
     }
 }
 
-fn bar(len: u64, what: &str) -> ProgressBar {
+/// A progress bar in the project's style: `what`, the bar, position, elapsed time and ETA.
+pub(crate) fn bar(len: u64, what: &str) -> ProgressBar {
     let bar = ProgressBar::new(len);
     bar.set_style(
         ProgressStyle::with_template(

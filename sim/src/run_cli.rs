@@ -5,7 +5,6 @@ use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 
 use anyhow::Context as _;
-use indicatif::{ProgressBar, ProgressStyle};
 use sim::mapping::{default_map_dir, fresh_manifest, map_drive};
 use sim::run::{RunOptions, RunReport, run};
 use sim::scenario::Scenario;
@@ -45,24 +44,11 @@ pub struct RunArgs {
     pub pose_noise_rad: f64,
 }
 
-fn bar(len: u64, what: &str) -> ProgressBar {
-    let bar = ProgressBar::new(len);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{msg:>10} [{bar:40}] {pos}/{len} {elapsed_precise} eta {eta}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar())
-        .progress_chars("=> "),
-    );
-    bar.set_message(what.to_string());
-    bar
-}
-
 fn build_map(
     scenario: &Scenario,
     dir: &std::path::Path,
 ) -> anyhow::Result<sim::mapping::MapManifest> {
-    let progress = bar(0, "mapping");
+    let progress = crate::bar(0, "mapping");
     let manifest = map_drive(scenario, dir, &mut |done, total| {
         progress.set_length(total as u64);
         progress.set_position(done as u64);
@@ -122,7 +108,7 @@ pub fn run_cmd(args: &RunArgs) -> anyhow::Result<bool> {
     let stop = options.stop.clone();
     // A second Ctrl-C falls through to the default handler only if this one could not be set.
     let _ = ctrlc::set_handler(move || stop.store(true, Ordering::Relaxed));
-    let progress = bar(1000, "running");
+    let progress = crate::bar(1000, "running");
     let report = run(&scenario, &options, &mut |p| {
         progress.set_position((p.fraction * 1000.0) as u64);
         progress.set_message(format!(
