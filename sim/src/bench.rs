@@ -305,3 +305,54 @@ pub fn lidar_figures(
     );
     Ok(vec![against(fast, &generic), generic])
 }
+
+/// The closed-loop figures: one run of `scenario` (its offline map built first, in its default
+/// directory, when missing or stale), reporting the real-time factor and the wall time per 0.1 s
+/// of simulated time spent in each stage. One run, not a median.
+pub fn loop_figures(
+    scenario: &std::path::Path,
+    progress: &mut dyn FnMut(&str),
+) -> anyhow::Result<Vec<Figure>> {
+    let scenario = crate::scenario::Scenario::from_file(scenario)?;
+    let map_dir = &crate::mapping::default_map_dir(&scenario);
+    if crate::mapping::fresh_manifest(&scenario, map_dir)?.is_none() {
+        progress("mapping drive");
+        crate::mapping::map_drive(&scenario, map_dir, &mut |_, _| {})?;
+    }
+    progress("closed loop");
+    let report = crate::run::run(
+        &scenario,
+        &crate::run::RunOptions::new(map_dir.to_path_buf()),
+        &mut |_| {},
+    )?;
+    let scans = report.sim_time_s / 0.1;
+    let per_scan = |seconds: f64| seconds / scans.max(1.0);
+    let name = |what: &str| {
+        format!(
+            "loop/{}/{what}",
+            scenario
+                .path
+                .file_stem()
+                .map_or_else(String::new, |s| s.to_string_lossy().into_owned())
+        )
+    };
+    let s = &report.time_split_s;
+    let mut out = vec![Figure {
+        name: name("real_time_factor"),
+        median: report.real_time_factor,
+        unit: "x",
+        baseline: None,
+        ratio: None,
+        target: Some(">= 20x (parking lot)"),
+    }];
+    for (what, seconds) in [
+        ("lidar_per_scan", s.lidar),
+        ("mapping_per_scan", s.mapping),
+        ("distance_maps_per_scan", s.distance_maps),
+        ("planning_per_scan", s.planning),
+        ("physics_per_scan", s.physics),
+    ] {
+        out.push(figure(&name(what), per_scan(seconds), "ms", None));
+    }
+    Ok(out)
+}

@@ -51,6 +51,9 @@ enum Command {
         /// Timed batches per figure (the median is reported).
         #[arg(long, default_value_t = 15)]
         samples: usize,
+        /// Scenario of `bench loop`.
+        #[arg(long, default_value = "scenarios/straight_cone_under_wing.toml")]
+        scenario: PathBuf,
     },
     /// Run a scenario in closed loop (builds its offline map first when missing or stale).
     /// Exit code 0 when every expectation held, 1 when one did not, 2 on bad input.
@@ -78,6 +81,8 @@ enum BenchTarget {
     Mapper,
     /// One HDL-32E revolution: the fast cast vs Rapier's generic per-ray query.
     Lidar,
+    /// The closed loop on `--scenario`: real-time factor and wall time per stage.
+    Loop,
 }
 
 /// Raised by [`emit`] when stdout's reader went away (`taxi-sim ... | head`): not an error.
@@ -127,7 +132,8 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
             what,
             json,
             samples,
-        } => bench(what, json, samples),
+            scenario,
+        } => bench(what, json, samples, &scenario),
         Command::Model(ModelCommand::Fit(args)) => model_cli::run(&args),
         Command::Check(args) => check_cli::run(&args),
         Command::Map(args) => run_cli::map(&args),
@@ -192,12 +198,18 @@ fn demo(out: PathBuf, scans: usize, seed: u64) -> anyhow::Result<()> {
     emit(&t)
 }
 
-fn bench(what: BenchTarget, json: bool, samples: usize) -> anyhow::Result<()> {
+fn bench(
+    what: BenchTarget,
+    json: bool,
+    samples: usize,
+    scenario: &std::path::Path,
+) -> anyhow::Result<()> {
     let progress = ProgressBar::new_spinner();
     let mut report = |what: &str| progress.set_message(format!("measuring {what}"));
     let figures = match what {
         BenchTarget::Mapper => sim::bench::mapper_figures(samples, &mut report),
         BenchTarget::Lidar => sim::bench::lidar_figures(samples, &mut report)?,
+        BenchTarget::Loop => sim::bench::loop_figures(scenario, &mut report)?,
     };
     progress.finish_and_clear();
     let mut t = String::new();
