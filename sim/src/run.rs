@@ -176,11 +176,152 @@ struct PassTracker {
     contacts_before: usize,
 }
 
+/// What a run shows as it goes (the replay implements it; see `replay`). Every method has a
+/// no-op default; what is passed is borrowed for the call only. An error ends the run.
+pub trait Observer {
+    /// Once, before the first step.
+    fn start(&mut self, _run: &RunStart<'_>) -> anyhow::Result<()> {
+        Ok(())
+    }
+    /// After every LiDAR revolution, map update and plan (10 Hz).
+    fn scan(&mut self, _frame: &ScanFrame<'_>) -> anyhow::Result<()> {
+        Ok(())
+    }
+    /// After every physics step (100 Hz).
+    fn step(&mut self, _frame: &StepFrame<'_>) -> anyhow::Result<()> {
+        Ok(())
+    }
+    /// Something happened: a stop, a resume, a deviation, a contact, a lap, a pass.
+    fn event(&mut self, _t_s: f64, _event: &Event) -> anyhow::Result<()> {
+        Ok(())
+    }
+    /// Once, with the report (also after Ctrl-C).
+    fn finish(&mut self, _report: &RunReport) -> anyhow::Result<()> {
+        Ok(())
+    }
+}
+
+/// An observer that looks at nothing.
+pub struct NoObserver;
+
+impl Observer for NoObserver {}
+
+/// The run's fixed parts, given to [`Observer::start`].
+pub struct RunStart<'a> {
+    /// The scenario.
+    pub scenario: &'a Scenario,
+    /// Every solid of the world, objects first, then run-time obstacles (`first_obstacle..`).
+    pub scene: &'a crate::scene::Scene,
+    /// Index of the first run-time obstacle in `scene.solids`.
+    pub first_obstacle: usize,
+    /// The route as the planner follows it.
+    pub route: &'a RoutePath,
+    /// The vehicle's circle model (level of each circle, heights of the levels).
+    pub model: &'a CollisionModel,
+    /// The level of each vehicle part (`scenario.vehicle.vehicle.parts`).
+    pub part_levels: &'a [usize],
+    /// The LiDAR.
+    pub lidar: &'a Lidar,
+    /// Laps asked for.
+    pub laps: u32,
+    /// Seed used.
+    pub seed: u64,
+}
+
+/// One revolution, map update and plan, given to [`Observer::scan`].
+pub struct ScanFrame<'a> {
+    /// Simulated time, seconds.
+    pub t_s: f64,
+    /// True pose of the vehicle.
+    pub truth: Isometry2<f64>,
+    /// The pose the autonomy used.
+    pub estimate: Isometry2<f64>,
+    /// The revolution as the LiDAR returned it (with the object each ray hit).
+    pub lidar: &'a crate::lidar::LidarScan,
+    /// The map after the update (occupancy and distance maps per level).
+    pub map: &'a MultiHeightMap,
+    /// The planner's candidates and its choice.
+    pub plan: &'a Plan,
+    /// Speed commanded by the avoider, m/s.
+    pub speed_cmd_m_s: f64,
+    /// The avoider's speed over the wanted speed, 0..1 (0: stopped).
+    pub speed_scale: f64,
+    /// The world (ground truth: object poses, which ones are active).
+    pub world: &'a World,
+}
+
+/// One physics step, given to [`Observer::step`].
+pub struct StepFrame<'a> {
+    /// Simulated time, seconds.
+    pub t_s: f64,
+    /// The vehicle's state after the step.
+    pub state: &'a VehicleState,
+    /// The command it followed.
+    pub command: &'a Command,
+    /// Smallest ground-truth clearance per level to any object near the vehicle, metres.
+    pub clearance_m: &'a [f64],
+    /// Simulated seconds per wall second so far.
+    pub real_time_factor: f64,
+    /// The world (ground truth: object poses, which ones are active).
+    pub world: &'a World,
+}
+
+/// Something that happened in a run.
+#[derive(Clone, Debug, Serialize)]
+#[serde(tag = "event", rename_all = "snake_case")]
+pub enum Event {
+    /// The vehicle stopped at this arc length of the route.
+    Stop {
+        /// Metres along the route.
+        route_s_m: f64,
+    },
+    /// The vehicle moved again after a stop.
+    Resume {
+        /// How long it stood, seconds.
+        stopped_s: f64,
+    },
+    /// The planner chose a path off the route.
+    Deviate {
+        /// Target lateral offset, metres (positive: left).
+        offset_m: f64,
+    },
+    /// The planner came back to the route.
+    BackOnRoute,
+    /// A ground-truth contact began.
+    Contact(Contact),
+    /// A lap ended.
+    Lap {
+        /// Lap number (1-based).
+        lap: u32,
+        /// Its time, seconds.
+        time_s: f64,
+    },
+    /// The vehicle went by a run-time obstacle.
+    Pass {
+        /// The obstacle's id.
+        id: String,
+        /// `passed`, `deviated`, `stopped` or `collided`.
+        outcome: String,
+        /// Whether the scenario's expectation held.
+        met: bool,
+    },
+}
+
 /// Runs a scenario in closed loop over its offline map (which must exist: see `mapping`).
 pub fn run(
     scenario: &Scenario,
     options: &RunOptions,
     progress: &mut dyn FnMut(Progress),
+) -> anyhow::Result<RunReport> {
+    run_observed(scenario, options, progress, &mut NoObserver)
+}
+
+/// [`run`], showing every step, scan and event to `observer`.
+pub fn run_observed(
+    scenario: &Scenario,
+    options: &RunOptions,
+    progress: &mut dyn FnMut(Progress),
+    observer: &mut dyn Observer,
 ) -> anyhow::Result<RunReport> {
     let wall = Instant::now();
     let laps = options.laps.unwrap_or(scenario.laps).max(1);
@@ -286,6 +427,19 @@ pub fn run(
     let mut step: u64 = 0;
     let mut interrupted = false;
     world.set_vehicle_pose(&state.world_from_vehicle(), 0.0);
+    observer.start(&RunStart {
+        scenario,
+        scene: &scene,
+        first_obstacle,
+        route: &route,
+        model: &model,
+        part_levels: &part_levels,
+        lidar: &lidar,
+        laps,
+        seed,
+    })?;
+    let mut deviating = false;
+    let mut contacts_seen = 0;
     while laps_completed < laps {
         if options.stop.load(Ordering::Relaxed) || t > timeout_s {
             interrupted = true;
@@ -337,12 +491,16 @@ pub fn run(
             );
             split.lidar += t0.elapsed().as_secs_f64();
             let t1 = Instant::now();
-            let mut mapper_scan = scan.scan;
-            if estimate != truth {
-                mapper_scan = reexpress(&mapper_scan, &truth, &estimate)?;
-            }
+            let scan_view = scan;
+            let reexpressed;
+            let mapper_scan = if estimate != truth {
+                reexpressed = reexpress(&scan_view.scan, &truth, &estimate)?;
+                &reexpressed
+            } else {
+                &scan_view.scan
+            };
             map.recenter(Point2::from(estimate.translation.vector))?;
-            map.insert_scan(&mapper_scan, Some(&self_filter))?;
+            map.insert_scan(mapper_scan, Some(&self_filter))?;
             split.mapping += t1.elapsed().as_secs_f64();
             let t2 = Instant::now();
             map.update_distance_maps_around(
@@ -369,8 +527,34 @@ pub fn run(
             );
             offset_prev = p.chosen().offset_m;
             speed_cmd = v;
-            current = Some(p);
             split.planning += t3.elapsed().as_secs_f64();
+            if (offset_prev.abs() > 0.5) != deviating {
+                deviating = !deviating;
+                let event = if deviating {
+                    Event::Deviate {
+                        offset_m: offset_prev,
+                    }
+                } else {
+                    Event::BackOnRoute
+                };
+                observer.event(t, &event)?;
+            }
+            observer.scan(&ScanFrame {
+                t_s: t,
+                truth,
+                estimate,
+                lidar: &scan_view,
+                map: &map,
+                plan: &p,
+                speed_cmd_m_s: v,
+                speed_scale: if scenario.route.speed_m_s > 0.0 {
+                    v / scenario.route.speed_m_s
+                } else {
+                    0.0
+                },
+                world: &world,
+            })?;
+            current = Some(p);
         }
 
         let physics = Instant::now();
@@ -383,14 +567,11 @@ pub fn run(
                 &options.autonomy,
             )
         });
-        bicycle.step(
-            &mut state,
-            &Command {
-                speed_m_s: speed_cmd,
-                steering_rad: steering,
-            },
-            dt,
-        );
+        let command = Command {
+            speed_m_s: speed_cmd,
+            steering_rad: steering,
+        };
+        bicycle.step(&mut state, &command, dt);
         t += dt;
         step += 1;
         world.set_vehicle_pose(&state.world_from_vehicle(), t);
@@ -409,15 +590,30 @@ pub fn run(
         let stopped = state.speed_m_s.abs() < 0.05 && speed_cmd == 0.0;
         let moving = state.speed_m_s.abs() > 0.3;
         match stops.last_mut() {
-            Some(last) if last.end_s.is_none() && moving => last.end_s = Some(t),
+            Some(last) if last.end_s.is_none() && moving => {
+                last.end_s = Some(t);
+                observer.event(
+                    t,
+                    &Event::Resume {
+                        stopped_s: t - last.start_s,
+                    },
+                )?;
+            }
             Some(last) if last.end_s.is_none() => {}
-            _ if stopped && t > 1.0 => stops.push(Stop {
-                start_s: t,
-                end_s: None,
-                route_s_m: s_now,
-            }),
+            _ if stopped && t > 1.0 => {
+                stops.push(Stop {
+                    start_s: t,
+                    end_s: None,
+                    route_s_m: s_now,
+                });
+                observer.event(t, &Event::Stop { route_s_m: s_now })?;
+            }
             _ => {}
         }
+        for c in &world.contacts()[contacts_seen..] {
+            observer.event(c.time_s, &Event::Contact(c.clone()))?;
+        }
+        contacts_seen = world.contacts().len();
 
         // Obstacle passes: a window from 25 m before to 10 m after each obstacle.
         let lap_s = (s_start + s_total).rem_euclid(if route.closed() {
@@ -471,6 +667,14 @@ pub fn run(
                             Expectation::Stop => outcome == "stopped",
                             Expectation::NoContact => true,
                         };
+                    observer.event(
+                        t,
+                        &Event::Pass {
+                            id: id.clone(),
+                            outcome: outcome.into(),
+                            met,
+                        },
+                    )?;
                     reports[k].passes.push(Pass {
                         lap: laps_completed + 1,
                         outcome: outcome.into(),
@@ -481,12 +685,18 @@ pub fn run(
                 }
             }
         }
-        for (level, d) in clearance_per_level(&world, &part_levels, heights.len())
-            .into_iter()
-            .enumerate()
-        {
-            min_clearance[level] = min_clearance[level].min(d);
+        let clearance_now = clearance_per_level(&world, &part_levels, heights.len());
+        for (level, d) in clearance_now.iter().enumerate() {
+            min_clearance[level] = min_clearance[level].min(*d);
         }
+        observer.step(&StepFrame {
+            t_s: t,
+            state: &state,
+            command: &command,
+            clearance_m: &clearance_now,
+            real_time_factor: t / wall.elapsed().as_secs_f64().max(1e-9),
+            world: &world,
+        })?;
 
         // Laps.
         let done_m = s_total;
@@ -495,6 +705,13 @@ pub fn run(
         {
             laps_completed += 1;
             lap_times.push(t - lap_start_t);
+            observer.event(
+                t,
+                &Event::Lap {
+                    lap: laps_completed,
+                    time_s: t - lap_start_t,
+                },
+            )?;
             lap_start_t = t;
             if !route.closed() && laps_completed < laps {
                 // An open route starts again from its start pose.
@@ -525,7 +742,7 @@ pub fn run(
     let every_pass_met = reports
         .iter()
         .all(|r| !r.passes.is_empty() && r.passes.iter().all(|p| p.met));
-    Ok(RunReport {
+    let report = RunReport {
         scenario: scenario.name.clone(),
         seed,
         expectations_met: !interrupted
@@ -544,7 +761,9 @@ pub fn run(
         real_time_factor: t / wall_time_s.max(1e-9),
         interrupted,
         time_split_s: split,
-    })
+    };
+    observer.finish(&report)?;
+    Ok(report)
 }
 
 /// Ground-truth distance from every active object to the vehicle's parts of each level, now.
