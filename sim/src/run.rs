@@ -76,7 +76,8 @@ pub struct Pass {
     pub min_clearance_m: Vec<f64>,
     /// Largest lateral offset from the route near the obstacle, metres.
     pub max_offset_m: f64,
-    /// Whether this pass met the obstacle's expectation.
+    /// Whether this pass met the obstacle's expectation: the outcome it expects, no contact, and
+    /// no clearance under the scenario's danger distance (when it states one).
     pub met: bool,
 }
 
@@ -127,6 +128,9 @@ pub struct RunReport {
     pub stops: Vec<Stop>,
     /// Smallest ground-truth clearance per level to any object, metres.
     pub min_clearance_m: Vec<f64>,
+    /// The scenario's danger distance, metres (`None`: not stated): a pass closer than this to
+    /// its obstacle, at any level, does not meet its expectation.
+    pub danger_distance_m: Option<f64>,
     /// Simulated time, seconds.
     pub sim_time_s: f64,
     /// Wall time, seconds.
@@ -172,6 +176,9 @@ struct PassTracker {
     active: bool,
     offset: f64,
     stopped: bool,
+    /// Whether the obstacle was in the world at some time in the window (one that appears or
+    /// disappears may be absent on some laps: no pass then).
+    present: bool,
     clearance: Vec<f64>,
     contacts_before: usize,
 }
@@ -380,6 +387,7 @@ pub fn run_observed(
                 active: false,
                 offset: 0.0,
                 stopped: false,
+                present: false,
                 clearance: vec![f64::INFINITY; heights.len()],
                 contacts_before: 0,
             }
@@ -633,6 +641,7 @@ pub fn run_observed(
                     active: true,
                     offset: 0.0,
                     stopped: false,
+                    present: false,
                     clearance: vec![f64::INFINITY; heights.len()],
                     contacts_before: world.contacts().len(),
                     ..*tr
@@ -641,11 +650,15 @@ pub fn run_observed(
             if tr.active {
                 tr.offset = tr.offset.max(d_now.abs());
                 tr.stopped |= stopped && rel < 0.0;
+                tr.present |= world.object_active(tr.solid_index);
                 for (part, d) in world.distances_to(tr.solid_index).into_iter().enumerate() {
                     let level = part_levels[part];
                     tr.clearance[level] = tr.clearance[level].min(d);
                 }
-                if !inside {
+                if !inside && !tr.present {
+                    // Not in the world during this window (appears later or has gone): no pass.
+                    tr.active = false;
+                } else if !inside {
                     tr.active = false;
                     let id = &scene.solids[tr.solid_index].id;
                     let collided = world.contacts()[tr.contacts_before..]
@@ -660,7 +673,11 @@ pub fn run_observed(
                     } else {
                         "passed"
                     };
+                    let too_close = scenario
+                        .danger_distance_m
+                        .is_some_and(|danger| tr.clearance.iter().any(|d| *d < danger));
                     let met = !collided
+                        && !too_close
                         && match tr.expect {
                             Expectation::PassUnder => outcome == "passed",
                             Expectation::Deviate => outcome == "deviated",
@@ -756,6 +773,7 @@ pub fn run_observed(
         obstacles: reports,
         stops,
         min_clearance_m: min_clearance,
+        danger_distance_m: scenario.danger_distance_m,
         sim_time_s: t,
         wall_time_s,
         real_time_factor: t / wall_time_s.max(1e-9),

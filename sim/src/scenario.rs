@@ -1,6 +1,6 @@
-//! Scenario files: the TOML format (world, vehicle, route, static objects, painted patches,
-//! run-time obstacles with expectations, laps, seed), its validation and its conversion into a
-//! [`Scene`].
+//! Scenario files: the TOML format (world, vehicle, route, static objects and rows of them,
+//! painted patches, run-time obstacles with expectations, laps, seed), its validation and its
+//! conversion into a [`Scene`].
 //!
 //! The serde structs ([`ScenarioFile`] and the `*Spec` structs) are the file as written; every
 //! field's unit and default is documented on it, unknown keys are rejected everywhere. Numbers
@@ -351,12 +351,30 @@ pub struct ScenarioFile {
     /// Static objects: in the world from the start, and in the offline map. Default none.
     #[serde(default)]
     pub objects: Vec<Spanned<ObjectSpec>>,
+    /// Rows of static objects along a line (edge markers, parked cars): each expands into
+    /// ordinary static objects. Default none.
+    #[serde(default)]
+    pub rows: Vec<Spanned<RowSpec>>,
     /// Painted markings on the ground (remission texture). Default none.
     #[serde(default)]
     pub patches: Vec<Spanned<PatchSpec>>,
     /// Run-time obstacles: absent from the mapping drive and the offline map. Default none.
     #[serde(default)]
     pub obstacles: Vec<Spanned<ObstacleSpec>>,
+    /// Expectations about the whole run, beyond each obstacle's `expect`. Default none.
+    #[serde(default)]
+    pub expectations: ExpectationsSpec,
+}
+
+/// `[expectations]`: what must hold over the whole run, beside each obstacle's `expect`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExpectationsSpec {
+    /// The danger distance, metres, > 0: the smallest ground-truth clearance between any part of
+    /// the vehicle and any run-time obstacle must never fall under it (the thesis' tall
+    /// obstacles were passed inside the safety distance but never closer than the danger
+    /// distance). Default none: only a contact fails.
+    pub danger_distance_m: Option<Positive>,
 }
 
 /// `[world]`: the ground, a rectangle of the plane z = 0.
@@ -431,7 +449,7 @@ pub struct RouteSpec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectSpec {
-    /// Unique name across objects, patches and obstacles. Required.
+    /// Unique name across objects, rows, patches and obstacles. Required.
     pub id: Spanned<String>,
     /// What it is (snake_case [`ObjectKind`]). Required.
     pub kind: ObjectKind,
@@ -459,7 +477,7 @@ pub struct ObjectSpec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PatchSpec {
-    /// Unique name across objects, patches and obstacles. Required.
+    /// Unique name across objects, rows, patches and obstacles. Required.
     pub id: Spanned<String>,
     /// Centre, metres. Required.
     pub x_m: Finite,
@@ -475,6 +493,63 @@ pub struct PatchSpec {
     /// LiDAR remission in [0, 1]. Default 0.8 (white paint).
     pub remission: Option<Remission>,
 }
+
+/// The line a row follows when it is not given as `along_m`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RowLine {
+    /// The scenario's route (closed or not, as the route is).
+    Route,
+}
+
+/// `[[rows]]`: a row of identical static objects at a regular spacing along a line, repeated at
+/// lateral offsets from it; it expands into ordinary static objects with ids `<id>_<n>`
+/// (`n` from 1, along the line first, then in the order of `offsets_m` at each station). The
+/// shape fields are those of [`ObjectSpec`], with the same per-kind defaults.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RowSpec {
+    /// Prefix of the objects' ids; unique across objects, rows, patches and obstacles, and so
+    /// are the ids it makes. Required.
+    pub id: Spanned<String>,
+    /// What its objects are (snake_case [`ObjectKind`]). Required.
+    pub kind: ObjectKind,
+    /// The line, `[[x, y], ...]`, metres: at least 2 points, no two consecutive equal.
+    /// Exactly one of `along_m` and `along`.
+    pub along_m: Option<Spanned<Vec<[Finite; 2]>>>,
+    /// `"route"`: the line is the route (with its closing segment when it is closed).
+    pub along: Option<Spanned<RowLine>>,
+    /// Distance between stations, measured along the line, metres, > 0. Required.
+    pub spacing_m: Spanned<Positive>,
+    /// Lateral offsets from the line, metres, left of its direction positive; one object per
+    /// offset at each station (`[-11.5, 11.5]`: both edges). No repeats. Default `[0.0]`.
+    pub offsets_m: Option<Spanned<Vec<Finite>>>,
+    /// Arc length of the first station, metres, >= 0. Default 0.
+    pub start_m: Option<Spanned<NonNegative>>,
+    /// Arc length the stations stop at (inclusive), metres, > `start_m`, at most the line's
+    /// length. Default the line's end (on a closed route the station that would repeat the
+    /// first is left out).
+    pub end_m: Option<Spanned<NonNegative>>,
+    /// Heading of each object relative to the line's direction where it stands, radians
+    /// (a box's x extent runs along the line at 0; `1.5708` turns parked cars across it).
+    /// Default 0.
+    #[serde(default)]
+    pub yaw_rad: Finite,
+    /// Height of the objects' base above the ground, metres, >= 0. Default 0.
+    #[serde(default)]
+    pub z_min_m: NonNegative,
+    /// Box kinds: full extents `[x, y, z]`, metres, each > 0. Default per kind.
+    pub size_m: Option<Spanned<[Positive; 3]>>,
+    /// Round kinds: base radius, metres, > 0. Default per kind.
+    pub radius_m: Option<Spanned<Positive>>,
+    /// Round kinds: height, metres, > 0. Default per kind.
+    pub height_m: Option<Spanned<Positive>>,
+    /// LiDAR remission in [0, 1]. Default per kind.
+    pub remission: Option<Remission>,
+}
+
+/// The most objects one row may make (a guard against a spacing typed in the wrong unit).
+pub const MAX_ROW_OBJECTS: usize = 10_000;
 
 /// What the vehicle must do about a run-time obstacle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Deserialize)]
@@ -508,7 +583,7 @@ impl Expectation {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObstacleSpec {
-    /// Unique name across objects, patches and obstacles. Required.
+    /// Unique name across objects, rows, patches and obstacles. Required.
     pub id: Spanned<String>,
     /// What it is (snake_case [`ObjectKind`]). Required.
     pub kind: ObjectKind,
@@ -672,12 +747,17 @@ pub struct Scenario {
     pub vehicle: ScenarioVehicle,
     /// The route.
     pub route: Route,
-    /// Static objects (`runtime` false).
+    /// Static objects (`runtime` false): the `[[objects]]` in file order, then the objects of
+    /// each `[[rows]]` in file order.
     pub objects: Vec<Solid>,
     /// Painted patches.
     pub patches: Vec<Patch>,
     /// Run-time obstacles.
     pub obstacles: Vec<Obstacle>,
+    /// The danger distance (`[expectations] danger_distance_m`), metres: the smallest
+    /// ground-truth clearance between the vehicle and any run-time obstacle must stay at or
+    /// above it. `None`: not checked (only a contact fails).
+    pub danger_distance_m: Option<f64>,
 }
 
 impl Scenario {
@@ -738,19 +818,22 @@ impl Resolver<'_> {
         let route = self.route(&spec.route, &world)?;
         let vehicle = self.vehicle(&spec.vehicle, &route, &world)?;
 
+        // Every id, with who uses it (as error messages name it).
         let mut ids: HashMap<String, String> = HashMap::new();
-        let mut unique = |id: &Spanned<String>, field: String| -> Result<(), ScenarioError> {
-            if id.get_ref().is_empty() {
-                return Err(self.err(id.span(), &field, "an id must not be empty"));
+        let mut claim = |id: &str,
+                         span: Range<usize>,
+                         field: &str,
+                         owner: String,
+                         made: &str|
+         -> Result<(), ScenarioError> {
+            if id.is_empty() {
+                return Err(self.err(span, field, "an id must not be empty"));
             }
-            if let Some(first) = ids.insert(id.get_ref().clone(), field.clone()) {
+            if let Some(first) = ids.insert(id.to_string(), owner) {
                 return Err(self.err(
-                    id.span(),
-                    &field,
-                    format!(
-                        "duplicate id `{}` (already used by `{first}`)",
-                        id.get_ref()
-                    ),
+                    span,
+                    field,
+                    format!("{made}duplicate id `{id}` (already used by {first})"),
                 ));
             }
             Ok(())
@@ -760,7 +843,7 @@ impl Resolver<'_> {
         for (i, o) in spec.objects.iter().enumerate() {
             let field = format!("objects[{i}]");
             let o_ref = o.get_ref();
-            unique(&o_ref.id, format!("{field}.id"))?;
+            claim_id(&mut claim, &o_ref.id, &field)?;
             let shape = self.shape(
                 &field,
                 o.span(),
@@ -787,11 +870,53 @@ impl Resolver<'_> {
             objects.push(solid);
         }
 
+        for (i, r) in spec.rows.iter().enumerate() {
+            let field = format!("rows[{i}]");
+            let id = &r.get_ref().id;
+            claim_id(&mut claim, id, &field)?;
+            for (n, made) in self.row(r, &field, &route)?.into_iter().enumerate() {
+                let solid = made.solid;
+                let what = format!(
+                    "object {} (arc length {:.2} m, offset {} m)",
+                    n + 1,
+                    made.s_m,
+                    made.offset_m
+                );
+                claim(
+                    &solid.id,
+                    id.span(),
+                    &format!("{field}.id"),
+                    format!("`{field}`, its {what}"),
+                    &format!("its {what} is `{}`: ", solid.id),
+                )?;
+                if !(world.min_m[0]..=world.max_m[0]).contains(&solid.x_m)
+                    || !(world.min_m[1]..=world.max_m[1]).contains(&solid.y_m)
+                {
+                    return Err(self.err(
+                        id.span(),
+                        &field,
+                        format!(
+                            "its {what}, `{}` at ({:.3}, {:.3}), lies outside the world [{}, {}] .. [{}, {}]",
+                            solid.id,
+                            solid.x_m,
+                            solid.y_m,
+                            world.min_m[0],
+                            world.min_m[1],
+                            world.max_m[0],
+                            world.max_m[1]
+                        ),
+                    ));
+                }
+                self.no_start_overlap(&vehicle, &solid, &field, id.span())?;
+                objects.push(solid);
+            }
+        }
+
         let mut patches = Vec::with_capacity(spec.patches.len());
         for (i, p) in spec.patches.iter().enumerate() {
             let field = format!("patches[{i}]");
             let p = p.get_ref();
-            unique(&p.id, format!("{field}.id"))?;
+            claim_id(&mut claim, &p.id, &field)?;
             self.inside_world(&world, &field, p.id.span(), p.x_m.0, p.y_m.0)?;
             patches.push(Patch {
                 id: p.id.get_ref().clone(),
@@ -807,7 +932,7 @@ impl Resolver<'_> {
         let mut obstacles = Vec::with_capacity(spec.obstacles.len());
         for (i, o) in spec.obstacles.iter().enumerate() {
             let field = format!("obstacles[{i}]");
-            unique(&o.get_ref().id, format!("{field}.id"))?;
+            claim_id(&mut claim, &o.get_ref().id, &field)?;
             let obstacle = self.obstacle(o, &field)?;
             let id_span = o.get_ref().id.span();
             self.inside_world(
@@ -840,6 +965,7 @@ impl Resolver<'_> {
             objects,
             patches,
             obstacles,
+            danger_distance_m: spec.expectations.danger_distance_m.map(|d| d.0),
         })
     }
 
@@ -885,6 +1011,7 @@ impl Resolver<'_> {
 
     /// Checks a polyline: at least `min` points, no two consecutive equal (nor, when `closed`,
     /// the last and the first).
+    #[allow(clippy::too_many_arguments)]
     fn polyline(
         &self,
         points: &[Point2<f64>],
@@ -892,13 +1019,14 @@ impl Resolver<'_> {
         closed: bool,
         span: Range<usize>,
         field: &str,
+        what: &str,
     ) -> Result<(), ScenarioError> {
         if points.len() < min {
             return Err(self.err(
                 span,
                 field,
                 format!(
-                    "{} point(s): {}a route needs at least {min}",
+                    "{} point(s): {}{what} needs at least {min}",
                     points.len(),
                     if closed { "closed, " } else { "" }
                 ),
@@ -960,7 +1088,14 @@ impl Resolver<'_> {
                 (pts, yaws, p.span(), "route.pose_file")
             }
         };
-        self.polyline(&waypoints_m, min, spec.closed, span.clone(), field)?;
+        self.polyline(
+            &waypoints_m,
+            min,
+            spec.closed,
+            span.clone(),
+            field,
+            "a route",
+        )?;
         for (k, p) in waypoints_m.iter().enumerate() {
             if p.x < world.min_m[0]
                 || p.x > world.max_m[0]
@@ -1175,6 +1310,186 @@ impl Resolver<'_> {
         }
     }
 
+    /// Expands a row into its objects (ids, shapes, poses), with the checks that need only the
+    /// row and the route; ids, the world and the start overlap are checked by the caller.
+    fn row(
+        &self,
+        r: &Spanned<RowSpec>,
+        field: &str,
+        route: &Route,
+    ) -> Result<Vec<RowObject>, ScenarioError> {
+        let spec = r.get_ref();
+        let shape = self.shape(
+            field,
+            r.span(),
+            spec.kind,
+            &spec.size_m,
+            &spec.radius_m,
+            &spec.height_m,
+        )?;
+        let line = match (&spec.along_m, &spec.along) {
+            (Some(_), Some(a)) => {
+                return Err(self.err(
+                    a.span(),
+                    &format!("{field}.along"),
+                    "give either along_m or along, not both",
+                ));
+            }
+            (None, None) => {
+                return Err(self.err(
+                    r.span(),
+                    field,
+                    "missing the row's line: give along_m = [[x, y], ...] or along = \"route\"",
+                ));
+            }
+            (Some(a), None) => {
+                let pts: Vec<Point2<f64>> = a
+                    .get_ref()
+                    .iter()
+                    .map(|p| Point2::new(p[0].0, p[1].0))
+                    .collect();
+                self.polyline(
+                    &pts,
+                    2,
+                    false,
+                    a.span(),
+                    &format!("{field}.along_m"),
+                    "a row's line",
+                )?;
+                Polyline::new(&pts, false)
+            }
+            (None, Some(a)) => match a.get_ref() {
+                RowLine::Route => Polyline::new(&route.waypoints_m, route.closed),
+            },
+        };
+        let length = line.length_m();
+
+        let offsets: Vec<f64> = match &spec.offsets_m {
+            None => vec![0.0],
+            Some(o) => {
+                let v: Vec<f64> = o.get_ref().iter().map(|x| x.0).collect();
+                if v.is_empty() {
+                    return Err(self.err(
+                        o.span(),
+                        &format!("{field}.offsets_m"),
+                        "no offsets: give at least one, e.g. [0.0] (on the line)",
+                    ));
+                }
+                for (k, a) in v.iter().enumerate() {
+                    if v[..k].contains(a) {
+                        return Err(self.err(
+                            o.span(),
+                            &format!("{field}.offsets_m"),
+                            format!("offset {a} m is given twice"),
+                        ));
+                    }
+                }
+                v
+            }
+        };
+
+        let start = spec.start_m.as_ref().map_or(0.0, |s| s.get_ref().0);
+        // On a closed line without end_m, the station at the full length would repeat s = 0.
+        let (end, open_end) = match &spec.end_m {
+            Some(e) => {
+                let end = e.get_ref().0;
+                if end <= start {
+                    return Err(self.err(
+                        e.span(),
+                        &format!("{field}.end_m"),
+                        format!("{end} m is not after start_m ({start} m)"),
+                    ));
+                }
+                if end > length + 1e-9 {
+                    return Err(self.err(
+                        e.span(),
+                        &format!("{field}.end_m"),
+                        format!("{end} m lies beyond the end of the line ({length:.3} m long)"),
+                    ));
+                }
+                (end, false)
+            }
+            None => {
+                if let Some(s) = &spec.start_m
+                    && start >= length
+                {
+                    return Err(self.err(
+                        s.span(),
+                        &format!("{field}.start_m"),
+                        format!(
+                            "{start} m lies at or beyond the end of the line ({length:.3} m long)"
+                        ),
+                    ));
+                }
+                (length, line.closed)
+            }
+        };
+        let spacing = spec.spacing_m.get_ref().0;
+        let stations = ((end - start) / spacing + 1e-9).floor() + 1.0;
+        let count = stations * offsets.len() as f64;
+        if count > MAX_ROW_OBJECTS as f64 {
+            return Err(self.err(
+                spec.spacing_m.span(),
+                &format!("{field}.spacing_m"),
+                format!(
+                    "{spacing} m over {:.1} m with {} offset(s) makes {count:.0} objects, more than {MAX_ROW_OBJECTS}",
+                    end - start,
+                    offsets.len()
+                ),
+            ));
+        }
+
+        let remission = spec
+            .remission
+            .map_or_else(|| default_remission(spec.kind), |r| r.0);
+        let prefix = spec.id.get_ref();
+        let mut made = Vec::with_capacity(count as usize);
+        for k in 0..stations as usize {
+            let s_m = start + k as f64 * spacing;
+            if s_m > end + 1e-9 || (open_end && s_m >= length - 1e-9) {
+                break;
+            }
+            let (p, heading) = line.at(s_m);
+            let normal = Vector2::new(-heading.sin(), heading.cos());
+            for &offset_m in &offsets {
+                let q = p + normal * offset_m;
+                // A sharp turn of the line puts an offset object of one segment over another:
+                // refuse it rather than place an object where the line runs.
+                let d = line.distance(&q);
+                if d < 0.9 * offset_m.abs() - 1e-9 {
+                    let span = spec
+                        .offsets_m
+                        .as_ref()
+                        .map_or_else(|| r.span(), |o| o.span());
+                    return Err(self.err(
+                        span,
+                        &format!("{field}.offsets_m"),
+                        format!(
+                            "the object at arc length {s_m:.2} m, offset {offset_m} m, ({:.2}, {:.2}) lies {d:.2} m from the line: it turns too sharply there for this offset (round the corner with more points, or limit the row with start_m/end_m)",
+                            q.x, q.y
+                        ),
+                    ));
+                }
+                made.push(RowObject {
+                    solid: Solid {
+                        id: format!("{prefix}_{}", made.len() + 1),
+                        kind: spec.kind,
+                        shape,
+                        x_m: q.x,
+                        y_m: q.y,
+                        z_min_m: spec.z_min_m.0,
+                        yaw_rad: crate::motion::wrap_angle(heading + spec.yaw_rad.0),
+                        remission,
+                        runtime: false,
+                    },
+                    s_m,
+                    offset_m,
+                });
+            }
+        }
+        Ok(made)
+    }
+
     fn obstacle(&self, o: &Spanned<ObstacleSpec>, field: &str) -> Result<Obstacle, ScenarioError> {
         let s = o.get_ref();
         let shape = self.shape(field, o.span(), s.kind, &s.size_m, &s.radius_m, &s.height_m)?;
@@ -1202,7 +1517,14 @@ impl Resolver<'_> {
                     .iter()
                     .map(|p| Point2::new(p[0].0, p[1].0))
                     .collect();
-                self.polyline(&pts, 2, false, path.span(), &format!("{field}.path_m"))?;
+                self.polyline(
+                    &pts,
+                    2,
+                    false,
+                    path.span(),
+                    &format!("{field}.path_m"),
+                    "a path",
+                )?;
                 let d = pts[1] - pts[0];
                 let motion = ObstacleMotion {
                     path_m: pts.clone(),
@@ -1288,6 +1610,76 @@ impl Resolver<'_> {
             ));
         }
         Ok(())
+    }
+}
+
+/// Claims the id of table `field` (`objects[3]`) through `claim` (id, span, field, owner, prefix).
+fn claim_id(
+    claim: &mut impl FnMut(&str, Range<usize>, &str, String, &str) -> Result<(), ScenarioError>,
+    id: &Spanned<String>,
+    field: &str,
+) -> Result<(), ScenarioError> {
+    let field = format!("{field}.id");
+    claim(id.get_ref(), id.span(), &field, format!("`{field}`"), "")
+}
+
+/// An object a row made, with where along its line it stands.
+struct RowObject {
+    solid: Solid,
+    /// Arc length along the row's line, metres.
+    s_m: f64,
+    /// Lateral offset from the line, metres, left positive.
+    offset_m: f64,
+}
+
+/// A row's line: a polyline with arc lengths (closed: back to its first point).
+struct Polyline {
+    points: Vec<Point2<f64>>,
+    s: Vec<f64>,
+    closed: bool,
+}
+
+impl Polyline {
+    fn new(points: &[Point2<f64>], closed: bool) -> Self {
+        let mut points = points.to_vec();
+        if closed && let Some(first) = points.first().copied() {
+            points.push(first);
+        }
+        let mut s = vec![0.0];
+        for w in points.windows(2) {
+            s.push(s[s.len() - 1] + (w[1] - w[0]).norm());
+        }
+        Polyline { points, s, closed }
+    }
+
+    fn length_m(&self) -> f64 {
+        self.s[self.s.len() - 1]
+    }
+
+    /// Point and heading at arc length `s` in [0, length]; on a vertex, the heading of the
+    /// segment leaving it (of the last segment at the end).
+    fn at(&self, s: f64) -> (Point2<f64>, f64) {
+        let i = self
+            .s
+            .partition_point(|&x| x <= s)
+            .saturating_sub(1)
+            .min(self.points.len() - 2);
+        let (a, b) = (self.points[i], self.points[i + 1]);
+        let d = b - a;
+        let len = d.norm();
+        (a + d * ((s - self.s[i]) / len), d.y.atan2(d.x))
+    }
+
+    /// Distance from `p` to the nearest point of the line.
+    fn distance(&self, p: &Point2<f64>) -> f64 {
+        self.points
+            .windows(2)
+            .map(|w| {
+                let ab = w[1] - w[0];
+                let t = ((p - w[0]).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+                (p - (w[0] + ab * t)).norm()
+            })
+            .fold(f64::INFINITY, f64::min)
     }
 }
 
