@@ -523,3 +523,53 @@ fn cells_an_obstacle_left_are_cleared_unless_walks_stop_at_any_occupied_cell() {
         assert_eq!(p < 0.5, cleared, "{rule:?}: p = {p} after the car left");
     }
 }
+
+#[test]
+fn occupancy_no_longer_seen_fades_to_the_prior_and_what_is_still_seen_stays() {
+    // Two walls: one stays, one vanishes and is never looked at again (the sensor is told
+    // nothing about it: scans of the scene with the wall are replaced by scans without any
+    // return near it, as if the airframe hid it).
+    let stays = Point2::new(9.15, 0.0);
+    let hidden = Point2::new(-9.15, 0.0);
+    let both = scene(vec![
+        Solid::standing_box(10.0, 0.0, 1.8, 4.5, 1.5),
+        Solid::standing_box(-10.0, 0.0, 1.8, 4.5, 1.5),
+    ]);
+    let one = scene(vec![Solid::standing_box(10.0, 0.0, 1.8, 4.5, 1.5)]);
+    let mut map = map_with(Levels::cumulative(vec![0.0]).unwrap());
+    insert(&mut map, &both, 3);
+    assert!(map.probability_at(0, &hidden).unwrap() > 0.99);
+    // Scans of `one` that keep only the returns ahead (x > 0): nothing crosses the hidden wall.
+    let full = scan_from(&one, 0.0, 0.0);
+    let returns = full
+        .returns()
+        .iter()
+        .map(|r| r.filter(|r| r.point_in_world.x > 0.0))
+        .collect();
+    let ahead = mapper::Scan::new(full.beams(), full.columns().to_vec(), returns).unwrap();
+    let tau = 2.0;
+    let mut t = 0.0;
+    let mut occupied_until = None;
+    while t < 5.0 * tau {
+        // Fade, then insert (as the closed loop does): what is seen again is refreshed.
+        let changed = map.forget_unseen(Point2::origin(), 50.0, 0.1, tau);
+        assert!(changed > 0, "both walls fade a little each time");
+        map.insert_scan(&ahead, None).unwrap();
+        t += 0.1;
+        if occupied_until.is_none() && map.probability_at(0, &hidden).is_none_or(|p| p <= 0.5) {
+            occupied_until = Some(t);
+        }
+        assert!(
+            map.probability_at(0, &stays).unwrap() > 0.99,
+            "t = {t:.1}: the wall still seen stays"
+        );
+    }
+    // From certainty over an unknown prior (p = 0.5) it never crosses one half by fading, but
+    // is handed back (unknown) once within 0.01 of it: ln(0.5 / 0.01) = 3.9 time constants.
+    let gone = occupied_until.expect("the hidden wall is forgotten");
+    assert!(
+        gone > 3.5 * tau && gone < 4.3 * tau,
+        "forgotten after {gone:.1} s"
+    );
+    assert_eq!(map.probability_at(0, &hidden), None, "handed back to the (unknown) prior");
+}

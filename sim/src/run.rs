@@ -44,6 +44,11 @@ pub struct RunOptions {
     /// Default 50: the planner's horizon (30 m) plus a jet's reach (12 m) plus 8 m, so every
     /// collision decision sees the same distances as over the whole window.
     pub distance_map_half_size_m: f64,
+    /// Live occupancy the LiDAR no longer sees fades back to the offline map with this time
+    /// constant, seconds (`MultiHeightMap::forget_unseen`, CARMEN's decay to the offline map);
+    /// `None`: never (a moving vehicle's trail hidden behind the airframe then stays). Default
+    /// 10 s: a cell seen occupied once stops being an obstacle about 7 s after it was last seen.
+    pub forget_time_constant_s: Option<f64>,
     /// Set from outside (Ctrl-C) to end the run with a partial report.
     pub stop: Arc<AtomicBool>,
 }
@@ -60,6 +65,7 @@ impl RunOptions {
             pose_noise: (0.0, 0.0),
             autonomy: AutonomyConfig::default(),
             distance_map_half_size_m: 50.0,
+            forget_time_constant_s: Some(10.0),
             stop: Arc::new(AtomicBool::new(false)),
         }
     }
@@ -508,6 +514,15 @@ pub fn run_observed(
                 &scan_view.scan
             };
             map.recenter(Point2::from(estimate.translation.vector))?;
+            // Fade what is no longer seen, then insert: what is seen again is refreshed.
+            if let Some(tau) = options.forget_time_constant_s {
+                map.forget_unseen(
+                    Point2::from(estimate.translation.vector),
+                    options.distance_map_half_size_m,
+                    1.0 / options.scan_hz,
+                    tau,
+                );
+            }
             map.insert_scan(mapper_scan, Some(&self_filter))?;
             split.mapping += t1.elapsed().as_secs_f64();
             let t2 = Instant::now();
