@@ -9,6 +9,7 @@
 //! - [`autonomy`]: route geometry, planner, obstacle avoider, behaviour, path follower.
 //! - [`mapping`]: the mapping drive that builds a scenario's offline map.
 //! - [`run`]: the closed loop and its report.
+//! - [`replay`]: the Rerun recording and live view of a run (the only module that knows Rerun).
 //! - [`bench`]: the headline performance figures, measured without criterion.
 //! - [`demo`]: a mapping drive through a synthetic parking lot, exporting every level.
 
@@ -19,6 +20,7 @@ pub mod lidar;
 pub mod mapping;
 pub mod motion;
 pub mod ply;
+pub mod replay;
 pub mod run;
 pub mod scenario;
 pub mod scene;

@@ -6,7 +6,8 @@ use std::sync::atomic::Ordering;
 
 use anyhow::Context as _;
 use sim::mapping::{default_map_dir, fresh_manifest, map_drive};
-use sim::run::{RunOptions, RunReport, run};
+use sim::replay::{Replay, ReplayOptions};
+use sim::run::{NoObserver, Observer, RunOptions, RunReport, run_observed};
 use sim::scenario::Scenario;
 
 /// Arguments of `taxi-sim map`.
@@ -42,6 +43,45 @@ pub struct RunArgs {
     /// Standard deviation of the pose noise given to the autonomy: heading in radians.
     #[arg(long, default_value_t = 0.0)]
     pub pose_noise_rad: f64,
+    /// Write a Rerun recording of the run here (.rrd; open it with `rerun FILE`, viewer 0.36).
+    #[arg(long, value_name = "FILE")]
+    pub record: Option<PathBuf>,
+    /// Start a Rerun viewer (`rerun` on the PATH) and stream the run to it.
+    #[arg(long)]
+    pub spawn: bool,
+    /// Stream the run to a running Rerun viewer (default 127.0.0.1:9876).
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:9876")]
+    pub connect: Option<String>,
+    /// Replay: LiDAR points and planner candidates every N revolutions (10 per second).
+    #[arg(long, value_name = "N", default_value_t = ReplayOptions::default().scan_every)]
+    pub replay_scan_every: u32,
+    /// Replay: keep every K-th column of a logged revolution (all 32 beams).
+    #[arg(long, value_name = "K", default_value_t = ReplayOptions::default().point_stride)]
+    pub replay_point_stride: usize,
+    /// Replay: occupancy and distance maps per second of simulated time (0: none).
+    #[arg(long, value_name = "HZ", default_value_t = ReplayOptions::default().maps_hz)]
+    pub replay_maps_hz: f64,
+    /// Replay: half side of the square of map logged around the vehicle, metres.
+    #[arg(long, value_name = "M", default_value_t = ReplayOptions::default().map_half_m)]
+    pub replay_map_half_m: f64,
+    /// Replay: vehicle pose and time series per second of simulated time.
+    #[arg(long, value_name = "HZ", default_value_t = ReplayOptions::default().steps_hz)]
+    pub replay_steps_hz: f64,
+}
+
+impl RunArgs {
+    fn replay_options(&self) -> ReplayOptions {
+        ReplayOptions {
+            record: self.record.clone(),
+            spawn: self.spawn,
+            connect: self.connect.clone(),
+            scan_every: self.replay_scan_every,
+            point_stride: self.replay_point_stride,
+            maps_hz: self.replay_maps_hz,
+            map_half_m: self.replay_map_half_m,
+            steps_hz: self.replay_steps_hz,
+        }
+    }
 }
 
 fn build_map(
@@ -90,6 +130,8 @@ pub fn run_cmd(args: &RunArgs) -> anyhow::Result<bool> {
         "--pose-noise-rad {}: must be >= 0",
         args.pose_noise_rad
     );
+    let replay_options = args.replay_options();
+    replay_options.validate()?;
     let dir = args
         .map_dir
         .clone()
@@ -108,16 +150,48 @@ pub fn run_cmd(args: &RunArgs) -> anyhow::Result<bool> {
     let stop = options.stop.clone();
     // A second Ctrl-C falls through to the default handler only if this one could not be set.
     let _ = ctrlc::set_handler(move || stop.store(true, Ordering::Relaxed));
+    let mut replay = if replay_options.enabled() {
+        Some(Replay::new(&replay_options, &scenario.name)?)
+    } else {
+        None
+    };
+    let mut no_observer = NoObserver;
+    let observer: &mut dyn Observer = match replay.as_mut() {
+        Some(r) => r,
+        None => &mut no_observer,
+    };
     let progress = crate::bar(1000, "running");
-    let report = run(&scenario, &options, &mut |p| {
-        progress.set_position((p.fraction * 1000.0) as u64);
-        progress.set_message(format!(
-            "lap {} t={:.0}s",
-            p.laps_completed + 1,
-            p.sim_time_s
-        ));
-    })?;
+    let report = run_observed(
+        &scenario,
+        &options,
+        &mut |p| {
+            progress.set_position((p.fraction * 1000.0) as u64);
+            progress.set_message(format!(
+                "lap {} t={:.0}s",
+                p.laps_completed + 1,
+                p.sim_time_s
+            ));
+        },
+        observer,
+    )?;
     progress.finish_and_clear();
+    if let Some(replay) = &replay {
+        let summary = replay.summary();
+        for w in &summary.warnings {
+            eprintln!("replay: {w}");
+        }
+        if let Some((path, bytes)) = &summary.recorded {
+            eprintln!(
+                "replay: wrote {} ({:.1} MB, {:.0} kB per simulated second)",
+                path.display(),
+                *bytes as f64 / 1e6,
+                *bytes as f64 / 1e3 / report.sim_time_s.max(1e-9)
+            );
+        }
+        if let Some(url) = &summary.streamed_to {
+            eprintln!("replay: streamed to {url}");
+        }
+    }
     if let Some(path) = &args.report {
         mapper::write_atomically(path, serde_json::to_string_pretty(&report)?.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;

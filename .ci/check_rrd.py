@@ -1,0 +1,71 @@
+#!/usr/bin/env python3
+"""Checks a taxi-sim Rerun recording: every entity path the README lists is there, with the
+archetype it should hold, on the `sim_time` timeline. Exits 1 naming what is missing.
+
+Usage: check_rrd.py RUN.rrd   (with the rerun-sdk matching the crate, see .ci/run)
+"""
+
+import sys
+
+import rerun as rr
+
+# (entity path or prefix ending in "/", archetype) - README "Replay in Rerun" lists them.
+EXPECTED = [
+    ("/world/ground", "rerun.archetypes.Boxes3D"),
+    ("/world/objects/", None),
+    ("/world/route", "rerun.archetypes.LineStrips3D"),
+    ("/world/obstacles/", None),
+    ("/world/vehicle", "rerun.archetypes.Transform3D"),
+    ("/world/vehicle/parts/", None),
+    ("/world/vehicle/circles/level_0", "rerun.archetypes.LineStrips3D"),
+    ("/world/vehicle/circles/level_1", "rerun.archetypes.LineStrips3D"),
+    ("/world/lidar", "rerun.archetypes.Points3D"),
+    ("/world/lidar", "rerun.archetypes.AnnotationContext"),
+    ("/world/maps/level_0/occupancy", "rerun.archetypes.GridMap"),
+    ("/world/maps/level_1/occupancy", "rerun.archetypes.GridMap"),
+    ("/maps/level_0/distance", "rerun.archetypes.DepthImage"),
+    ("/maps/level_1/distance", "rerun.archetypes.DepthImage"),
+    ("/world/planner/candidates", "rerun.archetypes.LineStrips3D"),
+    ("/world/planner/chosen", "rerun.archetypes.LineStrips3D"),
+    ("/plots/speed_m_s", "rerun.archetypes.Scalars"),
+    ("/plots/steering_rad", "rerun.archetypes.Scalars"),
+    ("/plots/clearance_m/level_0", "rerun.archetypes.Scalars"),
+    ("/plots/clearance_m/level_1", "rerun.archetypes.Scalars"),
+    ("/plots/real_time_factor", "rerun.archetypes.Scalars"),
+    ("/plots/speed_scale", "rerun.archetypes.Scalars"),
+    ("/events", "rerun.archetypes.TextLog"),
+]
+
+
+def main() -> int:
+    if len(sys.argv) != 2:
+        print(__doc__, file=sys.stderr)
+        return 2
+    path = sys.argv[1]
+    schema = rr.experimental.RrdReader(path).store().schema()
+    columns = schema.component_columns()
+    held = {(c.entity_path, c.archetype) for c in columns}
+    paths = {c.entity_path for c in columns}
+    missing = []
+    for entity, archetype in EXPECTED:
+        if entity.endswith("/"):
+            ok = any(p.startswith(entity) for p in paths)
+        elif archetype is None:
+            ok = entity in paths
+        else:
+            ok = (entity, archetype) in held
+        if not ok:
+            missing.append(f"{entity} ({archetype or 'any'})")
+    timelines = {c.name for c in schema.index_columns()}
+    if "sim_time" not in timelines:
+        missing.append(f"the sim_time timeline (timelines: {sorted(timelines)})")
+    if missing:
+        print(f"{path}: missing " + ", ".join(missing), file=sys.stderr)
+        print(f"{path}: has {sorted(paths)}", file=sys.stderr)
+        return 1
+    print(f"{path}: {len(paths)} entity paths, every expected one present")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
