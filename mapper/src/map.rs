@@ -651,14 +651,17 @@ impl MultiHeightMap {
     }
 
     /// Forgets live occupancy that is no longer seen: over the square of half side
-    /// `half_size_m` around `center`, every live cell more occupied than its prior moves toward
-    /// the prior's probability by `1 - exp(-dt_s / time_constant_s)` of the gap (an unknown prior
-    /// counts as p = 0.5), and is handed back to the prior (made unknown in the live map) once it
-    /// is no longer an obstacle or within 0.01 of the prior. CARMEN's decay to the offline map, as a time constant rather than a
-    /// per-update ratio. What the sensor still sees is hit again every revolution and stays
-    /// occupied; what it cannot see any more - the trail of a vehicle that drove on, hidden
-    /// behind the airframe - drops to p = 0.5 after `ln 2` time constants from certainty over a
-    /// free prior. Returns the cells changed; levels with changes need their distance maps again.
+    /// `half_size_m` around `center`, the log-odds of every live cell more occupied than its prior
+    /// move toward the prior's (0 where the prior is unknown) by `1 - exp(-dt_s /
+    /// time_constant_s)` of the gap, and the cell is handed back to the prior (unknown in the live
+    /// map) once it is no longer an obstacle (p <= 0.5) or within 0.05 of the prior. CARMEN's
+    /// decay to the offline map, as a time constant rather than a ratio per update, and in
+    /// log-odds so that a cell seen many times keeps its confidence against stray free-space
+    /// beams while it fades. What the sensor still sees is hit again every revolution and stays
+    /// occupied; what it cannot see any more - the trail of a vehicle that drove on, hidden behind
+    /// the airframe - stops being an obstacle after `ln 2` time constants from saturation over a
+    /// saturated free prior. Returns the cells changed; their levels need their distance maps
+    /// again.
     pub fn forget_unseen(
         &mut self,
         center: Point2<f64>,
@@ -670,16 +673,21 @@ impl MultiHeightMap {
             return 0;
         }
         let keep = (-dt_s / time_constant_s).exp() as f32;
-        let l_max = self.config.occupancy.l_max;
         let g = self.geometry;
         let half = (half_size_m / g.resolution_m()).ceil().max(1.0) as i64;
         let (cx, cy) = g.cell_coords(&center);
         let (w, h) = (g.width() as i64, g.height() as i64);
-        let (x0, x1) = ((cx - half).clamp(0, w) as usize, (cx + half).clamp(0, w) as usize);
-        let (y0, y1) = ((cy - half).clamp(0, h) as usize, (cy + half).clamp(0, h) as usize);
+        let (x0, x1) = (
+            (cx - half).clamp(0, w) as usize,
+            (cx + half).clamp(0, w) as usize,
+        );
+        let (y0, y1) = (
+            (cy - half).clamp(0, h) as usize,
+            (cy + half).clamp(0, h) as usize,
+        );
+        let width = g.width();
         let mut total = 0;
         for (k, (live, prior)) in self.live.iter_mut().zip(&self.prior).enumerate() {
-            let width = g.width();
             let mut changed = 0;
             let (live, prior) = (live.data_mut(), prior.data());
             for y in y0..y1 {
@@ -690,21 +698,16 @@ impl MultiHeightMap {
                     if !(l > 0.0) {
                         continue;
                     }
-                    let p_prior = if prior[i].is_nan() {
-                        0.5
-                    } else {
-                        probability(prior[i])
-                    };
-                    let p = probability(l);
-                    if p <= p_prior {
+                    let l_prior = if prior[i].is_nan() { 0.0 } else { prior[i] };
+                    if l <= l_prior {
                         continue;
                     }
-                    let p = p_prior + (p - p_prior) * keep;
-                    live[i] = if p <= 0.5 || p - p_prior < 0.01 {
+                    let l = l_prior + (l - l_prior) * keep;
+                    live[i] = if l <= 0.0 || l - l_prior < 0.05 {
                         // No longer an obstacle, or as good as the prior: hand the cell back to it.
                         f32::NAN
                     } else {
-                        crate::occupancy::log_odds(f64::from(p), l_max)
+                        l
                     };
                     changed += 1;
                 }

@@ -550,7 +550,7 @@ fn occupancy_no_longer_seen_fades_to_the_prior_and_what_is_still_seen_stays() {
     let tau = 2.0;
     let mut t = 0.0;
     let mut occupied_until = None;
-    while t < 5.0 * tau {
+    while t < 8.0 * tau {
         // Fade, then insert (as the closed loop does): what is seen again is refreshed.
         let changed = map.forget_unseen(Point2::origin(), 50.0, 0.1, tau);
         assert!(changed > 0, "both walls fade a little each time");
@@ -564,12 +564,17 @@ fn occupancy_no_longer_seen_fades_to_the_prior_and_what_is_still_seen_stays() {
             "t = {t:.1}: the wall still seen stays"
         );
     }
-    // From certainty over an unknown prior (p = 0.5) it never crosses one half by fading, but
-    // is handed back (unknown) once within 0.01 of it: ln(0.5 / 0.01) = 3.9 time constants.
+    // From saturation (log-odds 37) over an unknown prior (0) it never crosses one half by
+    // fading, but is handed back (unknown) once within 0.05 of it: ln(37 / 0.05) = 6.6 time
+    // constants.
     let gone = occupied_until.expect("the hidden wall is forgotten");
     assert!(
-        gone > 3.5 * tau && gone < 4.3 * tau,
+        gone > 6.0 * tau && gone < 7.0 * tau,
         "forgotten after {gone:.1} s"
     );
-    assert_eq!(map.probability_at(0, &hidden), None, "handed back to the (unknown) prior");
+    assert_eq!(
+        map.probability_at(0, &hidden),
+        None,
+        "handed back to the (unknown) prior"
+    );
 }
