@@ -306,11 +306,13 @@ pub fn lidar_figures(
     Ok(vec![against(fast, &generic), generic])
 }
 
-/// The closed-loop figures: one run of `scenario` (its offline map built first, in its default
-/// directory, when missing or stale), reporting the real-time factor and the wall time per 0.1 s
-/// of simulated time spent in each stage. One run, not a median.
+/// The closed-loop figures: one run of `scenario` for `laps` laps (0: the scenario's own; its
+/// offline map built first, in its default directory, when missing or stale), reporting the
+/// real-time factor and the wall time per 0.1 s of simulated time spent in each stage. One run,
+/// not a median.
 pub fn loop_figures(
     scenario: &std::path::Path,
+    laps: u32,
     progress: &mut dyn FnMut(&str),
 ) -> anyhow::Result<Vec<Figure>> {
     let scenario = crate::scenario::Scenario::from_file(scenario)?;
@@ -320,11 +322,11 @@ pub fn loop_figures(
         crate::mapping::map_drive(&scenario, map_dir, &mut |_, _| {})?;
     }
     progress("closed loop");
-    let report = crate::run::run(
-        &scenario,
-        &crate::run::RunOptions::new(map_dir.to_path_buf()),
-        &mut |_| {},
-    )?;
+    let options = crate::run::RunOptions {
+        laps: (laps > 0).then_some(laps),
+        ..crate::run::RunOptions::new(map_dir.to_path_buf())
+    };
+    let report = crate::run::run(&scenario, &options, &mut |_| {})?;
     let scans = report.sim_time_s / 0.1;
     let per_scan = |seconds: f64| seconds / scans.max(1.0);
     let name = |what: &str| {

@@ -51,9 +51,12 @@ enum Command {
         /// Timed batches per figure (the median is reported).
         #[arg(long, default_value_t = 15)]
         samples: usize,
-        /// Scenario of `bench loop`.
-        #[arg(long, default_value = "scenarios/straight_cone_under_wing.toml")]
+        /// Scenario of `bench loop` (the 20x target is set on the parking lot).
+        #[arg(long, default_value = "scenarios/parking_lot.toml")]
         scenario: PathBuf,
+        /// Laps of `bench loop` (default 1; 0: the scenario's own).
+        #[arg(long, default_value_t = 1)]
+        laps: u32,
     },
     /// Run a scenario in closed loop (builds its offline map first when missing or stale).
     /// Exit code 0 when every expectation held, 1 when one did not, 2 on bad input.
@@ -133,7 +136,8 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
             json,
             samples,
             scenario,
-        } => bench(what, json, samples, &scenario),
+            laps,
+        } => bench(what, json, samples, &scenario, laps),
         Command::Model(ModelCommand::Fit(args)) => model_cli::run(&args),
         Command::Check(args) => check_cli::run(&args),
         Command::Map(args) => run_cli::map(&args),
@@ -203,13 +207,14 @@ fn bench(
     json: bool,
     samples: usize,
     scenario: &std::path::Path,
+    laps: u32,
 ) -> anyhow::Result<()> {
     let progress = ProgressBar::new_spinner();
     let mut report = |what: &str| progress.set_message(format!("measuring {what}"));
     let figures = match what {
         BenchTarget::Mapper => sim::bench::mapper_figures(samples, &mut report),
         BenchTarget::Lidar => sim::bench::lidar_figures(samples, &mut report)?,
-        BenchTarget::Loop => sim::bench::loop_figures(scenario, &mut report)?,
+        BenchTarget::Loop => sim::bench::loop_figures(scenario, laps, &mut report)?,
     };
     progress.finish_and_clear();
     let mut t = String::new();

@@ -123,7 +123,7 @@ fn a_crossing_vehicle_stops_the_jet_which_resumes_once_it_has_gone() {
     assert_eq!(r.stops.len(), 1, "{:?}", r.stops);
     let stop = &r.stops[0];
     let waited = stop.end_s.expect("it resumes") - stop.start_s;
-    assert!((2.0..30.0).contains(&waited), "waited {waited:.1} s");
+    assert!((0.5..30.0).contains(&waited), "waited {waited:.1} s");
     assert_eq!(r.laps_completed, 1);
 }
 
