@@ -25,7 +25,7 @@
 //!    ([`FreeSpaceStop::AnyOccupied`], CARMEN's rule). The beams of a column share its vertical
 //!    plane, so one walk per column covers each of its beams' 2D traces once.
 
-use nalgebra::Point2;
+use nalgebra::{Point2, Point3};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -35,7 +35,7 @@ use crate::edt::EdtScratch;
 use crate::error::{MapError, Result, positive};
 use crate::grid::{Grid, GridGeometry};
 use crate::levels::{HeightClass, Levels};
-use crate::occupancy::{ObstacleTestParams, OccupancyParams, obstacle_probability, probability};
+use crate::occupancy::{ObstacleTest, ObstacleTestParams, OccupancyParams, probability};
 use crate::odm::{DistanceMap, DistanceMaps};
 use crate::remission::RemissionCell;
 use crate::scan::Scan;
@@ -557,6 +557,7 @@ impl MultiHeightMap {
     fn classify(&mut self, scan: &Scan, vehicle: Option<&CollisionModel>, stats: &mut InsertStats) {
         let beams = scan.beams();
         let params = self.config.obstacle_test;
+        let test = ObstacleTest::new(params);
         let margin = self.config.self_hit_margin_m;
         let geometry = self.geometry;
         self.classified.clear();
@@ -572,16 +573,23 @@ impl MultiHeightMap {
                 let sensor3 = nalgebra::Point3::from(column.world_from_sensor.translation.vector);
                 let vehicle_from_world = column.world_from_vehicle.inverse();
                 let (mut n, mut self_hits, mut far) = (0, 0, 0);
+                // The return of the beam below (dropped or not) and its horizontal range.
+                let mut below: Option<(Point3<f64>, f64)> = None;
                 for b in 0..beams {
                     out[b] = Classified {
                         cell: DROPPED,
                         ..Default::default()
                     };
-                    let Some(r) = returns[b] else { continue };
+                    let Some(r) = returns[b] else {
+                        below = None;
+                        continue;
+                    };
                     n += 1;
                     let p = r.point_in_world;
                     let xy = Point2::new(p.x, p.y);
-                    let range_xy = (xy - sensor).norm();
+                    let (dx, dy) = (p.x - sensor.x, p.y - sensor.y);
+                    let range_xy = (dx * dx + dy * dy).sqrt();
+                    let lower = below.replace((p, range_xy));
                     let height = p.z - params.ground_height_m;
                     let Some(cell) = geometry
                         .index_of(&xy)
@@ -596,10 +604,9 @@ impl MultiHeightMap {
                         self_hits += 1;
                         continue;
                     }
-                    let obstacle = match b.checked_sub(1).and_then(|lb| returns[lb]) {
-                        Some(lower) => {
-                            obstacle_probability(&sensor3, &lower.point_in_world, &p, &params)
-                                .is_some_and(|pr| pr > 0.5)
+                    let obstacle = match lower {
+                        Some((lower, lower_range_xy)) => {
+                            test.is_obstacle(&sensor3, &lower, lower_range_xy, &p, range_xy)
                         }
                         None => params
                             .unsafe_height_above_ground_m
@@ -694,8 +701,8 @@ impl MultiHeightMap {
                 let row = y * width;
                 for i in row + x0..row + x1 {
                     let l = live[i];
-                    // Only evidence of an obstacle (p > 0.5) fades; NaN compares false.
-                    if !(l > 0.0) {
+                    // Only evidence of an obstacle (p > 0.5) fades; unknown (NaN) stays.
+                    if l.is_nan() || l <= 0.0 {
                         continue;
                     }
                     let l_prior = if prior[i].is_nan() { 0.0 } else { prior[i] };
@@ -937,6 +944,8 @@ fn insert_level(
     // One free-space walk per column, to the farthest return this level considers.
     let mut free = 0;
     let (w, h) = (geometry.width() as i64, geometry.height() as i64);
+    // (horizontal range, height) of a column's returns, reused from column to column.
+    let mut ends: Vec<(f64, f64)> = Vec::with_capacity(beams);
     for (ci, column) in classified.chunks_exact(beams).enumerate() {
         let far = column
             .iter()
@@ -954,11 +963,13 @@ fn insert_level(
         // The lowest beam of the column crossing each distance: the nearest return beyond it.
         let ground = config.obstacle_test.ground_height_m;
         let sensor_z = sensor.z - ground;
-        let mut ends: Vec<(f64, f64)> = column
-            .iter()
-            .filter(|c| c.cell != DROPPED && class(c) != HeightClass::Above)
-            .map(|c| (c.range_xy_m as f64, c.height_m as f64))
-            .collect();
+        ends.clear();
+        ends.extend(
+            column
+                .iter()
+                .filter(|c| c.cell != DROPPED && class(c) != HeightClass::Above)
+                .map(|c| (c.range_xy_m as f64, c.height_m as f64)),
+        );
         ends.sort_by(|a, b| a.0.total_cmp(&b.0));
         let ray_z = |r: f64| {
             let i = ends.partition_point(|e| e.0 <= r);

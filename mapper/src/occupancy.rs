@@ -92,6 +92,61 @@ pub fn obstacle_probability(
     Some(evidence_to_probability(evidence, params.sigma))
 }
 
+/// The obstacle test of [`obstacle_probability`] answered as `probability > 0.5`, for the hot
+/// path: the same answer without the two exponentials of the probability curve (the evidence
+/// is compared with the curve's 0.5 crossing, computed once by [`ObstacleTest::new`]) and with
+/// the lower beam's horizontal range passed in rather than computed again.
+#[derive(Clone, Copy, Debug)]
+pub struct ObstacleTest {
+    params: ObstacleTestParams,
+    /// The evidence above which the probability exceeds 0.5.
+    evidence_at_half: f64,
+}
+
+impl ObstacleTest {
+    /// Prepares the test for `params`.
+    pub fn new(params: ObstacleTestParams) -> Self {
+        // evidence_to_probability(e) = 0.5  <=>  (1 - e)^2 = -sigma ln((1 + p0) / 2).
+        let p0 = (-1.0 / params.sigma).exp();
+        let evidence_at_half = 1.0 - (-params.sigma * (0.5 * (1.0 + p0)).ln()).sqrt();
+        ObstacleTest {
+            params,
+            evidence_at_half,
+        }
+    }
+
+    /// True when `upper` is an obstacle point against `lower` (the beam below it in the same
+    /// column), `lower_range_xy` being the horizontal distance from the sensor to `lower` and
+    /// `upper_range_xy` to `upper`.
+    #[inline]
+    pub fn is_obstacle(
+        &self,
+        sensor: &Point3<f64>,
+        lower: &Point3<f64>,
+        lower_range_xy: f64,
+        upper: &Point3<f64>,
+        upper_range_xy: f64,
+    ) -> bool {
+        let params = &self.params;
+        if params
+            .unsafe_height_above_ground_m
+            .is_some_and(|h| upper.z - params.ground_height_m >= h)
+        {
+            return true;
+        }
+        let drop_upper = sensor.z - upper.z;
+        if drop_upper <= 1e-6 {
+            return true;
+        }
+        let expected = upper_range_xy * (sensor.z - lower.z) / drop_upper - lower_range_xy;
+        let measured = upper_range_xy - lower_range_xy;
+        if expected <= 1e-9 || measured > expected {
+            return false;
+        }
+        ((expected - measured) / expected).min(1.0) > self.evidence_at_half
+    }
+}
+
 /// CARMEN's evidence-to-probability curve.
 #[inline]
 pub fn evidence_to_probability(evidence: f64, sigma: f64) -> f64 {
@@ -176,5 +231,42 @@ mod tests {
         assert!((evidence_to_probability(0.485, 0.45) - 0.5).abs() < 0.01);
         assert_eq!(log_odds(1.0, 37.0), 37.0);
         assert_eq!(log_odds(0.0, 37.0), -37.0);
+    }
+
+    #[test]
+    fn the_prepared_test_answers_as_the_probability_does() {
+        let s = p(0.3, -0.2, 1.9);
+        let range = |q: &Point3<f64>| (q.x - s.x).hypot(q.y - s.y);
+        for params in [
+            ObstacleTestParams::default(),
+            ObstacleTestParams {
+                sigma: 0.05,
+                unsafe_height_above_ground_m: Some(1.0),
+                ..Default::default()
+            },
+        ] {
+            let test = ObstacleTest::new(params);
+            let (mut yes, mut no) = (0, 0);
+            // Lower hits on the ground or low, upper hits from ground-like to wall-like.
+            for i in 0..60 {
+                for j in 0..60 {
+                    let lower = p(2.0 + 0.37 * i as f64, 0.5, 0.02 * (i % 7) as f64);
+                    let upper = p(
+                        lower.x + 0.013 * j as f64,
+                        0.5 + 0.01 * j as f64,
+                        lower.z + 0.025 * (j % 13) as f64,
+                    );
+                    let want = obstacle_probability(&s, &lower, &upper, &params)
+                        .is_some_and(|pr| pr > 0.5);
+                    let got = test.is_obstacle(&s, &lower, range(&lower), &upper, range(&upper));
+                    assert_eq!(got, want, "{lower:?} {upper:?} {params:?}");
+                    if want { yes += 1 } else { no += 1 }
+                }
+            }
+            assert!(
+                yes > 100 && no > 100,
+                "both answers are exercised: {yes} / {no}"
+            );
+        }
     }
 }

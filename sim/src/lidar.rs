@@ -435,6 +435,7 @@ impl Lidar {
         let beams = self.config.channels;
         let self_hits = self.self_hits(world);
         let scene = world.scene();
+        let ground = scene.ground_texture();
         // Every column writes its own slices of the preallocated outputs: no per-column vectors
         // to join afterwards.
         let n = self.config.columns * beams;
@@ -473,7 +474,7 @@ impl Lidar {
                 let mut rng = Xoshiro256PlusPlus::seed_from_u64(mix(seed, scan_index, c as u64));
                 for b in 0..beams {
                     (returns[b], owners[b]) =
-                        self.measure(scene, &mut rng, origin, hits[b], &dirs[b]);
+                        self.measure(scene, &ground, &mut rng, origin, hits[b], &dirs[b]);
                 }
                 *column = mapper::ScanColumn {
                     world_from_sensor: sensor,
@@ -493,6 +494,7 @@ impl Lidar {
     fn measure(
         &self,
         scene: &crate::scene::Scene,
+        ground: &crate::scene::GroundTexture,
         rng: &mut Xoshiro256PlusPlus,
         origin: Point3<f64>,
         hit: Option<(f32, Owner)>,
@@ -510,7 +512,7 @@ impl Lidar {
         let range = (t as f64 + noise).max(0.0);
         let point = origin + Vector3::new(d[0] as f64, d[1] as f64, d[2] as f64) * range;
         let remission = match owner {
-            Owner::Ground => scene.ground_remission_at(point.x, point.y),
+            Owner::Ground => ground.remission_at(point.x, point.y),
             Owner::Object(i) => scene.solids.get(i).map_or(0.5, |s| s.remission),
             Owner::VehiclePart(_) => 0.5,
         };

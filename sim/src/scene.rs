@@ -147,4 +147,114 @@ impl Scene {
             .find(|p| p.contains(x, y))
             .map_or(self.ground_remission, |p| p.remission)
     }
+
+    /// The ground's remission prepared for many lookups (the LiDAR's ground returns): the same
+    /// answers as [`Self::ground_remission_at`] without a sine and cosine per patch and point.
+    pub fn ground_texture(&self) -> GroundTexture {
+        GroundTexture {
+            ground_remission: self.ground_remission,
+            patches: self
+                .patches
+                .iter()
+                .rev()
+                .map(|p| {
+                    let (s, c) = p.yaw_rad.sin_cos();
+                    let (hl, hw) = (0.5 * p.length_m, 0.5 * p.width_m);
+                    // Axis-aligned half extents of the rotated rectangle: a cheap first test.
+                    let (ex, ey) = (c.abs() * hl + s.abs() * hw, s.abs() * hl + c.abs() * hw);
+                    PreparedPatch {
+                        x: p.x_m,
+                        y: p.y_m,
+                        sin: s,
+                        cos: c,
+                        half_length: hl,
+                        half_width: hw,
+                        extent: [ex, ey],
+                        remission: p.remission,
+                    }
+                })
+                .collect(),
+        }
+    }
+}
+
+/// [`Scene::ground_remission_at`] with each patch's rotation computed once.
+#[derive(Clone, Debug)]
+pub struct GroundTexture {
+    ground_remission: f32,
+    /// Last painted first.
+    patches: Vec<PreparedPatch>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct PreparedPatch {
+    x: f64,
+    y: f64,
+    sin: f64,
+    cos: f64,
+    half_length: f64,
+    half_width: f64,
+    extent: [f64; 2],
+    remission: f32,
+}
+
+impl GroundTexture {
+    /// Remission of the ground at (x, y).
+    pub fn remission_at(&self, x: f64, y: f64) -> f32 {
+        for p in &self.patches {
+            let (dx, dy) = (x - p.x, y - p.y);
+            if dx.abs() > p.extent[0] || dy.abs() > p.extent[1] {
+                continue;
+            }
+            let (along, across) = (p.cos * dx + p.sin * dy, -p.sin * dx + p.cos * dy);
+            if along.abs() <= p.half_length && across.abs() <= p.half_width {
+                return p.remission;
+            }
+        }
+        self.ground_remission
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_prepared_ground_texture_answers_as_the_scene_does() {
+        let patch = |id: &str, x, y, yaw, length, width, remission| Patch {
+            id: id.into(),
+            x_m: x,
+            y_m: y,
+            yaw_rad: yaw,
+            length_m: length,
+            width_m: width,
+            remission,
+        };
+        let scene = Scene {
+            min_m: [-20.0, -20.0],
+            max_m: [20.0, 20.0],
+            ground_remission: 0.2,
+            solids: Vec::new(),
+            patches: vec![
+                patch("lane", 0.0, 0.0, 0.0, 30.0, 0.3, 0.8),
+                patch("arrow", 3.0, 1.0, 0.7, 4.0, 1.0, 0.6),
+                patch("cross", 2.0, 0.5, 1.55, 6.0, 3.0, 0.4),
+                patch("slant", -5.0, -4.0, -2.4, 8.0, 0.5, 0.9),
+            ],
+        };
+        let texture = scene.ground_texture();
+        let mut painted = 0;
+        for i in -200..=200 {
+            for j in -200..=200 {
+                let (x, y) = (i as f64 * 0.05 + 0.013, j as f64 * 0.05 - 0.007);
+                let want = scene.ground_remission_at(x, y);
+                assert_eq!(texture.remission_at(x, y), want, "at ({x}, {y})");
+                painted += usize::from(want != 0.2);
+            }
+        }
+        assert!(
+            painted > 5_000,
+            "the patches cover part of the sweep: {painted}"
+        );
+    }
 }
