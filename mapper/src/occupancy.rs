@@ -69,27 +69,53 @@ pub fn obstacle_probability(
     upper: &Point3<f64>,
     params: &ObstacleTestParams,
 ) -> Option<f64> {
-    let ground = params.ground_height_m;
-    if let Some(unsafe_h) = params.unsafe_height_above_ground_m
-        && upper.z - ground >= unsafe_h
+    let d_lower = (lower.x - sensor.x).hypot(lower.y - sensor.y);
+    let d_upper = (upper.x - sensor.x).hypot(upper.y - sensor.y);
+    match evidence(sensor, lower, d_lower, upper, d_upper, params) {
+        Evidence::Certain => Some(1.0),
+        Evidence::Nothing => None,
+        Evidence::Partial(e) => Some(evidence_to_probability(e, params.sigma)),
+    }
+}
+
+/// What a pair of consecutive returns says about the upper one.
+enum Evidence {
+    /// An obstacle for sure (above the unsafe height, or a beam that does not descend).
+    Certain,
+    /// No information.
+    Nothing,
+    /// Evidence in (0, 1] for the probability curve.
+    Partial(f64),
+}
+
+/// The geometry shared by [`obstacle_probability`] and [`ObstacleTest::is_obstacle`]; the
+/// horizontal ranges from the sensor to each hit are passed in.
+#[inline]
+fn evidence(
+    sensor: &Point3<f64>,
+    lower: &Point3<f64>,
+    d_lower: f64,
+    upper: &Point3<f64>,
+    d_upper: f64,
+    params: &ObstacleTestParams,
+) -> Evidence {
+    if params
+        .unsafe_height_above_ground_m
+        .is_some_and(|h| upper.z - params.ground_height_m >= h)
     {
-        return Some(1.0);
+        return Evidence::Certain;
     }
     let drop_upper = sensor.z - upper.z; // how far below the sensor the upper hit is
     if drop_upper <= 1e-6 {
-        return Some(1.0); // a beam that does not descend never reaches the ground
+        return Evidence::Certain; // a beam that does not descend never reaches the ground
     }
-    let d_lower = (lower.x - sensor.x).hypot(lower.y - sensor.y);
-    let d_upper = (upper.x - sensor.x).hypot(upper.y - sensor.y);
     // The upper beam, continued to the plane of the lower hit (height lower.z).
-    let expected_upper = d_upper * (sensor.z - lower.z) / drop_upper;
-    let expected = expected_upper - d_lower;
+    let expected = d_upper * (sensor.z - lower.z) / drop_upper - d_lower;
     let measured = d_upper - d_lower;
     if expected <= 1e-9 || measured > expected {
-        return None;
+        return Evidence::Nothing;
     }
-    let evidence = ((expected - measured) / expected).min(1.0);
-    Some(evidence_to_probability(evidence, params.sigma))
+    Evidence::Partial(((expected - measured) / expected).min(1.0))
 }
 
 /// The obstacle test of [`obstacle_probability`] answered as `probability > 0.5`, for the hot
@@ -127,23 +153,18 @@ impl ObstacleTest {
         upper: &Point3<f64>,
         upper_range_xy: f64,
     ) -> bool {
-        let params = &self.params;
-        if params
-            .unsafe_height_above_ground_m
-            .is_some_and(|h| upper.z - params.ground_height_m >= h)
-        {
-            return true;
+        match evidence(
+            sensor,
+            lower,
+            lower_range_xy,
+            upper,
+            upper_range_xy,
+            &self.params,
+        ) {
+            Evidence::Certain => true,
+            Evidence::Nothing => false,
+            Evidence::Partial(e) => e > self.evidence_at_half,
         }
-        let drop_upper = sensor.z - upper.z;
-        if drop_upper <= 1e-6 {
-            return true;
-        }
-        let expected = upper_range_xy * (sensor.z - lower.z) / drop_upper - lower_range_xy;
-        let measured = upper_range_xy - lower_range_xy;
-        if expected <= 1e-9 || measured > expected {
-            return false;
-        }
-        ((expected - measured) / expected).min(1.0) > self.evidence_at_half
     }
 }
 
