@@ -24,6 +24,8 @@ const STRIPE: usize = 64;
 pub struct EdtScratch {
     /// Phase-1 column distances, stripe after stripe (each stripe row-major, `STRIPE` wide).
     stripes: Vec<Vec<u32>>,
+    /// Distances over a window of a map being updated ([`crate::odm::DistanceMap::update`]).
+    pub(crate) window: Vec<f32>,
 }
 
 /// Exact Euclidean distance transform.

@@ -217,6 +217,10 @@ pub struct MultiHeightMap {
     prior_remission: Grid<RemissionCell>,
     odm: DistanceMaps,
     odm_dirty: Vec<bool>,
+    /// Per level, the obstacle cells (region order) its distance map was last computed from.
+    odm_obstacles: Vec<Vec<bool>>,
+    /// Scratch for the obstacle cells of the level being updated.
+    odm_mask: Vec<bool>,
     prior_store: Option<BlockStore>,
     live_store: Option<BlockStore>,
     classified: Vec<Classified>,
@@ -276,6 +280,8 @@ impl MultiHeightMap {
             prior_remission: Grid::filled(geometry, RemissionCell::default()),
             odm,
             odm_dirty: vec![true; n],
+            odm_obstacles: vec![Vec::new(); n],
+            odm_mask: Vec::new(),
             prior_store,
             live_store,
             classified: Vec::new(),
@@ -634,18 +640,34 @@ impl MultiHeightMap {
         self.update_distance_region(0, 0, w, h)
     }
 
-    /// Like [`Self::update_distance_maps`] but only over the square of half side `half_size_m`
-    /// around `center` (clipped to the window): what a vehicle's checks need, at a fraction of
-    /// the cost. Obstacles outside the square are not seen, so a distance is exact wherever the
-    /// nearest obstacle lies inside it - in particular everywhere the distance is smaller than
-    /// the gap to the square's edge. Moving the square recomputes every level.
+    /// Like [`Self::update_distance_maps`] but only over a square region around `center` that
+    /// holds at least the square of half side `half_size_m` (clipped to the window): what a
+    /// vehicle's checks need, at a fraction of the cost. Obstacles outside the region are not
+    /// seen, so a distance is exact wherever the nearest obstacle lies inside it - in particular
+    /// everywhere the distance is smaller than the gap to the region's edge. The region's corner
+    /// snaps to a lattice of `half_size_m / 8` steps, so it moves only every few metres, and a
+    /// level whose obstacle cells in the region did not change keeps its map: the result is the
+    /// same as recomputing every time.
     pub fn update_distance_maps_around(&mut self, center: Point2<f64>, half_size_m: f64) -> usize {
         let g = self.geometry;
+        if !(center.x.is_finite() && center.y.is_finite() && half_size_m.is_finite()) {
+            return 0;
+        }
         let half = (half_size_m / g.resolution_m()).ceil().max(1.0) as i64;
+        let step = (half / 8).max(1);
         let (cx, cy) = g.cell_coords(&center);
+        // Cell coordinates are relative to the window, whose origin is on the block lattice:
+        // snap in world cells so the region does not move when the window does.
+        let (wx, wy) = (
+            self.window_lo.x * self.config.block_cells as i64,
+            self.window_lo.y * self.config.block_cells as i64,
+        );
+        let snap = |c: i64, w: i64| (c + w - half).div_euclid(step) * step - w;
+        let (lo_x, lo_y) = (snap(cx, wx), snap(cy, wy));
+        let side = 2 * half + step;
         let (w, h) = (g.width() as i64, g.height() as i64);
-        let (x0, x1) = ((cx - half).clamp(0, w), (cx + half).clamp(0, w));
-        let (y0, y1) = ((cy - half).clamp(0, h), (cy + half).clamp(0, h));
+        let (x0, x1) = (lo_x.clamp(0, w), (lo_x + side).clamp(0, w));
+        let (y0, y1) = (lo_y.clamp(0, h), (lo_y + side).clamp(0, h));
         if x1 <= x0 || y1 <= y0 {
             return 0;
         }
@@ -727,6 +749,9 @@ impl MultiHeightMap {
         total
     }
 
+    /// Recomputes, over the region of `rw` x `rh` cells from (`x0`, `y0`), the distance map of
+    /// each level that changed since its last computation and whose obstacle cells differ from
+    /// those it was computed from. Returns how many levels were recomputed.
     fn update_distance_region(&mut self, x0: usize, y0: usize, rw: usize, rh: usize) -> usize {
         let g = self.geometry;
         let origin = g.origin_m() + nalgebra::Vector2::new(x0 as f64, y0 as f64) * g.resolution_m();
@@ -742,6 +767,7 @@ impl MultiHeightMap {
                 self.odm = maps;
             }
             self.odm_dirty.iter_mut().for_each(|d| *d = true);
+            self.odm_obstacles.iter_mut().for_each(Vec::clear);
         }
         let threshold = self.config.obstacle_threshold;
         let l_threshold = (threshold / (1.0 - threshold)).ln();
@@ -752,22 +778,34 @@ impl MultiHeightMap {
             if !self.odm_dirty[k] {
                 continue;
             }
-            let live = self.live[k].data();
-            let prior = self.prior[k].data();
-            let is_obstacle = |i: usize| {
-                let j = (y0 + i / rw) * width + x0 + i % rw;
-                match merge {
-                    MergeMode::Fallback => {
-                        let l = if live[j].is_nan() { prior[j] } else { live[j] };
-                        l > l_threshold
-                    }
-                    MergeMode::Decay => {
-                        merge_log_odds(live[j], prior[j], merge).is_some_and(|l| l > l_threshold)
-                    }
-                }
-            };
-            self.odm.levels_mut()[k].recompute(is_obstacle, &mut self.edt_scratch);
             self.odm_dirty[k] = false;
+            let (live, prior) = (self.live[k].data(), self.prior[k].data());
+            let mask = &mut self.odm_mask;
+            mask.resize(rw * rh, false);
+            mask.par_chunks_mut(rw).enumerate().for_each(|(r, row)| {
+                let j0 = (y0 + r) * width + x0;
+                let (live, prior) = (&live[j0..j0 + rw], &prior[j0..j0 + rw]);
+                for ((m, &l), &p) in row.iter_mut().zip(live).zip(prior) {
+                    *m = match merge {
+                        MergeMode::Fallback => (if l.is_nan() { p } else { l }) > l_threshold,
+                        MergeMode::Decay => {
+                            merge_log_odds(l, p, merge).is_some_and(|l| l > l_threshold)
+                        }
+                    };
+                }
+            });
+            if *mask == self.odm_obstacles[k] {
+                continue; // the same obstacles: the same distances
+            }
+            let (mask, old) = (&*mask, &self.odm_obstacles[k]);
+            let odm = &mut self.odm.levels_mut()[k];
+            if old.len() == mask.len() {
+                // Same region: only around the cells that changed.
+                odm.update(old, mask, &mut self.edt_scratch);
+            } else {
+                odm.recompute(|i| mask[i], &mut self.edt_scratch);
+            }
+            std::mem::swap(&mut self.odm_obstacles[k], &mut self.odm_mask);
             recomputed += 1;
         }
         recomputed

@@ -454,7 +454,11 @@ fn distance_maps_around_the_vehicle_equal_the_full_window_inside_their_reach() {
     );
     let region = map.distance_maps();
     let g = *region.geometry();
-    assert_eq!((g.width(), g.height()), (200, 200));
+    // 2 x 20 m plus one snapping step (20 m / 8, 12 cells), holding the square asked for.
+    assert_eq!((g.width(), g.height()), (212, 212));
+    let side = g.width() as f64 * g.resolution_m();
+    assert!(g.origin_m().x <= 1.0 - 20.0 && g.origin_m().x + side >= 1.0 + 20.0);
+    assert!(g.origin_m().y <= 1.0 - 20.0 && g.origin_m().y + side >= 1.0 + 20.0);
     let mut compared = 0;
     for (k, full_k) in full.iter().enumerate() {
         for y in (0..g.height()).step_by(7) {
@@ -464,8 +468,8 @@ fn distance_maps_around_the_vehicle_equal_the_full_window_inside_their_reach() {
                 let d_full = full_k.distance_at(&p);
                 let to_edge = (p.x - g.origin_m().x)
                     .min(p.y - g.origin_m().y)
-                    .min(g.origin_m().x + 40.0 - p.x)
-                    .min(g.origin_m().y + 40.0 - p.y);
+                    .min(g.origin_m().x + side - p.x)
+                    .min(g.origin_m().y + side - p.y);
                 if (d_full as f64) < to_edge {
                     assert!(
                         (d_region - d_full).abs() < 1e-5,

@@ -18,7 +18,7 @@
 //! | `world/planner/candidates` | the planner's candidates (red: colliding) | every `scan_every` revolutions |
 //! | `world/planner/chosen` | the chosen path | every revolution |
 //! | `plots/speed_m_s`, `plots/steering_rad`, `plots/real_time_factor` | time series | `steps_hz` |
-//! | `plots/clearance_m/level_<k>` | ground-truth clearance per level (when something is within 30 m) | `steps_hz` |
+//! | `plots/clearance_m/level_<k>` | ground-truth clearance per level (when something is within about 15 m) | `steps_hz` |
 //! | `plots/speed_scale` | the avoider's speed over the wanted speed | every revolution |
 //! | `events` | stop, resume, deviate, back on route, contact, lap, pass (`TextLog`) | as they happen |
 //!

@@ -71,6 +71,16 @@ impl RunOptions {
     }
 }
 
+/// The cap of the run's distance maps for a vehicle. No check of the planner or the avoider
+/// reads a distance beyond the vehicle's bounding radius plus the planner's safety distance plus
+/// the early out's slack (a cell diagonal), so a cap 1 m beyond that changes no decision - and
+/// the smaller the cap, the smaller the part of a distance map a change in the map recomputes
+/// (`DistanceMap::update`).
+pub fn distance_cap_m(model: &CollisionModel, autonomy: &AutonomyConfig) -> f32 {
+    let safety = autonomy.planner_safety_m.max(autonomy.avoider_safety_m);
+    model.bounding_circle().radius_m as f32 + safety + 1.0 + 0.3
+}
+
 /// One pass of the vehicle by an obstacle.
 #[derive(Clone, Debug, Serialize)]
 pub struct Pass {
@@ -363,8 +373,12 @@ pub fn run_observed(
         .map_err(anyhow::Error::msg)?;
     let live = tempfile::tempdir().context("creating the live map's scratch directory")?;
     let prior = options.map_dir.join("blocks");
+    let map_config = mapper::MapConfig {
+        max_distance_m: distance_cap_m(&model, &options.autonomy),
+        ..crate::mapping::map_config()
+    };
     let mut map = MultiHeightMap::with_stores(
-        crate::mapping::map_config(),
+        map_config,
         crate::mapping::levels_of(scenario)?,
         Point2::from(start.translation.vector),
         Some(&prior),
@@ -799,17 +813,12 @@ pub fn run_observed(
     Ok(report)
 }
 
-/// Ground-truth distance from every active object to the vehicle's parts of each level, now.
+/// Ground truth now: per level, the distance from the vehicle's parts of that level to the
+/// nearest object in range (infinity if none).
 fn clearance_per_level(world: &World, part_levels: &[usize], levels: usize) -> Vec<f64> {
     let mut out = vec![f64::INFINITY; levels];
-    let here = world.vehicle_position();
-    for (i, solid) in world.scene().solids.iter().enumerate() {
-        if (solid.x_m - here.x).hypot(solid.y_m - here.y) > 30.0 {
-            continue;
-        }
-        for (part, d) in world.distances_to(i).into_iter().enumerate() {
-            out[part_levels[part]] = out[part_levels[part]].min(d);
-        }
+    for (d, level) in world.part_clearances_m().iter().zip(part_levels) {
+        out[*level] = out[*level].min(*d);
     }
     out
 }

@@ -24,6 +24,13 @@ const GROUND_THICKNESS_M: f64 = 0.1;
 /// Objects farther than this beyond the vehicle's bounding radius are not measured for clearance.
 const CLEARANCE_RANGE_M: f64 = 15.0;
 
+/// The gap between two boxes (0 when they overlap): a lower bound of the distance between
+/// anything they hold.
+fn aabb_gap(a: &Aabb, b: &Aabb) -> f64 {
+    let gap = (a.mins - b.maxs).max(b.mins - a.maxs).max(Vector::ZERO);
+    gap.length() as f64
+}
+
 /// nalgebra pose (f64) to Rapier pose (f32): the one conversion at the simulator's edge.
 pub fn to_pose(iso: &Isometry3<f64>) -> Pose {
     let t = iso.translation.vector;
@@ -92,6 +99,8 @@ pub struct World {
     touching: HashSet<(usize, usize)>,
     contacts: Vec<Contact>,
     min_clearance_m: Vec<f64>,
+    /// Per vehicle part, the distance to the nearest active object in range at the current pose.
+    part_clearance_m: Vec<f64>,
 }
 
 impl World {
@@ -172,6 +181,7 @@ impl World {
             touching: HashSet::new(),
             contacts: Vec::new(),
             min_clearance_m: vec![f64::INFINITY; n],
+            part_clearance_m: vec![f64::INFINITY; vehicle.parts.len()],
         };
         world.refresh();
         world
@@ -259,8 +269,19 @@ impl World {
         }
     }
 
+    /// Ground truth at the current pose: the distance from each part to each active object in
+    /// range, kept as the smallest per object so far and the smallest per part now. A pair's
+    /// exact (GJK) distance is computed only when the gap between their bounding boxes, a lower
+    /// bound, could lower one of the two.
     fn update_clearances(&mut self, pose: &Isometry2<f64>) {
         let (vx, vy) = (pose.translation.x, pose.translation.y);
+        self.part_clearance_m.fill(f64::INFINITY);
+        let parts: Vec<(&Collider, Aabb)> = self
+            .parts
+            .iter()
+            .filter_map(|(h, _)| self.physics.colliders.get(*h))
+            .map(|c| (c, c.compute_aabb()))
+            .collect();
         for (i, solid) in self.scene.solids.iter().enumerate() {
             if !self.object_active[i] {
                 continue;
@@ -273,18 +294,23 @@ impl World {
             let Some(obj) = self.physics.colliders.get(self.objects[i]) else {
                 continue;
             };
-            for (handle, _) in &self.parts {
-                let Some(part) = self.physics.colliders.get(*handle) else {
+            let obj_box = obj.compute_aabb();
+            for (p, (part, part_box)) in parts.iter().enumerate() {
+                let bound = aabb_gap(part_box, &obj_box);
+                let (per_object, per_part) =
+                    (&mut self.min_clearance_m[i], &mut self.part_clearance_m[p]);
+                if bound >= *per_object && bound >= *per_part {
                     continue;
-                };
+                }
                 if let Ok(d) = parry3d::query::distance(
                     part.position(),
                     part.shape(),
                     obj.position(),
                     obj.shape(),
                 ) {
-                    let m = &mut self.min_clearance_m[i];
-                    *m = m.min(d.distance as f64);
+                    let d = d.distance as f64;
+                    *per_object = per_object.min(d);
+                    *per_part = per_part.min(d);
                 }
             }
         }
@@ -330,6 +356,13 @@ impl World {
     /// within range), indexed like `scene().solids`.
     pub fn min_clearances_m(&self) -> &[f64] {
         &self.min_clearance_m
+    }
+
+    /// Ground truth at the current pose: per vehicle part (in the vehicle's part order), the
+    /// distance to the nearest active object whose centre lies within the vehicle's radius plus
+    /// the object's footprint radius plus 15 m (infinity if none).
+    pub fn part_clearances_m(&self) -> &[f64] {
+        &self.part_clearance_m
     }
 
     /// Who owns a collider.
