@@ -534,26 +534,32 @@ impl MultiHeightMap {
         let levels = &self.levels;
         let classified = &self.classified;
         let geometry = self.geometry;
-        let results: Vec<(usize, usize)> = self
-            .live
-            .par_iter_mut()
-            .enumerate()
-            .map(|(k, grid)| {
-                insert_level(k, grid, levels, classified, scan, beams, &geometry, &config)
-            })
-            .collect();
+        // The levels in parallel, and beside them the remission of the returns that are ground
+        // for level 0.
+        let (results, ()) = rayon::join(
+            || -> Vec<(usize, usize)> {
+                self.live
+                    .par_iter_mut()
+                    .enumerate()
+                    .map(|(k, grid)| {
+                        insert_level(k, grid, levels, classified, scan, beams, &geometry, &config)
+                    })
+                    .collect()
+            },
+            || {
+                let rem = self.live_remission.data_mut();
+                for (c, r) in classified.iter().zip(scan.returns()) {
+                    if let (Some(r), false, true) = (r, c.obstacle, c.cell != DROPPED) {
+                        rem[c.cell as usize].add(r.intensity);
+                    }
+                }
+            },
+        );
         for (k, (hits, free)) in results.into_iter().enumerate() {
             stats.hits[k] = hits;
             stats.free_cells[k] = free;
             if hits + free > 0 {
                 self.odm_dirty[k] = true;
-            }
-        }
-        // Remission from the returns that are ground for level 0.
-        let rem = self.live_remission.data_mut();
-        for (c, r) in self.classified.iter().zip(scan.returns()) {
-            if let (Some(r), false, true) = (r, c.obstacle, c.cell != DROPPED) {
-                rem[c.cell as usize].add(r.intensity);
             }
         }
         Ok(stats)
@@ -715,38 +721,48 @@ impl MultiHeightMap {
             (cy + half).clamp(0, h) as usize,
         );
         let width = g.width();
-        let mut total = 0;
-        for (k, (live, prior)) in self.live.iter_mut().zip(&self.prior).enumerate() {
-            let mut changed = 0;
-            let (live, prior) = (live.data_mut(), prior.data());
-            for y in y0..y1 {
-                let row = y * width;
-                for i in row + x0..row + x1 {
-                    let l = live[i];
-                    // Only evidence of an obstacle (p > 0.5) fades; unknown (NaN) stays.
-                    if l.is_nan() || l <= 0.0 {
+        // The levels in parallel; a row without a positive live cell (most of them: free or
+        // unknown) is passed over with one vectorised maximum.
+        let changed: Vec<usize> = self
+            .live
+            .par_iter_mut()
+            .zip(&self.prior)
+            .map(|(live, prior)| {
+                let mut changed = 0;
+                let (live, prior) = (live.data_mut(), prior.data());
+                for y in y0..y1 {
+                    let row = y * width + x0..y * width + x1;
+                    // f32::max ignores NaN (unknown).
+                    if live[row.clone()].iter().fold(0.0f32, |m, &l| m.max(l)) <= 0.0 {
                         continue;
                     }
-                    let l_prior = if prior[i].is_nan() { 0.0 } else { prior[i] };
-                    if l <= l_prior {
-                        continue;
+                    for i in row {
+                        let l = live[i];
+                        // Only evidence of an obstacle (p > 0.5) fades; unknown (NaN) stays.
+                        if l.is_nan() || l <= 0.0 {
+                            continue;
+                        }
+                        let l_prior = if prior[i].is_nan() { 0.0 } else { prior[i] };
+                        if l <= l_prior {
+                            continue;
+                        }
+                        let l = l_prior + (l - l_prior) * keep;
+                        live[i] = if l <= 0.0 || l - l_prior < 0.05 {
+                            // No longer an obstacle, or as good as the prior: hand the cell back.
+                            f32::NAN
+                        } else {
+                            l
+                        };
+                        changed += 1;
                     }
-                    let l = l_prior + (l - l_prior) * keep;
-                    live[i] = if l <= 0.0 || l - l_prior < 0.05 {
-                        // No longer an obstacle, or as good as the prior: hand the cell back to it.
-                        f32::NAN
-                    } else {
-                        l
-                    };
-                    changed += 1;
                 }
-            }
-            if changed > 0 {
-                self.odm_dirty[k] = true;
-            }
-            total += changed;
+                changed
+            })
+            .collect();
+        for (dirty, n) in self.odm_dirty.iter_mut().zip(&changed) {
+            *dirty |= *n > 0;
         }
-        total
+        changed.iter().sum()
     }
 
     /// Recomputes, over the region of `rw` x `rh` cells from (`x0`, `y0`), the distance map of

@@ -49,6 +49,11 @@ pub struct RunOptions {
     /// `None`: never (a moving vehicle's trail hidden behind the airframe then stays). Default
     /// 10 s: a cell seen occupied once stops being an obstacle about 7 s after it was last seen.
     pub forget_time_constant_s: Option<f64>,
+    /// Map and plan from the revolution taken one scan period ago while the LiDAR takes the
+    /// next one, as on the vehicle, where a revolution is mapped while the sensor turns: the map
+    /// the planner sees is one revolution (0.1 s) old, the pose is current. Default true; false
+    /// maps and plans each revolution the instant it is taken.
+    pub overlap_sensing: bool,
     /// Set from outside (Ctrl-C) to end the run with a partial report.
     pub stop: Arc<AtomicBool>,
 }
@@ -66,6 +71,7 @@ impl RunOptions {
             autonomy: AutonomyConfig::default(),
             distance_map_half_size_m: 50.0,
             forget_time_constant_s: Some(10.0),
+            overlap_sensing: true,
             stop: Arc::new(AtomicBool::new(false)),
         }
     }
@@ -273,6 +279,13 @@ pub struct ScanFrame<'a> {
     pub world: &'a World,
 }
 
+/// A revolution and the poses it was taken from.
+struct Captured {
+    scan: crate::lidar::LidarScan,
+    truth: Isometry2<f64>,
+    estimate: Isometry2<f64>,
+}
+
 /// One physics step, given to [`Observer::step`].
 pub struct StepFrame<'a> {
     /// Simulated time, seconds.
@@ -444,6 +457,8 @@ pub fn run_observed(
     );
     let s_start = s_hint;
     let mut current: Option<Plan> = None;
+    // With `overlap_sensing`, the revolution taken at the last scan time, mapped at the next one.
+    let mut pending: Option<Captured> = None;
     let mut speed_cmd = 0.0;
     let mut offset_prev = 0.0;
     let mut laps_completed = 0;
@@ -510,88 +525,131 @@ pub fn run_observed(
             route.project(&Point2::from(estimate.translation.vector), s_hint, 30.0);
 
         if step.is_multiple_of(steps_per_scan) {
-            let t0 = Instant::now();
-            let scan = lidar.scan(
-                &world,
-                &SweepPoses::still(truth),
-                step / steps_per_scan,
-                seed,
-            );
-            split.lidar += t0.elapsed().as_secs_f64();
-            let t1 = Instant::now();
-            let scan_view = scan;
-            let reexpressed;
-            let mapper_scan = if estimate != truth {
-                reexpressed = reexpress(&scan_view.scan, &truth, &estimate)?;
-                &reexpressed
-            } else {
-                &scan_view.scan
+            let capture = |world: &World| {
+                let t0 = Instant::now();
+                let scan = lidar.scan(
+                    world,
+                    &SweepPoses::still(truth),
+                    step / steps_per_scan,
+                    seed,
+                );
+                (
+                    Captured {
+                        scan,
+                        truth,
+                        estimate,
+                    },
+                    t0.elapsed().as_secs_f64(),
+                )
             };
-            map.recenter(Point2::from(estimate.translation.vector))?;
-            // Fade what is no longer seen, then insert: what is seen again is refreshed.
-            if let Some(tau) = options.forget_time_constant_s {
-                map.forget_unseen(
+            // Map the revolution (the one taken a revolution ago when sensing overlaps), then
+            // plan from the pose now over the updated distance maps.
+            let think = |map: &mut MultiHeightMap,
+                         captured: &Captured|
+             -> anyhow::Result<(Plan, f64, [f64; 3])> {
+                let t1 = Instant::now();
+                let reexpressed;
+                let mapper_scan = if captured.estimate != captured.truth {
+                    reexpressed =
+                        reexpress(&captured.scan.scan, &captured.truth, &captured.estimate)?;
+                    &reexpressed
+                } else {
+                    &captured.scan.scan
+                };
+                let at = Point2::from(captured.estimate.translation.vector);
+                map.recenter(at)?;
+                // Fade what is no longer seen, then insert: what is seen again is refreshed.
+                if let Some(tau) = options.forget_time_constant_s {
+                    map.forget_unseen(
+                        at,
+                        options.distance_map_half_size_m,
+                        1.0 / options.scan_hz,
+                        tau,
+                    );
+                }
+                map.insert_scan(mapper_scan, Some(&self_filter))?;
+                let t2 = Instant::now();
+                map.update_distance_maps_around(
                     Point2::from(estimate.translation.vector),
                     options.distance_map_half_size_m,
-                    1.0 / options.scan_hz,
-                    tau,
                 );
+                let t3 = Instant::now();
+                let checker = model.checker(map.distance_maps())?;
+                let p = plan(
+                    &checker,
+                    &route,
+                    s_est,
+                    d_est,
+                    offset_prev,
+                    behaviour,
+                    &options.autonomy,
+                );
+                let (v, _) = avoid(
+                    p.chosen(),
+                    scenario.route.speed_m_s,
+                    decel,
+                    &options.autonomy,
+                );
+                let times = [
+                    (t2 - t1).as_secs_f64(),
+                    (t3 - t2).as_secs_f64(),
+                    t3.elapsed().as_secs_f64(),
+                ];
+                Ok((p, v, times))
+            };
+            let (fresh, thought) = if options.overlap_sensing {
+                // The LiDAR's next revolution and the mapping of the last one run side by side.
+                let previous = pending.take();
+                let (fresh, thought) = rayon::join(
+                    || capture(&world),
+                    || previous.map(|c| think(&mut map, &c).map(|r| (r, c))),
+                );
+                (Some(fresh), thought.transpose()?)
+            } else {
+                let (c, lidar_s) = capture(&world);
+                split.lidar += lidar_s;
+                let r = think(&mut map, &c)?;
+                (None, Some((r, c)))
+            };
+            if let Some((c, lidar_s)) = fresh {
+                split.lidar += lidar_s;
+                pending = Some(c);
             }
-            map.insert_scan(mapper_scan, Some(&self_filter))?;
-            split.mapping += t1.elapsed().as_secs_f64();
-            let t2 = Instant::now();
-            map.update_distance_maps_around(
-                Point2::from(estimate.translation.vector),
-                options.distance_map_half_size_m,
-            );
-            split.distance_maps += t2.elapsed().as_secs_f64();
-            let t3 = Instant::now();
-            let checker = model.checker(map.distance_maps())?;
-            let p = plan(
-                &checker,
-                &route,
-                s_est,
-                d_est,
-                offset_prev,
-                behaviour,
-                &options.autonomy,
-            );
-            let (v, _) = avoid(
-                p.chosen(),
-                scenario.route.speed_m_s,
-                decel,
-                &options.autonomy,
-            );
-            offset_prev = p.chosen().offset_m;
-            speed_cmd = v;
-            split.planning += t3.elapsed().as_secs_f64();
-            if (offset_prev.abs() > 0.5) != deviating {
-                deviating = !deviating;
-                let event = if deviating {
-                    Event::Deviate {
-                        offset_m: offset_prev,
-                    }
-                } else {
-                    Event::BackOnRoute
-                };
-                observer.event(t, &event)?;
+            // Until the first revolution is mapped there is nothing to follow (the vehicle waits).
+            if let Some(((p, v, [mapping_s, odm_s, planning_s]), captured)) = thought {
+                split.mapping += mapping_s;
+                split.distance_maps += odm_s;
+                split.planning += planning_s;
+                offset_prev = p.chosen().offset_m;
+                speed_cmd = v;
+                if (offset_prev.abs() > 0.5) != deviating {
+                    deviating = !deviating;
+                    let event = if deviating {
+                        Event::Deviate {
+                            offset_m: offset_prev,
+                        }
+                    } else {
+                        Event::BackOnRoute
+                    };
+                    observer.event(t, &event)?;
+                }
+                observer.scan(&ScanFrame {
+                    t_s: t,
+                    truth: captured.truth,
+                    estimate: captured.estimate,
+                    lidar: &captured.scan,
+                    map: &map,
+                    plan: &p,
+                    speed_cmd_m_s: v,
+                    speed_scale: if scenario.route.speed_m_s > 0.0 {
+                        v / scenario.route.speed_m_s
+                    } else {
+                        0.0
+                    },
+                    world: &world,
+                })?;
+                current = Some(p);
             }
-            observer.scan(&ScanFrame {
-                t_s: t,
-                truth,
-                estimate,
-                lidar: &scan_view,
-                map: &map,
-                plan: &p,
-                speed_cmd_m_s: v,
-                speed_scale: if scenario.route.speed_m_s > 0.0 {
-                    v / scenario.route.speed_m_s
-                } else {
-                    0.0
-                },
-                world: &world,
-            })?;
-            current = Some(p);
         }
 
         let physics = Instant::now();

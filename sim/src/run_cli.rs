@@ -43,6 +43,10 @@ pub struct RunArgs {
     /// Standard deviation of the pose noise given to the autonomy: heading in radians.
     #[arg(long, default_value_t = 0.0)]
     pub pose_noise_rad: f64,
+    /// Map and plan each revolution the instant it is taken (no latency; slower), instead of
+    /// while the LiDAR takes the next one.
+    #[arg(long)]
+    pub sequential_sensing: bool,
     /// Write a Rerun recording of the run here (.rrd; open it with `rerun FILE`, viewer 0.36).
     #[arg(long, value_name = "FILE")]
     pub record: Option<PathBuf>,
@@ -147,6 +151,7 @@ pub fn run_cmd(args: &RunArgs) -> anyhow::Result<bool> {
     options.laps = args.laps;
     options.seed = args.seed;
     options.pose_noise = (args.pose_noise_m, args.pose_noise_rad);
+    options.overlap_sensing = !args.sequential_sensing;
     let stop = options.stop.clone();
     // A second Ctrl-C falls through to the default handler only if this one could not be set.
     let _ = ctrlc::set_handler(move || stop.store(true, Ordering::Relaxed));

@@ -72,6 +72,22 @@ fn the_car_deviates_around_a_cone_in_its_path() {
     );
 }
 
+/// The same without the overlap of sensing and mapping: each revolution is mapped and planned
+/// the instant it is taken.
+#[test]
+fn the_car_deviates_around_a_cone_in_its_path_with_sequential_sensing() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario("cone_in_path_car");
+    sim::mapping::map_drive(&s, dir.path(), &mut |_, _| {}).unwrap();
+    let options = RunOptions {
+        overlap_sensing: false,
+        ..RunOptions::new(dir.path().to_path_buf())
+    };
+    let r = run(&s, &options, &mut |_| {}).unwrap();
+    assert!(r.expectations_met, "{r:#?}");
+    assert!(outcomes(&r).iter().all(|(_, o)| o == "deviated"), "{r:#?}");
+}
+
 #[test]
 fn the_car_deviates_around_a_tall_container_in_its_wings_path() {
     let dir = tempfile::tempdir().unwrap();
