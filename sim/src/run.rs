@@ -41,9 +41,11 @@ pub struct RunOptions {
     /// Planner, avoider and follower.
     pub autonomy: AutonomyConfig,
     /// Distance maps are computed over a square of this half side around the vehicle, metres.
-    /// Default 50: the planner's horizon (30 m) plus a jet's reach (12 m) plus 8 m, so every
+    /// Default `None`: [`distance_map_half_size_m`] of the vehicle and planner, so every
     /// collision decision sees the same distances as over the whole window.
-    pub distance_map_half_size_m: f64,
+    pub distance_map_half_size_m: Option<f64>,
+    /// Forgetting works over a square of this half side around the vehicle, metres. Default 50.
+    pub forget_half_size_m: f64,
     /// Live occupancy the LiDAR no longer sees fades back to the offline map with this time
     /// constant, seconds (`MultiHeightMap::forget_unseen`, CARMEN's decay to the offline map);
     /// `None`: never (a moving vehicle's trail hidden behind the airframe then stays). Default
@@ -69,7 +71,8 @@ impl RunOptions {
             scan_hz: 10.0,
             pose_noise: (0.0, 0.0),
             autonomy: AutonomyConfig::default(),
-            distance_map_half_size_m: 50.0,
+            distance_map_half_size_m: None,
+            forget_half_size_m: 50.0,
             forget_time_constant_s: Some(10.0),
             overlap_sensing: true,
             stop: Arc::new(AtomicBool::new(false)),
@@ -85,6 +88,24 @@ impl RunOptions {
 pub fn distance_cap_m(model: &CollisionModel, autonomy: &AutonomyConfig) -> f32 {
     let safety = autonomy.planner_safety_m.max(autonomy.avoider_safety_m);
     model.bounding_circle().radius_m as f32 + safety + 1.0 + 0.3
+}
+
+/// The half side of the square around the vehicle over which the run's distance maps are
+/// computed: no check of the planner or the avoider reads a distance outside it or one that an
+/// obstacle outside it could lower. A candidate's pose lies within the horizon plus twice the
+/// largest offset of the vehicle (the vehicle may be off the route too); the early out reads the
+/// map at the bounding circle's centre up to its radius plus the safety distance plus a cell
+/// diagonal, and every circle lies inside the bounding circle; 1 m is kept.
+pub fn distance_map_half_size_m(model: &CollisionModel, autonomy: &AutonomyConfig) -> f64 {
+    let b = model.bounding_circle();
+    let safety = autonomy.planner_safety_m.max(autonomy.avoider_safety_m) as f64;
+    autonomy.horizon_m
+        + 2.0 * autonomy.max_offset_m
+        + b.center.coords.norm()
+        + b.radius_m
+        + safety
+        + 0.3
+        + 1.0
 }
 
 /// One pass of the vehicle by an obstacle.
@@ -390,6 +411,9 @@ pub fn run_observed(
         max_distance_m: distance_cap_m(&model, &options.autonomy),
         ..crate::mapping::map_config()
     };
+    let odm_half_size_m = options
+        .distance_map_half_size_m
+        .unwrap_or_else(|| distance_map_half_size_m(&model, &options.autonomy));
     let mut map = MultiHeightMap::with_stores(
         map_config,
         crate::mapping::levels_of(scenario)?,
@@ -560,18 +584,13 @@ pub fn run_observed(
                 map.recenter(at)?;
                 // Fade what is no longer seen, then insert: what is seen again is refreshed.
                 if let Some(tau) = options.forget_time_constant_s {
-                    map.forget_unseen(
-                        at,
-                        options.distance_map_half_size_m,
-                        1.0 / options.scan_hz,
-                        tau,
-                    );
+                    map.forget_unseen(at, options.forget_half_size_m, 1.0 / options.scan_hz, tau);
                 }
                 map.insert_scan(mapper_scan, Some(&self_filter))?;
                 let t2 = Instant::now();
                 map.update_distance_maps_around(
                     Point2::from(estimate.translation.vector),
-                    options.distance_map_half_size_m,
+                    odm_half_size_m,
                 );
                 let t3 = Instant::now();
                 let checker = model.checker(map.distance_maps())?;
