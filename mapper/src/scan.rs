@@ -6,6 +6,7 @@
 //! vehicle pose (for the self-hit filter). A beam with no echo is `None`.
 
 use nalgebra::{Isometry2, Isometry3, Point3};
+use rayon::prelude::*;
 
 use crate::error::{MapError, Result};
 
@@ -71,23 +72,24 @@ impl Scan {
                 ));
             }
         }
-        for (i, r) in returns.iter().enumerate() {
-            if let Some(r) = r {
-                let ok = r.point_in_world.iter().all(|x| x.is_finite())
+        // In parallel (a revolution is 70,000 returns); the first bad one is named.
+        let bad = returns.par_iter().enumerate().find_first(|(_, r)| {
+            r.is_some_and(|r| {
+                !(r.point_in_world.iter().all(|x| x.is_finite())
                     && r.range_m.is_finite()
                     && r.range_m >= 0.0
-                    && r.intensity.is_finite();
-                if !ok {
-                    return Err(MapError::invalid(
-                        "scan return",
-                        format!(
-                            "column {} beam {}: {r:?} has a non-finite value or a negative range",
-                            i / beams,
-                            i % beams
-                        ),
-                    ));
-                }
-            }
+                    && r.intensity.is_finite())
+            })
+        });
+        if let Some((i, Some(r))) = bad {
+            return Err(MapError::invalid(
+                "scan return",
+                format!(
+                    "column {} beam {}: {r:?} has a non-finite value or a negative range",
+                    i / beams,
+                    i % beams
+                ),
+            ));
         }
         Ok(Scan {
             beams,
