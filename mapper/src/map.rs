@@ -721,8 +721,8 @@ impl MultiHeightMap {
             (cy + half).clamp(0, h) as usize,
         );
         let width = g.width();
-        // The levels in parallel; a row without a positive live cell (most of them: free or
-        // unknown) is passed over with one vectorised maximum.
+        // The levels in parallel; a row without a positive live cell (only free or unknown
+        // cells) is passed over with one vectorised maximum.
         let changed: Vec<usize> = self
             .live
             .par_iter_mut()
