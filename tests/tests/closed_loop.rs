@@ -15,11 +15,24 @@ fn scenario(name: &str) -> Scenario {
 
 /// Builds the offline map (mapping drive) in a scratch directory, then runs the closed loop.
 fn run_scenario(name: &str, map_dir: &Path) -> RunReport {
+    run_scenario_with(name, map_dir, |o| o)
+}
+
+/// Like [`run_scenario`], with the run's options changed by `adjust`.
+fn run_scenario_with(
+    name: &str,
+    map_dir: &Path,
+    adjust: impl FnOnce(RunOptions) -> RunOptions,
+) -> RunReport {
     let s = scenario(name);
     sim::mapping::map_drive(&s, map_dir, &mut |_, _| {})
         .unwrap_or_else(|e| panic!("{name}: mapping drive: {e:#}"));
-    run(&s, &RunOptions::new(map_dir.to_path_buf()), &mut |_| {})
-        .unwrap_or_else(|e| panic!("{name}: {e:#}"))
+    run(
+        &s,
+        &adjust(RunOptions::new(map_dir.to_path_buf())),
+        &mut |_| {},
+    )
+    .unwrap_or_else(|e| panic!("{name}: {e:#}"))
 }
 
 fn outcomes(r: &RunReport) -> Vec<(String, String)> {
@@ -77,13 +90,10 @@ fn the_car_deviates_around_a_cone_in_its_path() {
 #[test]
 fn the_car_deviates_around_a_cone_in_its_path_with_sequential_sensing() {
     let dir = tempfile::tempdir().unwrap();
-    let s = scenario("cone_in_path_car");
-    sim::mapping::map_drive(&s, dir.path(), &mut |_, _| {}).unwrap();
-    let options = RunOptions {
+    let r = run_scenario_with("cone_in_path_car", dir.path(), |o| RunOptions {
         overlap_sensing: false,
-        ..RunOptions::new(dir.path().to_path_buf())
-    };
-    let r = run(&s, &options, &mut |_| {}).unwrap();
+        ..o
+    });
     assert!(r.expectations_met, "{r:#?}");
     assert!(outcomes(&r).iter().all(|(_, o)| o == "deviated"), "{r:#?}");
 }
@@ -148,13 +158,10 @@ fn a_crossing_vehicle_stops_the_jet_which_resumes_once_it_has_gone() {
 #[test]
 fn without_forgetting_the_jet_waits_for_the_crossing_cars_hidden_trail() {
     let dir = tempfile::tempdir().unwrap();
-    let s = scenario("crossing_vehicle");
-    sim::mapping::map_drive(&s, dir.path(), &mut |_, _| {}).unwrap();
-    let options = RunOptions {
+    let r = run_scenario_with("crossing_vehicle", dir.path(), |o| RunOptions {
         forget_time_constant_s: None,
-        ..RunOptions::new(dir.path().to_path_buf())
-    };
-    let r = run(&s, &options, &mut |_| {}).unwrap();
+        ..o
+    });
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     assert_eq!(r.stops.len(), 1);
     assert_eq!(r.stops[0].end_s, None, "never resumes");
