@@ -38,7 +38,7 @@ pub use collision::{
 pub use error::{MapError, Result};
 pub use grid::{Cell, Grid, GridGeometry};
 pub use levels::{HeightClass, LevelMode, Levels};
-pub use map::{FreeSpaceStop, InsertStats, MapConfig, MergeMode, MultiHeightMap};
+pub use map::{FreeSpaceStop, FreeSpaceWalks, InsertStats, MapConfig, MergeMode, MultiHeightMap};
 pub use occupancy::{ObstacleTestParams, OccupancyParams};
 pub use odm::{DistanceMap, DistanceMaps};
 pub use remission::RemissionCell;

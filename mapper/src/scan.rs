@@ -38,6 +38,9 @@ pub struct Scan {
     returns: Vec<Option<Return>>,
 }
 
+/// Beams per column a scan may have (128-beam sensors exist; the mapper indexes beams in 16 bits).
+pub const MAX_BEAMS: usize = 4096;
+
 impl Scan {
     /// A scan of `columns.len()` columns of `beams` returns each (`returns[column * beams + beam]`,
     /// beam 0 lowest). Every number must be finite and ranges >= 0.
@@ -48,6 +51,12 @@ impl Scan {
     ) -> Result<Self> {
         if beams == 0 {
             return Err(MapError::invalid("scan", "0 beams per column"));
+        }
+        if beams > MAX_BEAMS {
+            return Err(MapError::invalid(
+                "scan",
+                format!("{beams} beams per column (at most {MAX_BEAMS})"),
+            ));
         }
         if returns.len() != beams * columns.len() {
             return Err(MapError::invalid(

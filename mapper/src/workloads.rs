@@ -126,12 +126,12 @@ pub fn fake_wing_car() -> CollisionModel {
 
 /// A map with the fake-wing car's levels, centred on the origin.
 pub fn two_level_map() -> MultiHeightMap {
-    MultiHeightMap::new(
-        MapConfig::default(),
-        fake_wing_car_levels(),
-        Point2::origin(),
-    )
-    .unwrap_or_else(|e| unreachable!("fixed config: {e}"))
+    two_level_map_with(MapConfig::default()).unwrap_or_else(|e| unreachable!("fixed config: {e}"))
+}
+
+/// [`two_level_map`] with other settings.
+pub fn two_level_map_with(config: MapConfig) -> crate::error::Result<MultiHeightMap> {
+    MultiHeightMap::new(config, fake_wing_car_levels(), Point2::origin())
 }
 
 fn fake_wing_car_levels() -> Levels {

@@ -582,3 +582,88 @@ fn occupancy_no_longer_seen_fades_to_the_prior_and_what_is_still_seen_stays() {
         "handed back to the (unknown) prior"
     );
 }
+
+/// The coarse-to-fine free-space walks build the map the walk of every column builds - the same
+/// obstacles, the same free and unknown cells but for a few dozen cells, the same probabilities
+/// to a few thousandths - with fewer cell updates.
+#[test]
+fn coarse_to_fine_walks_map_what_every_column_maps_with_fewer_updates() {
+    let scene = mapper::workloads::parking_lot_scene();
+    let levels = || Levels::new(vec![0.0, 0.7], LevelMode::Cumulative, None).unwrap();
+    let mut maps = [
+        mapper::FreeSpaceWalks::EveryColumn,
+        mapper::FreeSpaceWalks::CoarseToFine,
+    ]
+    .map(|walks| {
+        let config = MapConfig {
+            free_space_walks: walks,
+            ..Default::default()
+        };
+        (
+            MultiHeightMap::new(config, levels(), Point2::origin()).unwrap(),
+            0usize,
+        )
+    });
+    // A drive down the aisle, three revolutions from each stop.
+    for i in 0..8 {
+        let scan = scan_from(&scene, -35.0 + 10.0 * i as f64, -3.0);
+        for _ in 0..3 {
+            for (map, updates) in &mut maps {
+                let stats = map.insert_scan(&scan, None).unwrap();
+                *updates += stats.free_cells.iter().sum::<usize>();
+            }
+        }
+    }
+    let [(every, every_updates), (coarse, coarse_updates)] = &maps;
+    for k in 0..2 {
+        let (a, b) = (
+            every.live_log_odds(k).unwrap(),
+            coarse.live_log_odds(k).unwrap(),
+        );
+        // Unknown, free (p <= 0.5), occupied.
+        let class = |l: f32| match l {
+            l if l.is_nan() => 0,
+            l if l > 0.0 => 2,
+            _ => 1,
+        };
+        let (mut known, mut differ, mut occupied, mut occupied_differ) = (0, 0, 0, 0);
+        let (mut both, mut gap) = (0, 0.0f64);
+        for (&p, &q) in a.data().iter().zip(b.data()) {
+            let (cp, cq) = (class(p), class(q));
+            if cp != 0 && cq != 0 {
+                both += 1;
+                gap += (mapper::occupancy::probability(p) - mapper::occupancy::probability(q)).abs()
+                    as f64;
+            }
+            known += usize::from(cp != 0 || cq != 0);
+            differ += usize::from(cp != cq);
+            occupied += usize::from(cp == 2 || cq == 2);
+            occupied_differ += usize::from((cp == 2) != (cq == 2));
+        }
+        eprintln!(
+            "level {k}: {known} known cells, {differ} classed differently; {occupied} occupied, \
+             {occupied_differ} differ; mean |p - p'| {:.4} where both know the cell",
+            gap / both as f64
+        );
+        assert!(known > 50_000, "level {k}: the drive maps the lot");
+        assert!(
+            (differ as f64) < 0.005 * known as f64,
+            "level {k}: {differ} of {known} cells differ"
+        );
+        assert!(
+            (occupied_differ as f64) < 0.02 * occupied as f64,
+            "level {k}: {occupied_differ} of {occupied} occupied cells differ"
+        );
+        assert!(
+            gap < 0.01 * both as f64,
+            "level {k}: the free evidence agrees"
+        );
+    }
+    eprintln!(
+        "free-space cell updates: every column {every_updates}, coarse to fine {coarse_updates}"
+    );
+    assert!(
+        (*coarse_updates as f64) < 0.7 * *every_updates as f64,
+        "{coarse_updates} vs {every_updates} updates"
+    );
+}

@@ -80,9 +80,30 @@ impl RoutePath {
     }
     /// Arc length and signed lateral offset (left positive) of a point, searched within
     /// `window_m` of `s_hint` (so a circuit that passes near itself is followed in order).
+    /// Only the segments whose arc-length span meets the window are visited (found by bisection),
+    /// in index order, so the result is that of testing every segment.
     pub fn project(&self, p: &Point2<f64>, s_hint: f64, window_m: f64) -> (f64, f64) {
+        let length = self.length_m();
+        let last = self.points.len() - 2;
+        // Index ranges of the segments to visit, ascending.
+        let mut spans = [(0, last), (1, 0)];
+        if window_m.is_finite() && window_m < 0.5 * length {
+            let (lo, hi) = if self.closed {
+                let h = s_hint.rem_euclid(length);
+                (h - window_m, h + window_m)
+            } else {
+                (s_hint - window_m, s_hint + window_m)
+            };
+            spans = if self.closed && lo < 0.0 {
+                [(0, self.segment(hi)), (self.segment(lo + length), last)]
+            } else if self.closed && hi > length {
+                [(0, self.segment(hi - length)), (self.segment(lo), last)]
+            } else {
+                [(self.segment(lo), self.segment(hi)), (1, 0)]
+            };
+        }
         let mut best = (f64::INFINITY, 0.0, 0.0);
-        for i in 0..self.points.len() - 1 {
+        for i in spans.iter().flat_map(|&(a, b)| a..=b) {
             let (a, b) = (self.points[i], self.points[i + 1]);
             let ab = b - a;
             let len2 = ab.norm_squared().max(1e-12);
@@ -90,8 +111,8 @@ impl RoutePath {
             let q = a + ab * t;
             let s = self.s[i] + t * len2.sqrt();
             let along = if self.closed {
-                let d = (s - s_hint).rem_euclid(self.length_m());
-                d.min(self.length_m() - d)
+                let d = (s - s_hint).rem_euclid(length);
+                d.min(length - d)
             } else {
                 (s - s_hint).abs()
             };
@@ -405,6 +426,60 @@ mod tests {
         );
         let (_, d) = r.project(&Point2::new(5.0, -1.0), 5.0, 10.0);
         assert!((d + 1.0).abs() < 1e-12);
+    }
+
+    /// The windowed search (bisection on arc length) agrees with testing every segment.
+    #[test]
+    fn windowed_projection_matches_the_exhaustive_search() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+        // A wobbly closed loop and an open one of many short segments.
+        let pts: Vec<Point2<f64>> = (0..400)
+            .map(|i| {
+                let a = i as f64 / 400.0 * std::f64::consts::TAU;
+                let r = 50.0 + 5.0 * (7.0 * a).sin();
+                Point2::new(r * a.cos(), r * a.sin())
+            })
+            .collect();
+        for closed in [true, false] {
+            let r = RoutePath::new(&pts, closed);
+            // The old search: every segment, and the whole route when none is in the window.
+            let brute = |p: &Point2<f64>, hint: f64, w: f64| {
+                let mut best = (f64::INFINITY, 0.0, 0.0);
+                for w in [w, f64::INFINITY] {
+                    for i in 0..r.points.len() - 1 {
+                        let (a, b) = (r.points[i], r.points[i + 1]);
+                        let ab = b - a;
+                        let len2 = ab.norm_squared().max(1e-12);
+                        let t = ((p - a).dot(&ab) / len2).clamp(0.0, 1.0);
+                        let s = r.s[i] + t * len2.sqrt();
+                        let along = if closed {
+                            let d = (s - hint).rem_euclid(r.length_m());
+                            d.min(r.length_m() - d)
+                        } else {
+                            (s - hint).abs()
+                        };
+                        let dist = (p - (a + ab * t)).norm();
+                        if along <= w && dist < best.0 {
+                            let side = ab.x * (p.y - a.y) - ab.y * (p.x - a.x);
+                            best = (dist, s, if side >= 0.0 { dist } else { -dist });
+                        }
+                    }
+                    if best.0.is_finite() {
+                        break;
+                    }
+                }
+                (best.1, best.2)
+            };
+            for _ in 0..2000 {
+                let p = Point2::new(rng.random_range(-60.0..60.0), rng.random_range(-60.0..60.0));
+                let hint = rng.random_range(-10.0..r.length_m() + 10.0);
+                let w = [5.0, 30.0, 100.0][rng.random_range(0..3)];
+                let fast = r.project(&p, hint, w);
+                let slow = brute(&p, hint, w);
+                assert_eq!(fast, slow, "closed {closed} p {p} hint {hint} window {w}");
+            }
+        }
     }
 
     #[test]
