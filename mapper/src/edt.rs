@@ -115,18 +115,7 @@ pub fn exact_edt(
                     ((d2 as f32).sqrt() * resolution_m).min(max_distance_m)
                 };
             };
-            // Dense rows (column distances mostly small) finish the search within the limit: at
-            // 2 % obstacles the mean column distance is ~45 cells while no cell of a row is more
-            // than ~15 cells from an obstacle. Sparse rows go straight to the envelope.
-            let mean_g = rs.row.iter().map(|&v| v as u64).sum::<u64>() / width as u64;
-            if mean_g < 4 * DENSE_SEARCH_LIMIT as u64
-                && neighbour_search(&rs.row, &mut rs.g2, &mut rs.best, DENSE_SEARCH_LIMIT)
-            {
-                for (x, b) in rs.best.iter().enumerate() {
-                    emit(x, *b as i64, out_row);
-                }
-                return;
-            }
+            // The columns with an obstacle within the cap: the envelope's sites.
             let mut n = 0;
             for (x, &v) in rs.row.iter().enumerate() {
                 if v < cap_cells {
@@ -137,6 +126,21 @@ pub fn exact_edt(
             if n == 0 {
                 out_row.fill(max_distance_m);
                 return;
+            }
+            // Dense rows (every column with an obstacle within the cap, column distances mostly
+            // small) finish the search within the limit: at 2 % obstacles the mean column
+            // distance is ~45 cells while no cell of a row is more than ~15 cells from an
+            // obstacle. Other rows go to the envelope, whose cost follows the sites.
+            if n == width {
+                let mean_g = rs.row.iter().map(|&v| v as u64).sum::<u64>() / width as u64;
+                if mean_g < 4 * DENSE_SEARCH_LIMIT as u64
+                    && neighbour_search(&rs.row, &mut rs.g2, &mut rs.best, DENSE_SEARCH_LIMIT)
+                {
+                    for (x, b) in rs.best.iter().enumerate() {
+                        emit(x, *b as i64, out_row);
+                    }
+                    return;
+                }
             }
             row_envelope(&rs.row, &rs.sites[..n], &mut rs.s, &mut rs.t, |x, d2| {
                 emit(x, d2, out_row)
@@ -355,7 +359,10 @@ pub(crate) mod tests {
             .collect()
     }
 
-    /// The envelope path alone, for rows the dense search hands over.
+    /// Both phase-2 paths: rows the dense search finishes, rows it hands over to the envelope
+    /// (cap 40 m = 200 cells: sparse rows go past the search limit), and rows where some columns
+    /// have no obstacle within the cap (cap 4.8 m = 24 cells, the car's: the envelope over the
+    /// columns that have one, as in the distance-map windows of the closed loop).
     #[test]
     fn both_row_paths_agree_with_brute_force() {
         let mut state = 0x1234_5678_u64;
@@ -365,21 +372,22 @@ pub(crate) mod tests {
             state ^= state << 17;
             state
         };
-        for density_per_mille in [1u64, 5, 20, 100] {
-            let (w, h) = (120, 90);
-            let mask: Vec<bool> = (0..w * h)
-                .map(|_| next() % 1000 < density_per_mille)
-                .collect();
-            // Cap 40 m = 200 cells: sparse rows go past the search limit and use the envelope.
-            let exact = run_exact(w, h, 0.2, 40.0, &mask);
-            let brute = brute_force(w, h, 0.2, 40.0, &mask);
-            for i in 0..w * h {
-                assert!(
-                    (exact[i] - brute[i]).abs() < 1e-4,
-                    "density {density_per_mille}/1000 cell {i}: {} vs {}",
-                    exact[i],
-                    brute[i]
-                );
+        for cap in [40.0, 4.8] {
+            for density_per_mille in [1u64, 5, 20, 100] {
+                let (w, h) = (120, 90);
+                let mask: Vec<bool> = (0..w * h)
+                    .map(|_| next() % 1000 < density_per_mille)
+                    .collect();
+                let exact = run_exact(w, h, 0.2, cap, &mask);
+                let brute = brute_force(w, h, 0.2, cap, &mask);
+                for i in 0..w * h {
+                    assert!(
+                        (exact[i] - brute[i]).abs() < 1e-4,
+                        "cap {cap} density {density_per_mille}/1000 cell {i}: {} vs {}",
+                        exact[i],
+                        brute[i]
+                    );
+                }
             }
         }
     }

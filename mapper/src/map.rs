@@ -285,7 +285,44 @@ pub struct MultiHeightMap {
     classified: Vec<Classified>,
     /// Per column, per level (column-major): the summary of the classification pass.
     column_levels: Vec<ColumnLevel>,
+    /// Per level, the live cells that may be occupied: what forgetting visits.
+    occupied: Vec<OccupiedCells>,
     edt_scratch: EdtScratch,
+}
+
+/// The live cells of one level whose log-odds may be positive (p > 0.5), so that forgetting
+/// visits them instead of sweeping its square: a superset, as a list and a flag per cell. A hit
+/// that makes a cell positive lists it; forgetting drops the cells that are no longer positive
+/// (lowered by free-space walks, handed back to the prior); re-centring lists the window anew.
+#[derive(Clone, Debug, Default)]
+struct OccupiedCells {
+    cells: Vec<u32>,
+    listed: Vec<bool>,
+}
+
+impl OccupiedCells {
+    /// Lists every positive cell of `live`, and only those.
+    fn rebuild(&mut self, live: &[f32]) {
+        self.listed.clear();
+        self.listed.extend(live.iter().map(|&l| l > 0.0));
+        self.cells.clear();
+        self.cells.extend(
+            self.listed
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| **l)
+                .map(|(i, _)| i as u32),
+        );
+    }
+
+    /// Lists cell `i` if it is not listed yet.
+    #[inline]
+    fn note(&mut self, i: u32) {
+        if !self.listed[i as usize] {
+            self.listed[i as usize] = true;
+            self.cells.push(i);
+        }
+    }
 }
 
 impl MultiHeightMap {
@@ -347,12 +384,14 @@ impl MultiHeightMap {
             live_store,
             classified: Vec::new(),
             column_levels: Vec::new(),
+            occupied: vec![OccupiedCells::default(); n],
             edt_scratch: EdtScratch::default(),
             levels,
         };
         for index in map.window_blocks(window_lo) {
             map.load_into_window(index)?;
         }
+        map.list_occupied();
         Ok(map)
     }
 
@@ -467,8 +506,17 @@ impl MultiHeightMap {
         for (index, (prior, live)) in loaded {
             self.put_blocks(index, prior.as_ref(), live.as_ref());
         }
+        self.list_occupied();
         self.odm_dirty.iter_mut().for_each(|d| *d = true);
         Ok(true)
+    }
+
+    /// Lists the positive live cells of every level anew (after the window changed).
+    fn list_occupied(&mut self) {
+        self.occupied
+            .par_iter_mut()
+            .zip(&self.live)
+            .for_each(|(o, live)| o.rebuild(live.data()));
     }
 
     fn read_stores(&self, index: BlockIndex) -> Result<(Option<Block>, Option<Block>)> {
@@ -602,15 +650,17 @@ impl MultiHeightMap {
             || -> Vec<(usize, usize)> {
                 self.live
                     .par_iter_mut()
+                    .zip(self.occupied.par_iter_mut())
                     .enumerate()
-                    .map(|(k, grid)| {
+                    .map(|(k, (grid, occupied))| {
                         let summary = ColumnsOfLevel {
                             all: column_levels,
                             levels: levels.count(),
                             k,
                         };
                         insert_level(
-                            k, grid, levels, classified, summary, scan, &geometry, &config,
+                            k, grid, occupied, levels, classified, summary, scan, &geometry,
+                            &config,
                         )
                     })
                     .collect()
@@ -822,41 +872,45 @@ impl MultiHeightMap {
             (cy + half).clamp(0, h) as usize,
         );
         let width = g.width();
-        // The levels in parallel; a row without a positive live cell (only free or unknown
-        // cells) is passed over with one vectorised maximum.
+        // The levels in parallel, each over its list of cells that may be occupied (only
+        // evidence of an obstacle, p > 0.5, fades), dropping those that no longer are.
         let changed: Vec<usize> = self
             .live
             .par_iter_mut()
             .zip(&self.prior)
-            .map(|(live, prior)| {
+            .zip(self.occupied.par_iter_mut())
+            .map(|((live, prior), occupied)| {
                 let mut changed = 0;
                 let (live, prior) = (live.data_mut(), prior.data());
-                for y in y0..y1 {
-                    let row = y * width + x0..y * width + x1;
-                    // f32::max ignores NaN (unknown).
-                    if live[row.clone()].iter().fold(0.0f32, |m, &l| m.max(l)) <= 0.0 {
-                        continue;
+                let OccupiedCells { cells, listed } = occupied;
+                cells.retain(|&i| {
+                    let i = i as usize;
+                    let l = live[i];
+                    // Unknown (NaN) and free cells are not listed.
+                    if l.is_nan() || l <= 0.0 {
+                        listed[i] = false;
+                        return false;
                     }
-                    for i in row {
-                        let l = live[i];
-                        // Only evidence of an obstacle (p > 0.5) fades; unknown (NaN) stays.
-                        if l.is_nan() || l <= 0.0 {
-                            continue;
-                        }
-                        let l_prior = if prior[i].is_nan() { 0.0 } else { prior[i] };
-                        if l <= l_prior {
-                            continue;
-                        }
-                        let l = l_prior + (l - l_prior) * keep;
-                        live[i] = if l <= 0.0 || l - l_prior < 0.05 {
-                            // No longer an obstacle, or as good as the prior: hand the cell back.
-                            f32::NAN
-                        } else {
-                            l
-                        };
-                        changed += 1;
+                    let (x, y) = (i % width, i / width);
+                    if x < x0 || x >= x1 || y < y0 || y >= y1 {
+                        return true;
                     }
-                }
+                    let l_prior = if prior[i].is_nan() { 0.0 } else { prior[i] };
+                    if l <= l_prior {
+                        return true;
+                    }
+                    let l = l_prior + (l - l_prior) * keep;
+                    changed += 1;
+                    if l <= 0.0 || l - l_prior < 0.05 {
+                        // No longer an obstacle, or as good as the prior: hand the cell back.
+                        live[i] = f32::NAN;
+                        listed[i] = false;
+                        false
+                    } else {
+                        live[i] = l;
+                        true
+                    }
+                });
                 changed
             })
             .collect();
@@ -1050,6 +1104,7 @@ impl ColumnsOfLevel<'_> {
 fn insert_level(
     k: usize,
     grid: &mut Grid<f32>,
+    occupied: &mut OccupiedCells,
     levels: &Levels,
     classified: &[Classified],
     summary: ColumnsOfLevel,
@@ -1077,14 +1132,18 @@ fn insert_level(
         }
         for (b, c) in classified[ci * beams..(ci + 1) * beams].iter().enumerate() {
             if c.cell != DROPPED && c.obstacle && class(c) == HeightClass::Inside {
+                let v = &mut data[c.cell as usize];
                 add(
-                    &mut data[c.cell as usize],
+                    v,
                     if b == nearest as usize {
                         2.0 * occ.l_occ
                     } else {
                         occ.l_occ
                     },
                 );
+                if *v > 0.0 {
+                    occupied.note(c.cell);
+                }
                 hits += 1;
                 hit_cells.push(c.cell);
             }

@@ -583,6 +583,97 @@ fn occupancy_no_longer_seen_fades_to_the_prior_and_what_is_still_seen_stays() {
     );
 }
 
+/// Forgetting visits a list of the cells that may be occupied instead of sweeping its square:
+/// after hits, walks that clear cells, a prior, re-centring away and back (blocks saved and
+/// reloaded) and squares that cut through obstacles, every cell equals the sweep of the square
+/// done here by hand, and the counts agree.
+#[test]
+fn forgetting_changes_exactly_the_cells_a_sweep_of_its_square_changes() {
+    let prior_dir = tempfile::tempdir().unwrap();
+    let live_dir = tempfile::tempdir().unwrap();
+    let levels = || Levels::cumulative(vec![0.0, 0.7]).unwrap();
+    // The prior: a wall that will stay and a box that will be gone.
+    let offline = scene(vec![
+        Solid::standing_box(12.0, 0.0, 1.0, 6.0, 1.5),
+        Solid::standing_box(-8.0, 4.0, 1.0, 1.0, 1.5),
+    ]);
+    let mut mapping = map_with(levels());
+    insert(&mut mapping, &offline, 1);
+    let store = mapper::BlockStore::open(prior_dir.path(), mapping.block_spec().clone()).unwrap();
+    mapping.save_live(&store).unwrap();
+    let mut map = MultiHeightMap::with_stores(
+        MapConfig::default(),
+        levels(),
+        Point2::origin(),
+        Some(prior_dir.path()),
+        Some(live_dir.path()),
+    )
+    .unwrap();
+    let with_cars = scene(vec![
+        Solid::standing_box(12.0, 0.0, 1.0, 6.0, 1.5),
+        Solid::standing_box(4.0, -6.0, 4.5, 1.8, 1.5),
+        Solid::post(-5.0, -5.0, 0.2, 0.45),
+    ]);
+    let empty = scene(vec![Solid::standing_box(12.0, 0.0, 1.0, 6.0, 1.5)]);
+    let (tau, dt) = (1.5, 0.1);
+    let mut total_changed = 0;
+    for step in 0..40 {
+        // Cars and a cone for a while, then gone (walks lower the cells they showed), and as they
+        // go a trip away and back: the cells behind their faces are reloaded occupied and only
+        // forgetting lowers them.
+        let world = if step < 10 { &with_cars } else { &empty };
+        let x = -2.0 + 0.2 * step as f64;
+        if step == 10 {
+            assert!(map.recenter(Point2::new(500.0, 0.0)).unwrap());
+            assert_eq!(map.forget_unseen(Point2::new(500.0, 0.0), 50.0, dt, tau), 0);
+            assert!(map.recenter(Point2::new(x, 0.0)).unwrap());
+        }
+        map.insert_scan(&scan_from(world, x, 0.0), None).unwrap();
+        // A square that moves and cuts through the cars: some occupied cells outside it.
+        let (center, half_m) = (Point2::new(x + 3.0, 1.0), 6.0 + 0.1 * step as f64);
+        let g = *map.geometry();
+        let before: Vec<Vec<f32>> = (0..2)
+            .map(|k| map.live_log_odds(k).unwrap().data().to_vec())
+            .collect();
+        let changed = map.forget_unseen(center, half_m, dt, tau);
+        total_changed += changed;
+        let keep = (-dt / tau).exp() as f32;
+        let half = (half_m / g.resolution_m()).ceil() as i64;
+        let (cx, cy) = g.cell_coords(&center);
+        let (w, h) = (g.width() as i64, g.height() as i64);
+        let mut expected_changed = 0;
+        for (k, before) in before.iter().enumerate() {
+            let prior = map.prior_log_odds(k).unwrap().data();
+            let after = map.live_log_odds(k).unwrap().data();
+            for (i, (&l, &got)) in before.iter().zip(after).enumerate() {
+                let (x, y) = ((i as i64) % w, (i as i64) / w);
+                let inside = (cx - half).clamp(0, w) <= x
+                    && x < (cx + half).clamp(0, w)
+                    && (cy - half).clamp(0, h) <= y
+                    && y < (cy + half).clamp(0, h);
+                let l_prior = if prior[i].is_nan() { 0.0 } else { prior[i] };
+                let want = if inside && l > 0.0 && l > l_prior {
+                    expected_changed += 1;
+                    let faded = l_prior + (l - l_prior) * keep;
+                    if faded <= 0.0 || faded - l_prior < 0.05 {
+                        f32::NAN
+                    } else {
+                        faded
+                    }
+                } else {
+                    l
+                };
+                assert!(
+                    want.to_bits() == got.to_bits() || (want.is_nan() && got.is_nan()),
+                    "step {step} level {k} cell ({x}, {y}): {l} -> {got}, the sweep gives {want}"
+                );
+            }
+        }
+        assert_eq!(changed, expected_changed, "step {step}");
+    }
+    assert!(total_changed > 1000, "{total_changed} cells faded in all");
+}
+
 /// The coarse-to-fine free-space walks build the map the walk of every column builds - the same
 /// obstacles, the same free and unknown cells but for a few dozen cells, the same probabilities
 /// to a few thousandths - with fewer cell updates.
