@@ -280,6 +280,11 @@ pub struct MultiHeightMap {
     odm_obstacles: Vec<Vec<bool>>,
     /// Scratch for the obstacle cells of the level being updated.
     odm_mask: Vec<bool>,
+    /// Per level, the cells whose obstacle state may have changed since its distance map was
+    /// last brought up to date.
+    touched: Vec<TouchedCells>,
+    /// Scratch for the region cells whose obstacle state did change.
+    odm_changed: Vec<usize>,
     prior_store: Option<BlockStore>,
     live_store: Option<BlockStore>,
     classified: Vec<Classified>,
@@ -323,6 +328,61 @@ impl OccupiedCells {
             self.cells.push(i);
         }
     }
+}
+
+/// The live cells of one level whose obstacle state (live merged with prior) may have changed
+/// since the level's distance map was last brought up to date, so that the update re-tests
+/// them instead of sweeping its region: every cell a hit raises, every cell a free-space walk
+/// lowers from the obstacle side of the threshold or from unknown (rare once an area has been
+/// seen: walks mostly lower free cells, which cannot change state), every cell forgetting
+/// changes. A superset, in the order noted, repeats allowed; past [`TOUCHED_CAP`] cells it only
+/// remembers that it overflowed, and the update sweeps the region as without it. Re-centring
+/// (every index moves) starts the distance maps over instead.
+#[derive(Clone, Debug, Default)]
+struct TouchedCells {
+    cells: Vec<u32>,
+    overflowed: bool,
+}
+
+/// Cells a [`TouchedCells`] list holds before it overflows (1 MiB of indices; a 100 m square
+/// of 0.2 m cells is 250,000).
+const TOUCHED_CAP: usize = 1 << 18;
+
+impl TouchedCells {
+    #[inline]
+    fn note(&mut self, i: u32) {
+        if self.cells.len() < TOUCHED_CAP {
+            self.cells.push(i);
+        } else {
+            self.overflowed = true;
+        }
+    }
+    fn clear(&mut self) {
+        self.cells.clear();
+        self.overflowed = false;
+    }
+}
+
+/// Live log-odds at or below which a cell is not an obstacle, whatever its prior, under the
+/// map's merge and threshold: a free-space walk lowering such a cell cannot change its obstacle
+/// state. With [`MergeMode::Fallback`] the merged value of a known live cell is the live one;
+/// with [`MergeMode::Decay`] `(10 p_live + p_prior) / 11 > threshold` needs `p_live > (11
+/// threshold - 1) / 10` at the least. Lowered by a margin for rounding (a cell noted for
+/// nothing costs only time).
+fn no_obstacle_at_or_below(config: &MapConfig) -> f32 {
+    let logit = |p: f32| (p / (1.0 - p)).ln();
+    let t = config.obstacle_threshold;
+    let bound = match config.merge {
+        MergeMode::Fallback => logit(t),
+        MergeMode::Decay => {
+            let p = (11.0 * t - 1.0) / 10.0;
+            if p <= 0.0 {
+                return f32::NEG_INFINITY;
+            }
+            logit(p)
+        }
+    };
+    bound - 1e-3
 }
 
 impl MultiHeightMap {
@@ -380,6 +440,8 @@ impl MultiHeightMap {
             odm_dirty: vec![true; n],
             odm_obstacles: vec![Vec::new(); n],
             odm_mask: Vec::new(),
+            touched: vec![TouchedCells::default(); n],
+            odm_changed: Vec::new(),
             prior_store,
             live_store,
             classified: Vec::new(),
@@ -508,6 +570,10 @@ impl MultiHeightMap {
         }
         self.list_occupied();
         self.odm_dirty.iter_mut().for_each(|d| *d = true);
+        // Every cell index moved: what the distance maps were computed from is void, whatever
+        // region they are asked for next.
+        self.odm_obstacles.iter_mut().for_each(Vec::clear);
+        self.touched.iter_mut().for_each(TouchedCells::clear);
         Ok(true)
     }
 
@@ -651,16 +717,17 @@ impl MultiHeightMap {
                 self.live
                     .par_iter_mut()
                     .zip(self.occupied.par_iter_mut())
+                    .zip(self.touched.par_iter_mut())
                     .enumerate()
-                    .map(|(k, (grid, occupied))| {
+                    .map(|(k, ((grid, occupied), touched))| {
                         let summary = ColumnsOfLevel {
                             all: column_levels,
                             levels: levels.count(),
                             k,
                         };
                         insert_level(
-                            k, grid, occupied, levels, classified, summary, scan, &geometry,
-                            &config,
+                            k, grid, occupied, touched, levels, classified, summary, scan,
+                            &geometry, &config,
                         )
                     })
                     .collect()
@@ -879,7 +946,8 @@ impl MultiHeightMap {
             .par_iter_mut()
             .zip(&self.prior)
             .zip(self.occupied.par_iter_mut())
-            .map(|((live, prior), occupied)| {
+            .zip(self.touched.par_iter_mut())
+            .map(|(((live, prior), occupied), touched)| {
                 let mut changed = 0;
                 let (live, prior) = (live.data_mut(), prior.data());
                 let OccupiedCells { cells, listed } = occupied;
@@ -901,6 +969,7 @@ impl MultiHeightMap {
                     }
                     let l = l_prior + (l - l_prior) * keep;
                     changed += 1;
+                    touched.note(i as u32);
                     if l <= 0.0 || l - l_prior < 0.05 {
                         // No longer an obstacle, or as good as the prior: hand the cell back.
                         live[i] = f32::NAN;
@@ -943,41 +1012,69 @@ impl MultiHeightMap {
         let threshold = self.config.obstacle_threshold;
         let l_threshold = (threshold / (1.0 - threshold)).ln();
         let merge = self.config.merge;
+        let is_obstacle = move |l: f32, p: f32| match merge {
+            MergeMode::Fallback => (if l.is_nan() { p } else { l }) > l_threshold,
+            MergeMode::Decay => merge_log_odds(l, p, merge).is_some_and(|l| l > l_threshold),
+        };
         let width = g.width();
         let mut recomputed = 0;
         for k in 0..self.levels.count() {
+            let touched = std::mem::take(&mut self.touched[k]);
             if !self.odm_dirty[k] {
+                self.touched[k] = touched;
                 continue;
             }
             self.odm_dirty[k] = false;
             let (live, prior) = (self.live[k].data(), self.prior[k].data());
-            let mask = &mut self.odm_mask;
-            mask.resize(rw * rh, false);
-            mask.par_chunks_mut(rw).enumerate().for_each(|(r, row)| {
-                let j0 = (y0 + r) * width + x0;
-                let (live, prior) = (&live[j0..j0 + rw], &prior[j0..j0 + rw]);
-                for ((m, &l), &p) in row.iter_mut().zip(live).zip(prior) {
-                    *m = match merge {
-                        MergeMode::Fallback => (if l.is_nan() { p } else { l }) > l_threshold,
-                        MergeMode::Decay => {
-                            merge_log_odds(l, p, merge).is_some_and(|l| l > l_threshold)
-                        }
-                    };
-                }
-            });
-            if *mask == self.odm_obstacles[k] {
-                continue; // the same obstacles: the same distances
-            }
-            let (mask, old) = (&*mask, &self.odm_obstacles[k]);
             let odm = &mut self.odm.levels_mut()[k];
-            if old.len() == mask.len() {
-                // Same region: only around the cells that changed.
-                odm.update(old, mask, &mut self.edt_scratch);
+            if self.odm_obstacles[k].len() == rw * rh && !touched.overflowed {
+                // Computed on this region before: only the touched cells can have changed.
+                let (obstacles, changed) = (&mut self.odm_obstacles[k], &mut self.odm_changed);
+                changed.clear();
+                for &i in &touched.cells {
+                    let i = i as usize;
+                    let (x, y) = (i % width, i / width);
+                    if x < x0 || x >= x0 + rw || y < y0 || y >= y0 + rh {
+                        continue;
+                    }
+                    let j = (y - y0) * rw + (x - x0);
+                    let now = is_obstacle(live[i], prior[i]);
+                    if now != obstacles[j] {
+                        obstacles[j] = now;
+                        changed.push(j);
+                    }
+                }
+                if !changed.is_empty() {
+                    changed.sort_unstable();
+                    odm.update_cells(changed, obstacles, &mut self.edt_scratch);
+                    recomputed += 1;
+                }
             } else {
-                odm.recompute(|i| mask[i], &mut self.edt_scratch);
+                // A new region (or too many touched cells): sweep it.
+                let mask = &mut self.odm_mask;
+                mask.resize(rw * rh, false);
+                mask.par_chunks_mut(rw).enumerate().for_each(|(r, row)| {
+                    let j0 = (y0 + r) * width + x0;
+                    let (live, prior) = (&live[j0..j0 + rw], &prior[j0..j0 + rw]);
+                    for ((m, &l), &p) in row.iter_mut().zip(live).zip(prior) {
+                        *m = is_obstacle(l, p);
+                    }
+                });
+                if *mask != self.odm_obstacles[k] {
+                    let (mask, old) = (&*mask, &self.odm_obstacles[k]);
+                    if old.len() == mask.len() {
+                        // Same region: only around the cells that changed.
+                        odm.update(old, mask, &mut self.edt_scratch);
+                    } else {
+                        odm.recompute(|i| mask[i], &mut self.edt_scratch);
+                    }
+                    std::mem::swap(&mut self.odm_obstacles[k], &mut self.odm_mask);
+                    recomputed += 1;
+                }
             }
-            std::mem::swap(&mut self.odm_obstacles[k], &mut self.odm_mask);
-            recomputed += 1;
+            let mut touched = touched;
+            touched.clear();
+            self.touched[k] = touched;
         }
         recomputed
     }
@@ -1105,6 +1202,7 @@ fn insert_level(
     k: usize,
     grid: &mut Grid<f32>,
     occupied: &mut OccupiedCells,
+    touched: &mut TouchedCells,
     levels: &Levels,
     classified: &[Classified],
     summary: ColumnsOfLevel,
@@ -1151,6 +1249,10 @@ fn insert_level(
     }
     hit_cells.sort_unstable();
     hit_cells.dedup();
+    for &i in &hit_cells {
+        touched.note(i);
+    }
+    let watch = no_obstacle_at_or_below(config);
     // Below this height a beam crossing an older occupied cell is evidence the cell is free.
     let clear_below = levels.heights_m()[k] + CLEAR_MARGIN_M;
     let stops_walk = |i: usize, ray_z: f64| match config.free_space_stop {
@@ -1225,6 +1327,7 @@ fn insert_level(
             |r| hierarchy.weight(depth, r) * occ.l_free,
             occ.l_max,
             |i, r| stops_walk(i, ray_z(r)),
+            (watch, &mut *touched),
         );
         free += updated;
         reach[ci] = reached_m;
@@ -1349,8 +1452,9 @@ fn bresenham_at(a: (i64, i64), b: (i64, i64), k: i64) -> (i64, i64, i64) {
 
 /// Bresenham walk along `walk` adding `l_free(distance from the sensor)` to each cell from
 /// `walk.start_m` on, stopping at the window's edge or at the first known cell with p >= 0.5 for
-/// which `stops(index, distance)` holds (other occupied cells are lowered and passed). Returns
-/// the cells updated and the distance reached.
+/// which `stops(index, distance)` holds (other occupied cells are lowered and passed). Notes in
+/// `touched.1` every cell it lowers from above `touched.0` or from unknown. Returns the cells
+/// updated and the distance reached.
 fn walk_free(
     data: &mut [f32],
     w: i64,
@@ -1359,7 +1463,9 @@ fn walk_free(
     l_free: impl Fn(f64) -> f32,
     l_max: f32,
     stops: impl Fn(usize, f64) -> bool,
+    touched: (f32, &mut TouchedCells),
 ) -> (usize, f64) {
+    let (watch, touched) = touched;
     let (a, b) = (walk.from, walk.to);
     let (dx, dy) = ((b.0 - a.0).abs(), -(b.1 - a.1).abs());
     let (sx, sy) = ((b.0 - a.0).signum(), (b.1 - a.1).signum());
@@ -1387,6 +1493,9 @@ fn walk_free(
         let v = &mut data[i];
         if *v >= 0.0 && stops(i, r) {
             return (updated, r); // p >= 0.5 (NaN, unknown, compares false)
+        }
+        if !(*v <= watch) {
+            touched.note(i as u32); // may have been an obstacle (NaN: unknown, the prior's)
         }
         let cur = if v.is_nan() { 0.0 } else { *v };
         *v = (cur + delta).max(-l_max);

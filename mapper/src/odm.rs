@@ -70,15 +70,34 @@ impl DistanceMap {
     /// # Panics
     /// If `old` or `new` does not have one flag per cell (a programming error).
     pub fn update(&mut self, old: &[bool], new: &[bool], scratch: &mut EdtScratch) -> usize {
+        assert!(old.len() == new.len(), "DistanceMap::update: mask size");
+        let changed: Vec<usize> = (0..new.len()).filter(|&i| old[i] != new[i]).collect();
+        self.update_cells(&changed, new, scratch)
+    }
+
+    /// [`Self::update`] when the caller knows which cells changed: `changed` lists the indices
+    /// (row-major, ascending, each once) of the cells whose flag differs from the one the map
+    /// was last computed from, and `new` holds every cell's flag now. A cell changed but not
+    /// listed keeps a stale distance; a listed cell that did not change costs only time.
+    ///
+    /// # Panics
+    /// If `new` does not have one flag per cell, or an index is out of range (a programming
+    /// error).
+    pub fn update_cells(
+        &mut self,
+        changed: &[usize],
+        new: &[bool],
+        scratch: &mut EdtScratch,
+    ) -> usize {
         let g = *self.grid.geometry();
         let (w, h) = (g.width(), g.height());
-        assert!(
-            old.len() == w * h && new.len() == w * h,
-            "DistanceMap::update: mask size"
-        );
+        assert!(new.len() == w * h, "DistanceMap::update_cells: mask size");
+        if changed.is_empty() {
+            return 0;
+        }
         // Cells (Chebyshev) beyond which a change cannot move a capped distance, with a cell to spare.
         let reach = (self.max_distance_m / g.resolution_m() as f32).ceil() as usize + 1;
-        let changes = changed_boxes(old, new, w, 4 * reach);
+        let changes = changed_boxes(changed, w, 4 * reach);
         let cells: usize = changes
             .iter()
             .map(|b| b.grown(2 * reach, w, h).area())
@@ -170,11 +189,11 @@ impl CellBox {
     }
 }
 
-/// Bounding boxes of the cells where `old` and `new` differ (row-major, `w` wide), merged
-/// until no two boxes are closer than `merge_gap` cells.
-fn changed_boxes(old: &[bool], new: &[bool], w: usize, merge_gap: usize) -> Vec<CellBox> {
+/// Bounding boxes of the `changed` cells (row-major indices, `w` wide), merged until no two
+/// boxes are closer than `merge_gap` cells.
+fn changed_boxes(changed: &[usize], w: usize, merge_gap: usize) -> Vec<CellBox> {
     let mut boxes: Vec<CellBox> = Vec::new();
-    for (i, _) in old.iter().zip(new).enumerate().filter(|(_, (a, b))| a != b) {
+    for &i in changed {
         let (x, y) = (i % w, i / w);
         let cell = CellBox {
             x0: x,
@@ -266,7 +285,8 @@ mod tests {
         for x in [5, 9, 60] {
             new[3 * w + x] = true;
         }
-        let boxes = changed_boxes(&old, &new, w, 10);
+        let changed: Vec<usize> = (0..w * h).filter(|&i| old[i] != new[i]).collect();
+        let boxes = changed_boxes(&changed, w, 10);
         assert_eq!(boxes.len(), 2, "{boxes:?}");
         assert!(boxes.contains(&CellBox {
             x0: 5,
@@ -274,7 +294,7 @@ mod tests {
             x1: 10,
             y1: 4
         }));
-        assert!(changed_boxes(&old, &old, w, 10).is_empty());
+        assert!(changed_boxes(&[], w, 10).is_empty());
     }
 
     proptest! {
@@ -283,7 +303,7 @@ mod tests {
         #[test]
         fn update_equals_recompute(
             width in 1usize..90, height in 1usize..90, density in 0.0f64..0.2,
-            flips in 0usize..12, cap in 0.2f32..4.0, seed in any::<u64>(),
+            flips in 0usize..12, extra in 0usize..12, cap in 0.2f32..4.0, seed in any::<u64>(),
         ) {
             let mut state = seed | 1;
             let old: Vec<bool> = (0..width * height)
@@ -297,9 +317,20 @@ mod tests {
             let g = GridGeometry::new(Point2::new(-3.0, 2.0), 0.2, width, height).unwrap();
             let mut scratch = EdtScratch::default();
             let mut map = DistanceMap::compute(g, cap, |i| old[i], &mut scratch);
+            let mut listed = map.clone();
             map.update(&old, &new, &mut scratch);
             let fresh = DistanceMap::compute(g, cap, |i| new[i], &mut scratch);
             prop_assert_eq!(map.grid().data(), fresh.grid().data());
+            // Listing cells that did not change as well (as the mapper's lists of touched cells
+            // do) changes nothing but the time.
+            let mut cells: Vec<usize> = (0..width * height).filter(|&i| old[i] != new[i]).collect();
+            for _ in 0..extra {
+                cells.push((xorshift(&mut state) % (width * height) as u64) as usize);
+            }
+            cells.sort_unstable();
+            cells.dedup();
+            listed.update_cells(&cells, &new, &mut scratch);
+            prop_assert_eq!(listed.grid().data(), fresh.grid().data());
         }
     }
 

@@ -81,15 +81,26 @@ impl Scan {
                 ));
             }
         }
-        // In parallel (a revolution is 70,000 returns); the first bad one is named.
-        let bad = returns.par_iter().enumerate().find_first(|(_, r)| {
-            r.is_some_and(|r| {
-                !(r.point_in_world.iter().all(|x| x.is_finite())
+        // A revolution is 70,000 returns: checked in parallel by chunks of columns with a plain
+        // loop each (rayon's `find_first` tests a shared atomic per item, which cost more than
+        // the check: 6 % of the closed loop's CPU time), then, only when one is bad, searched for
+        // the first bad one to name it.
+        let valid = |r: &Option<Return>| {
+            r.is_none_or(|r| {
+                r.point_in_world.iter().all(|x| x.is_finite())
                     && r.range_m.is_finite()
                     && r.range_m >= 0.0
-                    && r.intensity.is_finite())
+                    && r.intensity.is_finite()
             })
-        });
+        };
+        let all_valid = returns
+            .par_chunks(beams * 64)
+            .all(|chunk| chunk.iter().fold(true, |ok, r| ok & valid(r)));
+        let bad = if all_valid {
+            None
+        } else {
+            returns.iter().enumerate().find(|(_, r)| !valid(r))
+        };
         if let Some((i, Some(r))) = bad {
             return Err(MapError::invalid(
                 "scan return",

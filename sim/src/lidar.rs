@@ -518,7 +518,10 @@ impl Lidar {
         };
         let intensity = (remission as f64 * (-cfg.atmosphere_attenuation_rate * t as f64).exp())
             .clamp(0.0, 1.0);
-        let drop_by_intensity = intensity < cfg.dropoff_intensity_limit
+        // (Tested first: with the rate at 0, its default, `u4 < 0` never holds, and the
+        // division a ray is skipped.)
+        let drop_by_intensity = cfg.dropoff_zero_intensity > 0.0
+            && intensity < cfg.dropoff_intensity_limit
             && u4
                 < cfg.dropoff_zero_intensity
                     * (1.0 - intensity / cfg.dropoff_intensity_limit.max(1e-12));
