@@ -1321,8 +1321,7 @@ fn insert_level(
         };
         let (updated, reached_m) = walk_free(
             data,
-            w,
-            h,
+            (w, h),
             &walk,
             |r| hierarchy.weight(depth, r) * occ.l_free,
             occ.l_max,
@@ -1457,8 +1456,7 @@ fn bresenham_at(a: (i64, i64), b: (i64, i64), k: i64) -> (i64, i64, i64) {
 /// updated and the distance reached.
 fn walk_free(
     data: &mut [f32],
-    w: i64,
-    h: i64,
+    (w, h): (i64, i64),
     walk: &Walk,
     l_free: impl Fn(f64) -> f32,
     l_max: f32,
@@ -1494,7 +1492,7 @@ fn walk_free(
         if *v >= 0.0 && stops(i, r) {
             return (updated, r); // p >= 0.5 (NaN, unknown, compares false)
         }
-        if !(*v <= watch) {
+        if v.is_nan() || *v > watch {
             touched.note(i as u32); // may have been an obstacle (NaN: unknown, the prior's)
         }
         let cur = if v.is_nan() { 0.0 } else { *v };

@@ -253,8 +253,8 @@ impl Lidar {
             0.0
         };
         let columns = self.config.columns;
-        let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); columns];
-        let mut candidates = Vec::new();
+        // Each candidate with the columns it may be seen from (`None`: all of them).
+        let mut candidates: Vec<(Candidate, Option<std::ops::Range<i64>>)> = Vec::new();
         for (owner, collider) in world.object_colliders() {
             let aabb = collider.compute_aabb();
             let (lo, hi) = (aabb.mins, aabb.maxs);
@@ -278,12 +278,11 @@ impl Lidar {
             };
             let (el_top_max, _) = elev(hi.z + pad);
             let (_, el_bottom_min) = elev(lo.z - pad);
-            let index = candidates.len() as u32;
             let analytic = match owner {
                 Owner::Object(i) => world.scene().solids.get(i).and_then(Vertical::of),
                 _ => None,
             };
-            candidates.push(Candidate {
+            let candidate = Candidate {
                 owner,
                 collider,
                 analytic,
@@ -292,10 +291,10 @@ impl Lidar {
                     .max(-std::f32::consts::FRAC_PI_2)
                     .sin(),
                 sin_el_max: (el_top_max + 1e-3).min(std::f32::consts::FRAC_PI_2).sin(),
-            });
+            };
             // Azimuth window: all columns when the origin is inside (or near) the box's footprint.
             if d_min <= 0.0 {
-                buckets.iter_mut().for_each(|b| b.push(index));
+                candidates.push((candidate, None));
                 continue;
             }
             let corners = [(lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y)];
@@ -330,18 +329,24 @@ impl Lidar {
             } else {
                 0
             };
-            for k in (c_lo - yaw_pad)..(c_lo + span + yaw_pad).min(c_lo - yaw_pad + columns as i64)
-            {
-                buckets[k.rem_euclid(columns as i64) as usize].push(index);
+            let ks = (c_lo - yaw_pad)..(c_lo + span + yaw_pad).min(c_lo - yaw_pad + columns as i64);
+            candidates.push((candidate, Some(ks)));
+        }
+        // Nearest first (a stable sort: equals keep the colliders' order), so that every bucket,
+        // filled in this order, is sorted without sorting 2187 buckets a revolution.
+        candidates.sort_by(|a, b| a.0.d_min.total_cmp(&b.0.d_min));
+        let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); columns];
+        for (index, (_, ks)) in candidates.iter().enumerate() {
+            match ks {
+                None => buckets.iter_mut().for_each(|b| b.push(index as u32)),
+                Some(ks) => {
+                    for k in ks.clone() {
+                        buckets[k.rem_euclid(columns as i64) as usize].push(index as u32);
+                    }
+                }
             }
         }
-        for b in &mut buckets {
-            b.sort_by(|&i, &j| {
-                candidates[i as usize]
-                    .d_min
-                    .total_cmp(&candidates[j as usize].d_min)
-            });
-        }
+        let candidates: Vec<Candidate> = candidates.into_iter().map(|(c, _)| c).collect();
         let scene = world.scene();
         let ground = (scene.min_m, scene.max_m);
         self.assemble(world, sweep, scan_index, seed, |c, origin, dirs, out| {
