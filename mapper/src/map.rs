@@ -524,28 +524,45 @@ impl MultiHeightMap {
             .into_iter()
             .filter(|i| !self.in_window(new_lo, *i))
             .collect();
-        // Read everything first so a bad file leaves the map as it was.
-        let mut loaded = Vec::with_capacity(entering.len());
-        for &index in &entering {
-            loaded.push((index, self.read_stores(index)?));
-        }
+        // Read everything first so a bad file leaves the map as it was. The blocks in parallel;
+        // the first error in block order is the one reported.
+        let read: Vec<Result<_>> = entering
+            .par_iter()
+            .map(|&index| self.read_stores(index).map(|r| (index, r)))
+            .collect();
+        let loaded = read.into_iter().collect::<Result<Vec<_>>>()?;
         if let Some(store) = &self.live_store {
-            for &index in &leaving {
-                let block = self.extract_live(index);
-                if !block.is_unknown() {
-                    store.save(&block)?;
-                }
-            }
+            let saved: Vec<Result<()>> = leaving
+                .par_iter()
+                .map(|&index| {
+                    let block = self.extract_live(index);
+                    match block.is_unknown() {
+                        true => Ok(()),
+                        false => store.save(&block),
+                    }
+                })
+                .collect();
+            saved.into_iter().collect::<Result<()>>()?;
         }
         let (dx, dy) = (
             (new_lo.x - old_lo.x) * self.config.block_cells as i64,
             (new_lo.y - old_lo.y) * self.config.block_cells as i64,
         );
-        for g in self.live.iter_mut().chain(self.prior.iter_mut()) {
-            shift(g, dx, dy, f32::NAN);
-        }
-        shift(&mut self.live_remission, dx, dy, RemissionCell::default());
-        shift(&mut self.prior_remission, dx, dy, RemissionCell::default());
+        let (live_rem, prior_rem) = (&mut self.live_remission, &mut self.prior_remission);
+        rayon::join(
+            || {
+                self.live
+                    .par_iter_mut()
+                    .chain(self.prior.par_iter_mut())
+                    .for_each(|g| shift(g, dx, dy, f32::NAN));
+            },
+            || {
+                rayon::join(
+                    || shift(live_rem, dx, dy, RemissionCell::default()),
+                    || shift(prior_rem, dx, dy, RemissionCell::default()),
+                )
+            },
+        );
         self.window_lo = new_lo;
         let origin = Point2::new(
             new_lo.x as f64 * self.config.block_m(),
@@ -758,7 +775,7 @@ impl MultiHeightMap {
         let test = ObstacleTest::new(params);
         let margin = self.config.self_hit_margin_m;
         let geometry = self.geometry;
-        self.classified.clear();
+        // Every entry is written below: resizing (not clearing) spares a serial pass over them.
         self.classified
             .resize(scan.returns().len(), Classified::default());
         let bands: Vec<(f32, f32)> = (0..self.levels.count())
@@ -770,7 +787,6 @@ impl MultiHeightMap {
             })
             .collect();
         let n_levels = bands.len().max(1);
-        self.column_levels.clear();
         self.column_levels
             .resize(scan.columns().len() * n_levels, ColumnLevel::default());
         let counts: (usize, usize, usize) = self
@@ -784,6 +800,7 @@ impl MultiHeightMap {
                 let sensor3 = nalgebra::Point3::from(column.world_from_sensor.translation.vector);
                 let vehicle_from_world = column.world_from_vehicle.inverse();
                 let (mut n, mut self_hits, mut far) = (0, 0, 0);
+                summary.fill(ColumnLevel::default());
                 // The return of the beam below (dropped or not) and its horizontal range.
                 let mut below: Option<(Point3<f64>, f64)> = None;
                 for b in 0..beams {
@@ -1158,27 +1175,32 @@ pub fn merge_log_odds(live: f32, prior: f32, mode: MergeMode) -> Option<f32> {
     }
 }
 
-/// Moves a grid's content by (-dx, -dy) cells (the window moved by (dx, dy)); uncovered cells get `fill`.
+/// Moves a grid's content by (-dx, -dy) cells (the window moved by (dx, dy)); uncovered cells get
+/// `fill`. In place: rows are visited so that each source row is read before it is overwritten.
 fn shift<T: Copy>(grid: &mut Grid<T>, dx: i64, dy: i64, fill: T) {
     let (w, h) = (
         grid.geometry().width() as i64,
         grid.geometry().height() as i64,
     );
-    let old = grid.data().to_vec();
     let data = grid.data_mut();
-    data.fill(fill);
-    for y in 0..h {
+    // The destination columns that have a source column.
+    let (x0, x1) = ((-dx).max(0), (w - dx).min(w));
+    let mut move_row = |y: i64| {
+        let row = (y * w) as usize..((y + 1) * w) as usize;
         let sy = y + dy;
-        if !(0..h).contains(&sy) {
-            continue;
+        if !(0..h).contains(&sy) || x0 >= x1 {
+            data[row].fill(fill);
+            return;
         }
-        let (x0, x1) = ((-dx).max(0), (w - dx).min(w));
-        if x0 >= x1 {
-            continue;
-        }
-        let dst = (y * w + x0) as usize..(y * w + x1) as usize;
         let src = (sy * w + x0 + dx) as usize..(sy * w + x1 + dx) as usize;
-        data[dst].copy_from_slice(&old[src]);
+        data.copy_within(src, row.start + x0 as usize);
+        data[row.start..row.start + x0 as usize].fill(fill);
+        data[row.start + x1 as usize..row.end].fill(fill);
+    };
+    if dy >= 0 {
+        (0..h).for_each(&mut move_row);
+    } else {
+        (0..h).rev().for_each(&mut move_row);
     }
 }
 
@@ -1506,6 +1528,37 @@ fn walk_free(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The in-place shift moves every cell where a copy-then-fill would, for moves in every
+    /// direction, including moves of the whole grid out of the window.
+    #[test]
+    fn shifting_in_place_equals_copying() {
+        let (w, h) = (7usize, 5usize);
+        let g = GridGeometry::new(Point2::origin(), 1.0, w, h).unwrap();
+        for (dx, dy) in (-8..=8).flat_map(|x| (-6..=6).map(move |y| (x, y))) {
+            let mut grid = Grid::filled(g, 0.0f32);
+            for (i, v) in grid.data_mut().iter_mut().enumerate() {
+                *v = i as f32;
+            }
+            let old = grid.data().to_vec();
+            shift(&mut grid, dx, dy, -1.0);
+            for y in 0..h as i64 {
+                for x in 0..w as i64 {
+                    let (sx, sy) = (x + dx, y + dy);
+                    let expected = if (0..w as i64).contains(&sx) && (0..h as i64).contains(&sy) {
+                        old[(sy * w as i64 + sx) as usize]
+                    } else {
+                        -1.0
+                    };
+                    assert_eq!(
+                        grid.data()[(y * w as i64 + x) as usize],
+                        expected,
+                        "({dx}, {dy}) at ({x}, {y})"
+                    );
+                }
+            }
+        }
+    }
 
     /// The O(1) jump into a Bresenham line lands where stepping from its start does.
     #[test]

@@ -151,39 +151,44 @@ impl Scene {
     /// The ground's remission prepared for many lookups (the LiDAR's ground returns): the same
     /// answers as [`Self::ground_remission_at`] without a sine and cosine per patch and point.
     pub fn ground_texture(&self) -> GroundTexture {
+        let patches: Vec<PreparedPatch> = self
+            .patches
+            .iter()
+            .rev()
+            .map(|p| {
+                let (s, c) = p.yaw_rad.sin_cos();
+                let (hl, hw) = (0.5 * p.length_m, 0.5 * p.width_m);
+                // Axis-aligned half extents of the rotated rectangle: a cheap first test.
+                let (ex, ey) = (c.abs() * hl + s.abs() * hw, s.abs() * hl + c.abs() * hw);
+                PreparedPatch {
+                    x: p.x_m,
+                    y: p.y_m,
+                    sin: s,
+                    cos: c,
+                    half_length: hl,
+                    half_width: hw,
+                    extent: [ex, ey],
+                    remission: p.remission,
+                }
+            })
+            .collect();
+        let bins = PatchBins::new(&patches);
         GroundTexture {
             ground_remission: self.ground_remission,
-            patches: self
-                .patches
-                .iter()
-                .rev()
-                .map(|p| {
-                    let (s, c) = p.yaw_rad.sin_cos();
-                    let (hl, hw) = (0.5 * p.length_m, 0.5 * p.width_m);
-                    // Axis-aligned half extents of the rotated rectangle: a cheap first test.
-                    let (ex, ey) = (c.abs() * hl + s.abs() * hw, s.abs() * hl + c.abs() * hw);
-                    PreparedPatch {
-                        x: p.x_m,
-                        y: p.y_m,
-                        sin: s,
-                        cos: c,
-                        half_length: hl,
-                        half_width: hw,
-                        extent: [ex, ey],
-                        remission: p.remission,
-                    }
-                })
-                .collect(),
+            patches,
+            bins,
         }
     }
 }
 
-/// [`Scene::ground_remission_at`] with each patch's rotation computed once.
+/// [`Scene::ground_remission_at`] with each patch's rotation computed once, and the patches
+/// binned on a coarse grid so that a point tests only the few whose box reaches its bin.
 #[derive(Clone, Debug)]
 pub struct GroundTexture {
     ground_remission: f32,
     /// Last painted first.
     patches: Vec<PreparedPatch>,
+    bins: PatchBins,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -198,20 +203,122 @@ struct PreparedPatch {
     remission: f32,
 }
 
+impl PreparedPatch {
+    fn contains(&self, x: f64, y: f64) -> bool {
+        let (dx, dy) = (x - self.x, y - self.y);
+        if dx.abs() > self.extent[0] || dy.abs() > self.extent[1] {
+            return false;
+        }
+        let (along, across) = (
+            self.cos * dx + self.sin * dy,
+            -self.sin * dx + self.cos * dy,
+        );
+        along.abs() <= self.half_length && across.abs() <= self.half_width
+    }
+}
+
+/// A grid of square bins over the patches' boxes, each listing (in paint order, last first) the
+/// patches whose box reaches it or a neighbouring bin (a bin of slack against rounding at the
+/// edges). A point outside the grid is on no patch.
+#[derive(Clone, Debug, Default)]
+struct PatchBins {
+    origin: [f64; 2],
+    inv_side: f64,
+    size: [usize; 2],
+    /// Bin b lists `indices[start[b]..start[b + 1]]`.
+    start: Vec<u32>,
+    indices: Vec<u32>,
+}
+
+impl PatchBins {
+    /// Bins of 2 m, larger where the patches spread so far that there would be over 2^20.
+    fn new(patches: &[PreparedPatch]) -> Self {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in patches {
+            for (a, c) in [p.x, p.y].into_iter().enumerate() {
+                lo[a] = lo[a].min(c - p.extent[a]);
+                hi[a] = hi[a].max(c + p.extent[a]);
+            }
+        }
+        if !(lo[0].is_finite() && lo[1].is_finite() && hi[0].is_finite() && hi[1].is_finite()) {
+            return PatchBins::default();
+        }
+        let mut side = 2.0_f64;
+        let cells = |side: f64| -> [usize; 2] {
+            [0, 1].map(|a| ((hi[a] - lo[a]) / side).floor() as usize + 3)
+        };
+        while cells(side)[0] * cells(side)[1] > 1 << 20 {
+            side *= 2.0;
+        }
+        let size = cells(side);
+        // One bin of slack below, so the bins of a box never go negative.
+        let origin = [lo[0] - side, lo[1] - side];
+        let inv_side = 1.0 / side;
+        let bin = |v: f64, a: usize| ((v - origin[a]) * inv_side).floor() as i64;
+        let range = |p: &PreparedPatch, a: usize| {
+            let c = [p.x, p.y][a];
+            let first = (bin(c - p.extent[a], a) - 1).max(0) as usize;
+            let last = ((bin(c + p.extent[a], a) + 1).max(0) as usize).min(size[a] - 1);
+            first..=last
+        };
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); size[0] * size[1]];
+        for (i, p) in patches.iter().enumerate() {
+            for by in range(p, 1) {
+                for bx in range(p, 0) {
+                    lists[by * size[0] + bx].push(i as u32);
+                }
+            }
+        }
+        let mut start = Vec::with_capacity(lists.len() + 1);
+        let mut indices = Vec::new();
+        for l in &lists {
+            start.push(indices.len() as u32);
+            indices.extend_from_slice(l);
+        }
+        start.push(indices.len() as u32);
+        PatchBins {
+            origin,
+            inv_side,
+            size,
+            start,
+            indices,
+        }
+    }
+
+    /// The patches that may hold (x, y), in paint order (last first).
+    fn at(&self, x: f64, y: f64) -> &[u32] {
+        let (bx, by) = (
+            ((x - self.origin[0]) * self.inv_side).floor(),
+            ((y - self.origin[1]) * self.inv_side).floor(),
+        );
+        // NaN and points off the grid compare false.
+        if !(bx >= 0.0 && by >= 0.0 && bx < self.size[0] as f64 && by < self.size[1] as f64) {
+            return &[];
+        }
+        let b = by as usize * self.size[0] + bx as usize;
+        &self.indices[self.start[b] as usize..self.start[b + 1] as usize]
+    }
+}
+
 impl GroundTexture {
     /// Remission of the ground at (x, y).
     pub fn remission_at(&self, x: f64, y: f64) -> f32 {
-        for p in &self.patches {
-            let (dx, dy) = (x - p.x, y - p.y);
-            if dx.abs() > p.extent[0] || dy.abs() > p.extent[1] {
-                continue;
-            }
-            let (along, across) = (p.cos * dx + p.sin * dy, -p.sin * dx + p.cos * dy);
-            if along.abs() <= p.half_length && across.abs() <= p.half_width {
+        for &i in self.bins.at(x, y) {
+            let p = &self.patches[i as usize];
+            if p.contains(x, y) {
                 return p.remission;
             }
         }
         self.ground_remission
+    }
+
+    /// [`Self::remission_at`] trying every patch, the straightforward way (for tests).
+    #[cfg(test)]
+    fn remission_at_every_patch(&self, x: f64, y: f64) -> f32 {
+        self.patches
+            .iter()
+            .find(|p| p.contains(x, y))
+            .map_or(self.ground_remission, |p| p.remission)
     }
 }
 
@@ -244,11 +351,17 @@ mod tests {
         };
         let texture = scene.ground_texture();
         let mut painted = 0;
-        for i in -200..=200 {
+        // Beyond the patches too (x up to 25 m: off the bins' grid).
+        for i in -200..=500 {
             for j in -200..=200 {
                 let (x, y) = (i as f64 * 0.05 + 0.013, j as f64 * 0.05 - 0.007);
                 let want = scene.ground_remission_at(x, y);
                 assert_eq!(texture.remission_at(x, y), want, "at ({x}, {y})");
+                assert_eq!(
+                    texture.remission_at_every_patch(x, y),
+                    want,
+                    "at ({x}, {y})"
+                );
                 painted += usize::from(want != 0.2);
             }
         }
