@@ -536,9 +536,10 @@ impl MultiHeightMap {
                 .par_iter()
                 .map(|&index| {
                     let block = self.extract_live(index);
-                    match block.is_unknown() {
-                        true => Ok(()),
-                        false => store.save(&block),
+                    if block.is_unknown() {
+                        Ok(())
+                    } else {
+                        store.save(&block)
                     }
                 })
                 .collect();
@@ -1036,11 +1037,10 @@ impl MultiHeightMap {
         let width = g.width();
         let mut recomputed = 0;
         for k in 0..self.levels.count() {
-            let touched = std::mem::take(&mut self.touched[k]);
             if !self.odm_dirty[k] {
-                self.touched[k] = touched;
                 continue;
             }
+            let touched = &self.touched[k];
             self.odm_dirty[k] = false;
             let (live, prior) = (self.live[k].data(), self.prior[k].data());
             let odm = &mut self.odm.levels_mut()[k];
@@ -1089,9 +1089,7 @@ impl MultiHeightMap {
                     recomputed += 1;
                 }
             }
-            let mut touched = touched;
-            touched.clear();
-            self.touched[k] = touched;
+            self.touched[k].clear();
         }
         recomputed
     }
