@@ -841,20 +841,16 @@ impl MultiHeightMap {
                             .unsafe_height_above_ground_m
                             .is_some_and(|h| height >= h),
                     };
-                    out[b] = Classified {
+                    let c = Classified {
                         cell: cell as u32,
                         height_m: height as f32,
                         range_xy_m: range_xy as f32,
                         obstacle,
                     };
-                }
-                // Per level: the farthest return considered (the last of equals) and the nearest
-                // obstacle hit (the first of equals).
-                for (&(lo, hi), sum) in bands.iter().zip(summary.iter_mut()) {
-                    for (b, c) in out.iter().enumerate() {
-                        if c.cell == DROPPED {
-                            continue;
-                        }
+                    out[b] = c;
+                    // Per level: the farthest return considered (the last of equals) and the
+                    // nearest obstacle hit (the first of equals).
+                    for (&(lo, hi), sum) in bands.iter().zip(summary.iter_mut()) {
                         let class = height_class(c.height_m, lo, hi);
                         if class != HeightClass::Above && c.range_xy_m >= sum.far_m {
                             (sum.far, sum.far_m) = (b as u16, c.range_xy_m);
@@ -1275,10 +1271,10 @@ fn insert_level(
     let watch = no_obstacle_at_or_below(config);
     // Below this height a beam crossing an older occupied cell is evidence the cell is free.
     let clear_below = levels.heights_m()[k] + CLEAR_MARGIN_M;
-    let stops_walk = |i: usize, ray_z: f64| match config.free_space_stop {
+    let stops_walk = |i: usize, ray_z: &mut dyn FnMut() -> f64| match config.free_space_stop {
         FreeSpaceStop::AnyOccupied => true,
         FreeSpaceStop::ScanHits => {
-            ray_z >= clear_below || hit_cells.binary_search(&(i as u32)).is_ok()
+            ray_z() >= clear_below || hit_cells.binary_search(&(i as u32)).is_ok()
         }
     };
     // Free-space walks, to the farthest return this level considers in each column.
@@ -1318,15 +1314,20 @@ fn insert_level(
         // The lowest beam of the column crossing each distance: the nearest return beyond it.
         let ground = config.obstacle_test.ground_height_m;
         let sensor_z = sensor.z - ground;
-        ends.clear();
-        ends.extend(
-            classified[ci * beams..(ci + 1) * beams]
-                .iter()
-                .filter(|c| c.cell != DROPPED && class(c) != HeightClass::Above)
-                .map(|c| (c.range_xy_m as f64, c.height_m as f64)),
-        );
-        ends.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let ray_z = |r: f64| {
+        // Gathered and sorted only if a walk meets an occupied cell (most never do).
+        let mut ends_ready = false;
+        let mut ray_z = |r: f64| {
+            if !ends_ready {
+                ends.clear();
+                ends.extend(
+                    classified[ci * beams..(ci + 1) * beams]
+                        .iter()
+                        .filter(|c| c.cell != DROPPED && class(c) != HeightClass::Above)
+                        .map(|c| (c.range_xy_m as f64, c.height_m as f64)),
+                );
+                ends.sort_by(|a, b| a.0.total_cmp(&b.0));
+                ends_ready = true;
+            }
             let i = ends.partition_point(|e| e.0 <= r);
             ends.get(i).map_or(sensor_z, |&(range, z)| {
                 sensor_z + (z - sensor_z) * r / range.max(1e-6)
@@ -1345,7 +1346,7 @@ fn insert_level(
             &walk,
             |r| hierarchy.weight(depth, r) * occ.l_free,
             occ.l_max,
-            |i, r| stops_walk(i, ray_z(r)),
+            |i, r| stops_walk(i, &mut || ray_z(r)),
             (watch, &mut *touched),
         );
         free += updated;
@@ -1440,18 +1441,16 @@ struct Walk {
     stop_short: usize,
 }
 
-/// One step of the all-octant Bresenham loop (`d` = (|dx|, -|dy|), `s` the signs).
+/// One step of the all-octant Bresenham loop (`d` = (|dx|, -|dy|), `s` the signs). Without
+/// branches: on a slanted line which axis steps is as good as random, and the mispredicted
+/// branches cost more than the free-space walk's memory accesses.
 #[inline(always)]
 fn bresenham_step(x: &mut i64, y: &mut i64, err: &mut i64, d: (i64, i64), s: (i64, i64)) {
     let e2 = 2 * *err;
-    if e2 >= d.1 {
-        *err += d.1;
-        *x += s.0;
-    }
-    if e2 <= d.0 {
-        *err += d.0;
-        *y += s.1;
-    }
+    let (mx, my) = (i64::from(e2 >= d.1), i64::from(e2 <= d.0));
+    *err += mx * d.1 + my * d.0;
+    *x += mx * s.0;
+    *y += my * s.1;
 }
 
 /// The Bresenham state (x, y, error) of the line `a` to `b` after `k` steps, in O(1): the step
@@ -1480,7 +1479,7 @@ fn walk_free(
     walk: &Walk,
     l_free: impl Fn(f64) -> f32,
     l_max: f32,
-    stops: impl Fn(usize, f64) -> bool,
+    mut stops: impl FnMut(usize, f64) -> bool,
     touched: (f32, &mut TouchedCells),
 ) -> (usize, f64) {
     let (watch, touched) = touched;

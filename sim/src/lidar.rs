@@ -335,17 +335,30 @@ impl Lidar {
         // Nearest first (a stable sort: equals keep the colliders' order), so that every bucket,
         // filled in this order, is sorted without sorting 2187 buckets a revolution.
         candidates.sort_by(|a, b| a.0.d_min.total_cmp(&b.0.d_min));
-        let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); columns];
-        for (index, (_, ks)) in candidates.iter().enumerate() {
-            match ks {
-                None => buckets.iter_mut().for_each(|b| b.push(index as u32)),
-                Some(ks) => {
-                    for k in ks.clone() {
-                        buckets[k.rem_euclid(columns as i64) as usize].push(index as u32);
-                    }
-                }
-            }
+        // The buckets in one flat list (column c's are `flat[start[c]..start[c + 1]]`): counted,
+        // then filled in the candidates' order.
+        let mut start = vec![0u32; columns + 1];
+        let each_column = |ks: &Option<std::ops::Range<i64>>, f: &mut dyn FnMut(usize)| match ks {
+            None => (0..columns).for_each(&mut *f),
+            Some(ks) => ks
+                .clone()
+                .for_each(|k| f(k.rem_euclid(columns as i64) as usize)),
+        };
+        for (_, ks) in &candidates {
+            each_column(ks, &mut |c| start[c + 1] += 1);
         }
+        for c in 0..columns {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut flat = vec![0u32; start[columns] as usize];
+        for (index, (_, ks)) in candidates.iter().enumerate() {
+            each_column(ks, &mut |c| {
+                flat[fill[c] as usize] = index as u32;
+                fill[c] += 1;
+            });
+        }
+        let bucket = |c: usize| &flat[start[c] as usize..start[c + 1] as usize];
         let candidates: Vec<Candidate> = candidates.into_iter().map(|(c, _)| c).collect();
         let scene = world.scene();
         let ground = (scene.min_m, scene.max_m);
@@ -373,7 +386,7 @@ impl Lidar {
                 }
                 let horizontal = (dir.x * dir.x + dir.y * dir.y).sqrt();
                 let ray = Ray::new(o, dir);
-                for &i in &buckets[c] {
+                for &i in bucket(c) {
                     let cand = &candidates[i as usize];
                     if t_best * horizontal < cand.d_min {
                         break; // sorted by distance: nothing farther can be nearer than the hit
@@ -458,34 +471,42 @@ impl Lidar {
             .zip(owners.par_chunks_mut(beams))
             .zip(columns.par_iter_mut())
             .enumerate()
-            .for_each(|(c, ((returns, owners), column))| {
-                let (vehicle, sensor) = self.column_poses(sweep, c);
-                // Sensor to world rotation as an f32 matrix: 9 multiplications a ray.
-                let r = sensor
-                    .rotation
-                    .to_rotation_matrix()
-                    .matrix()
-                    .map(|v| v as f32);
-                let dirs: Vec<[f32; 3]> = self.directions[c * beams..(c + 1) * beams]
-                    .iter()
-                    .map(|d| {
+            .for_each_init(
+                // A worker's scratch, reused from column to column: directions and hits.
+                || (Vec::with_capacity(beams), Vec::with_capacity(beams)),
+                |(dirs, hits), (c, ((returns, owners), column))| {
+                    let (vehicle, sensor) = self.column_poses(sweep, c);
+                    // Sensor to world rotation as an f32 matrix: 9 multiplications a ray.
+                    let r = sensor
+                        .rotation
+                        .to_rotation_matrix()
+                        .matrix()
+                        .map(|v| v as f32);
+                    dirs.clear();
+                    dirs.extend(self.directions[c * beams..(c + 1) * beams].iter().map(|d| {
                         let w = r * nalgebra::Vector3::new(d[0], d[1], d[2]);
                         [w.x, w.y, w.z]
-                    })
-                    .collect();
-                let mut hits = self_hits[c * beams..(c + 1) * beams].to_vec();
-                let origin = Point3::from(sensor.translation.vector);
-                cast(c, origin, &dirs, &mut hits);
-                let mut rng = Xoshiro256PlusPlus::seed_from_u64(mix(seed, scan_index, c as u64));
-                for b in 0..beams {
-                    (returns[b], owners[b]) =
-                        self.measure(scene, &ground, &mut rng, origin, hits[b], &dirs[b]);
-                }
-                *column = mapper::ScanColumn {
-                    world_from_sensor: sensor,
-                    world_from_vehicle: vehicle,
-                };
-            });
+                    }));
+                    hits.clear();
+                    hits.extend_from_slice(&self_hits[c * beams..(c + 1) * beams]);
+                    let origin = Point3::from(sensor.translation.vector);
+                    cast(c, origin, dirs, hits);
+                    let mut rng =
+                        Xoshiro256PlusPlus::seed_from_u64(mix(seed, scan_index, c as u64));
+                    for (((ret, owner), hit), d) in returns
+                        .iter_mut()
+                        .zip(owners.iter_mut())
+                        .zip(hits.iter())
+                        .zip(dirs.iter())
+                    {
+                        self.measure(scene, &ground, &mut rng, origin, *hit, d, (ret, owner));
+                    }
+                    *column = mapper::ScanColumn {
+                        world_from_sensor: sensor,
+                        world_from_vehicle: vehicle,
+                    };
+                },
+            );
         // Finite poses and points by construction; an error here would be a bug, reported as an empty scan.
         let scan = mapper::Scan::new(beams, columns, returns).unwrap_or_default();
         LidarScan {
@@ -504,14 +525,15 @@ impl Lidar {
         origin: Point3<f64>,
         hit: Option<(f32, Owner)>,
         d: &[f32; 3],
-    ) -> (Option<mapper::Return>, Option<Owner>) {
+        (ret, owned): (&mut Option<mapper::Return>, &mut Option<Owner>),
+    ) {
         let cfg = &self.config;
         // Three draws a ray, hit or not, so the stream does not depend on what was hit: a standard
         // normal (ziggurat, usually one draw) and two uniforms for the drop-off.
         let z: f64 = rng.sample(StandardNormal);
         let (u3, u4): (f64, f64) = (rng.random(), rng.random());
         let Some((t, owner)) = hit else {
-            return (None, None);
+            return; // the outputs start as None
         };
         let noise = cfg.noise_stddev_m * z;
         let range = (t as f64 + noise).max(0.0);
@@ -531,16 +553,14 @@ impl Lidar {
                 < cfg.dropoff_zero_intensity
                     * (1.0 - intensity / cfg.dropoff_intensity_limit.max(1e-12));
         if u3 < cfg.dropoff_general_rate || drop_by_intensity {
-            return (None, None);
+            return;
         }
-        (
-            Some(mapper::Return {
-                point_in_world: point,
-                range_m: range as f32,
-                intensity: intensity as f32,
-            }),
-            Some(owner),
-        )
+        *ret = Some(mapper::Return {
+            point_in_world: point,
+            range_m: range as f32,
+            intensity: intensity as f32,
+        });
+        *owned = Some(owner);
     }
 
     /// Where each ray meets the vehicle itself, if it does: the sensor is rigidly mounted, so

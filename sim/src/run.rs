@@ -368,7 +368,7 @@ pub enum Event {
 pub fn run(
     scenario: &Scenario,
     options: &RunOptions,
-    progress: &mut dyn FnMut(Progress),
+    progress: &mut (dyn FnMut(Progress) + Send),
 ) -> anyhow::Result<RunReport> {
     run_observed(scenario, options, progress, &mut NoObserver)
 }
@@ -377,8 +377,20 @@ pub fn run(
 pub fn run_observed(
     scenario: &Scenario,
     options: &RunOptions,
-    progress: &mut dyn FnMut(Progress),
-    observer: &mut dyn Observer,
+    progress: &mut (dyn FnMut(Progress) + Send),
+    observer: &mut (dyn Observer + Send),
+) -> anyhow::Result<RunReport> {
+    // The loop itself runs on one of rayon's workers: its parallel stages then start where it
+    // runs instead of being handed to the pool and waited for from outside (a sleep and a
+    // wake-up of this thread each time).
+    rayon::scope(|_| run_on_worker(scenario, options, progress, observer))
+}
+
+fn run_on_worker(
+    scenario: &Scenario,
+    options: &RunOptions,
+    progress: &mut (dyn FnMut(Progress) + Send),
+    observer: &mut (dyn Observer + Send),
 ) -> anyhow::Result<RunReport> {
     let wall = Instant::now();
     let laps = options.laps.unwrap_or(scenario.laps).max(1);

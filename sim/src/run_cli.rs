@@ -161,7 +161,7 @@ pub fn run_cmd(args: &RunArgs) -> anyhow::Result<bool> {
         None
     };
     let mut no_observer = NoObserver;
-    let observer: &mut dyn Observer = match replay.as_mut() {
+    let observer: &mut (dyn Observer + Send) = match replay.as_mut() {
         Some(r) => r,
         None => &mut no_observer,
     };
