@@ -499,7 +499,7 @@ impl Lidar {
                         .zip(hits.iter())
                         .zip(dirs.iter())
                     {
-                        self.measure(scene, &ground, &mut rng, origin, *hit, d, (ret, owner));
+                        self.measure(scene, &ground, &mut rng, (origin, d), *hit, (ret, owner));
                     }
                     *column = mapper::ScanColumn {
                         world_from_sensor: sensor,
@@ -522,9 +522,8 @@ impl Lidar {
         scene: &crate::scene::Scene,
         ground: &crate::scene::GroundTexture,
         rng: &mut Xoshiro256PlusPlus,
-        origin: Point3<f64>,
+        (origin, d): (Point3<f64>, &[f32; 3]),
         hit: Option<(f32, Owner)>,
-        d: &[f32; 3],
         (ret, owned): (&mut Option<mapper::Return>, &mut Option<Owner>),
     ) {
         let cfg = &self.config;
