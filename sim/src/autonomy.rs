@@ -20,6 +20,7 @@
 
 use mapper::CollisionChecker;
 use nalgebra::{Isometry2, Point2, Vector2};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::motion::wrap_angle;
@@ -251,38 +252,41 @@ pub fn plan(
         }
     };
     let steps = (cfg.horizon_m / cfg.step_m).ceil() as usize;
-    let mut candidates = Vec::with_capacity(offsets.len());
-    for &target in &offsets {
-        let mut poses = Vec::with_capacity(steps + 1);
-        let mut collision_at_m = None;
-        let mut clearance_cost = 0.0;
-        for k in 0..=steps {
-            let ds = k as f64 * cfg.step_m;
-            let pose = frenet_pose(route, s0 + ds, d0, target, ds, cfg.transition_m);
-            let check = checker.check_pose(&pose, cfg.avoider_safety_m);
-            if check.colliding && collision_at_m.is_none() {
-                collision_at_m = Some(ds);
+    // The candidates side by side (collected in order: the same plan as one by one).
+    let candidates: Vec<Candidate> = offsets
+        .par_iter()
+        .map(|&target| {
+            let mut poses = Vec::with_capacity(steps + 1);
+            let mut collision_at_m = None;
+            let mut clearance_cost = 0.0;
+            for k in 0..=steps {
+                let ds = k as f64 * cfg.step_m;
+                let pose = frenet_pose(route, s0 + ds, d0, target, ds, cfg.transition_m);
+                let check = checker.check_pose(&pose, cfg.avoider_safety_m);
+                if check.colliding && collision_at_m.is_none() {
+                    collision_at_m = Some(ds);
+                }
+                let wanted = cfg.planner_safety_m - cfg.avoider_safety_m;
+                if check.margin_m < wanted {
+                    clearance_cost += ((wanted - check.margin_m) as f64).powi(2);
+                }
+                poses.push(pose);
             }
-            let wanted = cfg.planner_safety_m - cfg.avoider_safety_m;
-            if check.margin_m < wanted {
-                clearance_cost += ((wanted - check.margin_m) as f64).powi(2);
+            let cost = if collision_at_m.is_some() {
+                f64::INFINITY
+            } else {
+                cfg.w_offset * target.abs()
+                    + cfg.w_change * (target - previous_offset).abs()
+                    + cfg.w_clearance * clearance_cost
+            };
+            Candidate {
+                offset_m: target,
+                poses,
+                collision_at_m,
+                cost,
             }
-            poses.push(pose);
-        }
-        let cost = if collision_at_m.is_some() {
-            f64::INFINITY
-        } else {
-            cfg.w_offset * target.abs()
-                + cfg.w_change * (target - previous_offset).abs()
-                + cfg.w_clearance * clearance_cost
-        };
-        candidates.push(Candidate {
-            offset_m: target,
-            poses,
-            collision_at_m,
-            cost,
-        });
-    }
+        })
+        .collect();
     let best = candidates
         .iter()
         .enumerate()
