@@ -307,6 +307,31 @@ struct Captured {
     estimate: Isometry2<f64>,
 }
 
+/// A revolution mapped by a rayon task: the map back, the revolution, the wall time it took.
+struct Mapped {
+    map: MultiHeightMap,
+    captured: Captured,
+    mapping_s: f64,
+}
+
+/// Waits for a mapping task's answer, running other pending rayon work meanwhile (the task's
+/// own parallel pieces, typically) instead of blocking a worker.
+fn wait_for<T>(rx: &std::sync::mpsc::Receiver<anyhow::Result<T>>) -> anyhow::Result<T> {
+    loop {
+        match rx.try_recv() {
+            Ok(answer) => return answer,
+            Err(std::sync::mpsc::TryRecvError::Empty) => {
+                if rayon::yield_now() != Some(rayon::Yield::Executed) {
+                    std::thread::yield_now();
+                }
+            }
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => {
+                anyhow::bail!("the mapping task ended without an answer")
+            }
+        }
+    }
+}
+
 /// One physics step, given to [`Observer::step`].
 pub struct StepFrame<'a> {
     /// Simulated time, seconds.
@@ -426,13 +451,33 @@ fn run_on_worker(
     let odm_half_size_m = options
         .distance_map_half_size_m
         .unwrap_or_else(|| distance_map_half_size_m(&model, &options.autonomy));
-    let mut map = MultiHeightMap::with_stores(
+    let map = MultiHeightMap::with_stores(
         map_config,
         crate::mapping::levels_of(scenario)?,
         Point2::from(start.translation.vector),
         Some(&prior),
         Some(live.path()),
     )?;
+    // Map a revolution: re-centre the window, forget, insert. Returns the wall time it took.
+    let map_revolution = |map: &mut MultiHeightMap, captured: &Captured| -> anyhow::Result<f64> {
+        let t1 = Instant::now();
+        let reexpressed;
+        let mapper_scan = if captured.estimate != captured.truth {
+            reexpressed = reexpress(&captured.scan.scan, &captured.truth, &captured.estimate)?;
+            &reexpressed
+        } else {
+            &captured.scan.scan
+        };
+        let at = Point2::from(captured.estimate.translation.vector);
+        map.recenter(at)?;
+        // Fade what is no longer seen, then insert: what is seen again is refreshed.
+        if let Some(tau) = options.forget_time_constant_s {
+            map.forget_unseen(at, options.forget_half_size_m, 1.0 / options.scan_hz, tau);
+        }
+        map.insert_scan(mapper_scan, Some(&self_filter))?;
+        Ok(t1.elapsed().as_secs_f64())
+    };
+    let map_revolution = &map_revolution;
     let bicycle = Bicycle::new(vehicle.spec.motion.clone());
     let wheelbase = vehicle.spec.motion.wheelbase_m;
     let decel = vehicle.spec.motion.max_deceleration_m_s2;
@@ -493,8 +538,6 @@ fn run_on_worker(
     );
     let s_start = s_hint;
     let mut current: Option<Plan> = None;
-    // With `overlap_sensing`, the revolution taken at the last scan time, mapped at the next one.
-    let mut pending: Option<Captured> = None;
     let mut speed_cmd = 0.0;
     let mut offset_prev = 0.0;
     let mut laps_completed = 0;
@@ -519,360 +562,376 @@ fn run_on_worker(
     })?;
     let mut deviating = false;
     let mut contacts_seen = 0;
-    while laps_completed < laps {
-        if options.stop.load(Ordering::Relaxed) || t > timeout_s {
-            interrupted = true;
-            break;
-        }
-        let physics = Instant::now();
-        for (k, o) in scenario.obstacles.iter().enumerate() {
-            let i = first_obstacle + k;
-            match o.pose_at(t) {
-                Some((x, y, yaw)) => {
-                    if !world.object_active(i) {
-                        world.set_object_active(i, true);
-                    }
-                    if o.motion.is_some() {
-                        world.set_object_pose(i, x, y, yaw);
-                    }
-                }
-                None if world.object_active(i) => world.set_object_active(i, false),
-                None => {}
+    // With `overlap_sensing`, the last revolution's mapping in flight as a rayon task, holding
+    // the map: it runs beside the physics steps (nothing before the next plan needs it).
+    let mut in_flight: Option<std::sync::mpsc::Receiver<anyhow::Result<Mapped>>> = None;
+    let mut map = Some(map);
+    rayon::scope(|tasks| -> anyhow::Result<()> {
+        while laps_completed < laps {
+            if options.stop.load(Ordering::Relaxed) || t > timeout_s {
+                interrupted = true;
+                break;
             }
-        }
-        split.physics += physics.elapsed().as_secs_f64();
-
-        // The autonomy's view of the pose.
-        let truth = state.world_from_vehicle();
-        let estimate = if options.pose_noise.0 > 0.0 || options.pose_noise.1 > 0.0 {
-            let (nx, ny, nyaw): (f64, f64, f64) = (
-                rng.sample(StandardNormal),
-                rng.sample(StandardNormal),
-                rng.sample(StandardNormal),
-            );
-            Isometry2::new(
-                truth.translation.vector + nalgebra::Vector2::new(nx, ny) * options.pose_noise.0,
-                truth.rotation.angle() + nyaw * options.pose_noise.1,
-            )
-        } else {
-            truth
-        };
-        let (s_est, d_est) =
-            route.project(&Point2::from(estimate.translation.vector), s_hint, 30.0);
-
-        if step.is_multiple_of(steps_per_scan) {
-            let capture = |world: &World| {
-                let t0 = Instant::now();
-                let scan = lidar.scan(
-                    world,
-                    &SweepPoses::still(truth),
-                    step / steps_per_scan,
-                    seed,
-                );
-                (
-                    Captured {
-                        scan,
-                        truth,
-                        estimate,
-                    },
-                    t0.elapsed().as_secs_f64(),
-                )
-            };
-            // Map the revolution (the one taken a revolution ago when sensing overlaps), then
-            // plan from the pose now over the updated distance maps.
-            let think = |map: &mut MultiHeightMap,
-                         captured: &Captured|
-             -> anyhow::Result<(Plan, f64, [f64; 3])> {
-                let t1 = Instant::now();
-                let reexpressed;
-                let mapper_scan = if captured.estimate != captured.truth {
-                    reexpressed =
-                        reexpress(&captured.scan.scan, &captured.truth, &captured.estimate)?;
-                    &reexpressed
-                } else {
-                    &captured.scan.scan
-                };
-                let at = Point2::from(captured.estimate.translation.vector);
-                map.recenter(at)?;
-                // Fade what is no longer seen, then insert: what is seen again is refreshed.
-                if let Some(tau) = options.forget_time_constant_s {
-                    map.forget_unseen(at, options.forget_half_size_m, 1.0 / options.scan_hz, tau);
-                }
-                map.insert_scan(mapper_scan, Some(&self_filter))?;
-                let t2 = Instant::now();
-                map.update_distance_maps_around(
-                    Point2::from(estimate.translation.vector),
-                    odm_half_size_m,
-                );
-                let t3 = Instant::now();
-                let checker = model.checker(map.distance_maps())?;
-                let p = plan(
-                    &checker,
-                    &route,
-                    s_est,
-                    d_est,
-                    offset_prev,
-                    behaviour,
-                    &options.autonomy,
-                );
-                let (v, _) = avoid(
-                    p.chosen(),
-                    scenario.route.speed_m_s,
-                    decel,
-                    &options.autonomy,
-                );
-                let times = [
-                    (t2 - t1).as_secs_f64(),
-                    (t3 - t2).as_secs_f64(),
-                    t3.elapsed().as_secs_f64(),
-                ];
-                Ok((p, v, times))
-            };
-            let (fresh, thought) = if options.overlap_sensing {
-                // The LiDAR's next revolution and the mapping of the last one run side by side.
-                let previous = pending.take();
-                let (fresh, thought) = rayon::join(
-                    || capture(&world),
-                    || previous.map(|c| think(&mut map, &c).map(|r| (r, c))),
-                );
-                (Some(fresh), thought.transpose()?)
-            } else {
-                let (c, lidar_s) = capture(&world);
-                split.lidar += lidar_s;
-                let r = think(&mut map, &c)?;
-                (None, Some((r, c)))
-            };
-            if let Some((c, lidar_s)) = fresh {
-                split.lidar += lidar_s;
-                pending = Some(c);
-            }
-            // Until the first revolution is mapped there is nothing to follow (the vehicle waits).
-            if let Some(((p, v, [mapping_s, odm_s, planning_s]), captured)) = thought {
-                split.mapping += mapping_s;
-                split.distance_maps += odm_s;
-                split.planning += planning_s;
-                offset_prev = p.chosen().offset_m;
-                speed_cmd = v;
-                if (offset_prev.abs() > 0.5) != deviating {
-                    deviating = !deviating;
-                    let event = if deviating {
-                        Event::Deviate {
-                            offset_m: offset_prev,
+            let physics = Instant::now();
+            for (k, o) in scenario.obstacles.iter().enumerate() {
+                let i = first_obstacle + k;
+                match o.pose_at(t) {
+                    Some((x, y, yaw)) => {
+                        if !world.object_active(i) {
+                            world.set_object_active(i, true);
                         }
-                    } else {
-                        Event::BackOnRoute
-                    };
-                    observer.event(t, &event)?;
+                        if o.motion.is_some() {
+                            world.set_object_pose(i, x, y, yaw);
+                        }
+                    }
+                    None if world.object_active(i) => world.set_object_active(i, false),
+                    None => {}
                 }
-                observer.scan(&ScanFrame {
-                    t_s: t,
-                    truth: captured.truth,
-                    estimate: captured.estimate,
-                    lidar: &captured.scan,
-                    map: &map,
-                    plan: &p,
-                    speed_cmd_m_s: v,
-                    speed_scale: if scenario.route.speed_m_s > 0.0 {
-                        v / scenario.route.speed_m_s
-                    } else {
-                        0.0
-                    },
-                    world: &world,
-                })?;
-                current = Some(p);
             }
-        }
+            split.physics += physics.elapsed().as_secs_f64();
 
-        let physics = Instant::now();
-        let steering = current.as_ref().map_or(0.0, |p| {
-            pure_pursuit(
-                &estimate,
-                p.chosen(),
-                state.speed_m_s,
-                wheelbase,
-                &options.autonomy,
-            )
-        });
-        let command = Command {
-            speed_m_s: speed_cmd,
-            steering_rad: steering,
-        };
-        bicycle.step(&mut state, &command, dt);
-        t += dt;
-        step += 1;
-        world.set_vehicle_pose(&state.world_from_vehicle(), t);
-        split.physics += physics.elapsed().as_secs_f64();
-
-        // Progress along the route (truth, for judging).
-        let (s_now, d_now) = route.project(&Point2::new(state.x_m, state.y_m), s_hint, 30.0);
-        let mut ds = s_now - s_hint;
-        if route.closed() {
-            ds = (ds + length / 2.0).rem_euclid(length) - length / 2.0;
-        }
-        s_total += ds;
-        s_hint = s_now;
-
-        // Stops.
-        let stopped = state.speed_m_s.abs() < 0.05 && speed_cmd == 0.0;
-        let moving = state.speed_m_s.abs() > 0.3;
-        match stops.last_mut() {
-            Some(last) if last.end_s.is_none() && moving => {
-                last.end_s = Some(t);
-                observer.event(
-                    t,
-                    &Event::Resume {
-                        stopped_s: t - last.start_s,
-                    },
-                )?;
-            }
-            Some(last) if last.end_s.is_none() => {}
-            _ if stopped && t > 1.0 => {
-                stops.push(Stop {
-                    start_s: t,
-                    end_s: None,
-                    route_s_m: s_now,
-                });
-                observer.event(t, &Event::Stop { route_s_m: s_now })?;
-            }
-            _ => {}
-        }
-        for c in &world.contacts()[contacts_seen..] {
-            observer.event(c.time_s, &Event::Contact(c.clone()))?;
-        }
-        contacts_seen = world.contacts().len();
-
-        // Obstacle passes: a window from 25 m before to 10 m after each obstacle.
-        let lap_s = (s_start + s_total).rem_euclid(if route.closed() {
-            length
-        } else {
-            f64::INFINITY
-        });
-        for (k, tr) in trackers.iter_mut().enumerate() {
-            let rel = if route.closed() {
-                (lap_s - tr.route_s + length / 2.0).rem_euclid(length) - length / 2.0
+            // The autonomy's view of the pose.
+            let truth = state.world_from_vehicle();
+            let estimate = if options.pose_noise.0 > 0.0 || options.pose_noise.1 > 0.0 {
+                let (nx, ny, nyaw): (f64, f64, f64) = (
+                    rng.sample(StandardNormal),
+                    rng.sample(StandardNormal),
+                    rng.sample(StandardNormal),
+                );
+                Isometry2::new(
+                    truth.translation.vector
+                        + nalgebra::Vector2::new(nx, ny) * options.pose_noise.0,
+                    truth.rotation.angle() + nyaw * options.pose_noise.1,
+                )
             } else {
-                lap_s - tr.route_s
+                truth
             };
-            let inside = (-25.0..=10.0).contains(&rel);
-            if inside && !tr.active {
-                *tr = PassTracker {
-                    active: true,
-                    offset: 0.0,
-                    stopped: false,
-                    present: false,
-                    clearance: vec![f64::INFINITY; heights.len()],
-                    contacts_before: world.contacts().len(),
-                    ..*tr
+            let (s_est, d_est) =
+                route.project(&Point2::from(estimate.translation.vector), s_hint, 30.0);
+
+            if step.is_multiple_of(steps_per_scan) {
+                let capture = |world: &World| {
+                    let t0 = Instant::now();
+                    let scan = lidar.scan(
+                        world,
+                        &SweepPoses::still(truth),
+                        step / steps_per_scan,
+                        seed,
+                    );
+                    (
+                        Captured {
+                            scan,
+                            truth,
+                            estimate,
+                        },
+                        t0.elapsed().as_secs_f64(),
+                    )
                 };
-            }
-            if tr.active {
-                tr.offset = tr.offset.max(d_now.abs());
-                tr.stopped |= stopped && rel < 0.0;
-                tr.present |= world.object_active(tr.solid_index);
-                for (part, d) in world.distances_to(tr.solid_index).into_iter().enumerate() {
-                    let level = part_levels[part];
-                    tr.clearance[level] = tr.clearance[level].min(d);
-                }
-                if !inside && !tr.present {
-                    // Not in the world during this window (appears later or has gone): no pass.
-                    tr.active = false;
-                } else if !inside {
-                    tr.active = false;
-                    let id = &scene.solids[tr.solid_index].id;
-                    let collided = world.contacts()[tr.contacts_before..]
-                        .iter()
-                        .any(|c| &c.object == id);
-                    let outcome = if collided {
-                        "collided"
-                    } else if tr.stopped {
-                        "stopped"
-                    } else if tr.offset > 0.5 {
-                        "deviated"
-                    } else {
-                        "passed"
-                    };
-                    let too_close = scenario
-                        .danger_distance_m
-                        .is_some_and(|danger| tr.clearance.iter().any(|d| *d < danger));
-                    let met = !collided
-                        && !too_close
-                        && match tr.expect {
-                            Expectation::PassUnder => outcome == "passed",
-                            Expectation::Deviate => outcome == "deviated",
-                            Expectation::Stop => outcome == "stopped",
-                            Expectation::NoContact => true,
+                // Plan from the pose now over the distance maps updated around it.
+                let plan_now = |map: &mut MultiHeightMap| -> anyhow::Result<(Plan, f64, [f64; 2])> {
+                    let t2 = Instant::now();
+                    map.update_distance_maps_around(
+                        Point2::from(estimate.translation.vector),
+                        odm_half_size_m,
+                    );
+                    let t3 = Instant::now();
+                    let checker = model.checker(map.distance_maps())?;
+                    let p = plan(
+                        &checker,
+                        &route,
+                        s_est,
+                        d_est,
+                        offset_prev,
+                        behaviour,
+                        &options.autonomy,
+                    );
+                    let (v, _) = avoid(
+                        p.chosen(),
+                        scenario.route.speed_m_s,
+                        decel,
+                        &options.autonomy,
+                    );
+                    Ok((p, v, [(t3 - t2).as_secs_f64(), t3.elapsed().as_secs_f64()]))
+                };
+                // This revolution, to be mapped once the plan from the last one is made.
+                let mut to_map = None;
+                let thought = if options.overlap_sensing {
+                    // The LiDAR's next revolution beside the plan from the last one, which was mapped
+                    // while the physics steps ran.
+                    let rx = in_flight.take();
+                    let held = map.take();
+                    let (fresh, planned) = rayon::join(
+                        || capture(&world),
+                        || -> anyhow::Result<_> {
+                            let Some(rx) = rx else {
+                                return Ok((held.context("the map is missing")?, None));
+                            };
+                            let Mapped {
+                                map: mut m,
+                                captured,
+                                mapping_s,
+                            } = wait_for(&rx)?;
+                            let (p, v, [odm_s, planning_s]) = plan_now(&mut m)?;
+                            Ok((m, Some(((p, v, [mapping_s, odm_s, planning_s]), captured))))
+                        },
+                    );
+                    let (m, thought) = planned?;
+                    map = Some(m);
+                    let (c, lidar_s) = fresh;
+                    split.lidar += lidar_s;
+                    to_map = Some(c);
+                    thought
+                } else {
+                    let m = map.as_mut().context("the map is missing")?;
+                    let (c, lidar_s) = capture(&world);
+                    split.lidar += lidar_s;
+                    let mapping_s = map_revolution(m, &c)?;
+                    let (p, v, [odm_s, planning_s]) = plan_now(m)?;
+                    Some(((p, v, [mapping_s, odm_s, planning_s]), c))
+                };
+                // Until the first revolution is mapped there is nothing to follow (the vehicle waits).
+                if let Some(((p, v, [mapping_s, odm_s, planning_s]), captured)) = thought {
+                    split.mapping += mapping_s;
+                    split.distance_maps += odm_s;
+                    split.planning += planning_s;
+                    offset_prev = p.chosen().offset_m;
+                    speed_cmd = v;
+                    if (offset_prev.abs() > 0.5) != deviating {
+                        deviating = !deviating;
+                        let event = if deviating {
+                            Event::Deviate {
+                                offset_m: offset_prev,
+                            }
+                        } else {
+                            Event::BackOnRoute
                         };
+                        observer.event(t, &event)?;
+                    }
+                    observer.scan(&ScanFrame {
+                        t_s: t,
+                        truth: captured.truth,
+                        estimate: captured.estimate,
+                        lidar: &captured.scan,
+                        map: map.as_ref().context("the map is missing")?,
+                        plan: &p,
+                        speed_cmd_m_s: v,
+                        speed_scale: if scenario.route.speed_m_s > 0.0 {
+                            v / scenario.route.speed_m_s
+                        } else {
+                            0.0
+                        },
+                        world: &world,
+                    })?;
+                    current = Some(p);
+                }
+                if let Some(c) = to_map {
+                    let mut m = map.take().context("the map is missing")?;
+                    let (tx, rx) = std::sync::mpsc::channel();
+                    tasks.spawn(move |_| {
+                        let mapped = map_revolution(&mut m, &c).map(|mapping_s| Mapped {
+                            map: m,
+                            captured: c,
+                            mapping_s,
+                        });
+                        // The receiver is gone only if the loop has ended: nothing waits for this.
+                        let _ = tx.send(mapped);
+                    });
+                    in_flight = Some(rx);
+                }
+            }
+
+            let physics = Instant::now();
+            let steering = current.as_ref().map_or(0.0, |p| {
+                pure_pursuit(
+                    &estimate,
+                    p.chosen(),
+                    state.speed_m_s,
+                    wheelbase,
+                    &options.autonomy,
+                )
+            });
+            let command = Command {
+                speed_m_s: speed_cmd,
+                steering_rad: steering,
+            };
+            bicycle.step(&mut state, &command, dt);
+            t += dt;
+            step += 1;
+            world.set_vehicle_pose(&state.world_from_vehicle(), t);
+            split.physics += physics.elapsed().as_secs_f64();
+
+            // Progress along the route (truth, for judging).
+            let (s_now, d_now) = route.project(&Point2::new(state.x_m, state.y_m), s_hint, 30.0);
+            let mut ds = s_now - s_hint;
+            if route.closed() {
+                ds = (ds + length / 2.0).rem_euclid(length) - length / 2.0;
+            }
+            s_total += ds;
+            s_hint = s_now;
+
+            // Stops.
+            let stopped = state.speed_m_s.abs() < 0.05 && speed_cmd == 0.0;
+            let moving = state.speed_m_s.abs() > 0.3;
+            match stops.last_mut() {
+                Some(last) if last.end_s.is_none() && moving => {
+                    last.end_s = Some(t);
                     observer.event(
                         t,
-                        &Event::Pass {
-                            id: id.clone(),
-                            outcome: outcome.into(),
-                            met,
+                        &Event::Resume {
+                            stopped_s: t - last.start_s,
                         },
                     )?;
-                    reports[k].passes.push(Pass {
-                        lap: laps_completed + 1,
-                        outcome: outcome.into(),
-                        min_clearance_m: tr.clearance.clone(),
-                        max_offset_m: tr.offset,
-                        met,
+                }
+                Some(last) if last.end_s.is_none() => {}
+                _ if stopped && t > 1.0 => {
+                    stops.push(Stop {
+                        start_s: t,
+                        end_s: None,
+                        route_s_m: s_now,
                     });
+                    observer.event(t, &Event::Stop { route_s_m: s_now })?;
+                }
+                _ => {}
+            }
+            for c in &world.contacts()[contacts_seen..] {
+                observer.event(c.time_s, &Event::Contact(c.clone()))?;
+            }
+            contacts_seen = world.contacts().len();
+
+            // Obstacle passes: a window from 25 m before to 10 m after each obstacle.
+            let lap_s = (s_start + s_total).rem_euclid(if route.closed() {
+                length
+            } else {
+                f64::INFINITY
+            });
+            for (k, tr) in trackers.iter_mut().enumerate() {
+                let rel = if route.closed() {
+                    (lap_s - tr.route_s + length / 2.0).rem_euclid(length) - length / 2.0
+                } else {
+                    lap_s - tr.route_s
+                };
+                let inside = (-25.0..=10.0).contains(&rel);
+                if inside && !tr.active {
+                    *tr = PassTracker {
+                        active: true,
+                        offset: 0.0,
+                        stopped: false,
+                        present: false,
+                        clearance: vec![f64::INFINITY; heights.len()],
+                        contacts_before: world.contacts().len(),
+                        ..*tr
+                    };
+                }
+                if tr.active {
+                    tr.offset = tr.offset.max(d_now.abs());
+                    tr.stopped |= stopped && rel < 0.0;
+                    tr.present |= world.object_active(tr.solid_index);
+                    for (part, d) in world.distances_to(tr.solid_index).into_iter().enumerate() {
+                        let level = part_levels[part];
+                        tr.clearance[level] = tr.clearance[level].min(d);
+                    }
+                    if !inside && !tr.present {
+                        // Not in the world during this window (appears later or has gone): no pass.
+                        tr.active = false;
+                    } else if !inside {
+                        tr.active = false;
+                        let id = &scene.solids[tr.solid_index].id;
+                        let collided = world.contacts()[tr.contacts_before..]
+                            .iter()
+                            .any(|c| &c.object == id);
+                        let outcome = if collided {
+                            "collided"
+                        } else if tr.stopped {
+                            "stopped"
+                        } else if tr.offset > 0.5 {
+                            "deviated"
+                        } else {
+                            "passed"
+                        };
+                        let too_close = scenario
+                            .danger_distance_m
+                            .is_some_and(|danger| tr.clearance.iter().any(|d| *d < danger));
+                        let met = !collided
+                            && !too_close
+                            && match tr.expect {
+                                Expectation::PassUnder => outcome == "passed",
+                                Expectation::Deviate => outcome == "deviated",
+                                Expectation::Stop => outcome == "stopped",
+                                Expectation::NoContact => true,
+                            };
+                        observer.event(
+                            t,
+                            &Event::Pass {
+                                id: id.clone(),
+                                outcome: outcome.into(),
+                                met,
+                            },
+                        )?;
+                        reports[k].passes.push(Pass {
+                            lap: laps_completed + 1,
+                            outcome: outcome.into(),
+                            min_clearance_m: tr.clearance.clone(),
+                            max_offset_m: tr.offset,
+                            met,
+                        });
+                    }
                 }
             }
-        }
-        let clearance_now = clearance_per_level(&world, &part_levels, heights.len());
-        for (level, d) in clearance_now.iter().enumerate() {
-            min_clearance[level] = min_clearance[level].min(*d);
-        }
-        observer.step(&StepFrame {
-            t_s: t,
-            state: &state,
-            command: &command,
-            clearance_m: &clearance_now,
-            real_time_factor: t / wall.elapsed().as_secs_f64().max(1e-9),
-            world: &world,
-        })?;
+            let clearance_now = clearance_per_level(&world, &part_levels, heights.len());
+            for (level, d) in clearance_now.iter().enumerate() {
+                min_clearance[level] = min_clearance[level].min(*d);
+            }
+            observer.step(&StepFrame {
+                t_s: t,
+                state: &state,
+                command: &command,
+                clearance_m: &clearance_now,
+                real_time_factor: t / wall.elapsed().as_secs_f64().max(1e-9),
+                world: &world,
+            })?;
 
-        // Laps.
-        let done_m = s_total;
-        if (route.closed() && done_m >= length * (laps_completed + 1) as f64)
-            || (!route.closed() && s_now >= length - 0.5)
-        {
-            laps_completed += 1;
-            lap_times.push(t - lap_start_t);
-            observer.event(
-                t,
-                &Event::Lap {
-                    lap: laps_completed,
-                    time_s: t - lap_start_t,
-                },
-            )?;
-            lap_start_t = t;
-            if !route.closed() && laps_completed < laps {
-                // An open route starts again from its start pose.
-                state = VehicleState {
-                    x_m: start.translation.x,
-                    y_m: start.translation.y,
-                    yaw_rad: start.rotation.angle(),
-                    ..Default::default()
+            // Laps.
+            let done_m = s_total;
+            if (route.closed() && done_m >= length * (laps_completed + 1) as f64)
+                || (!route.closed() && s_now >= length - 0.5)
+            {
+                laps_completed += 1;
+                lap_times.push(t - lap_start_t);
+                observer.event(
+                    t,
+                    &Event::Lap {
+                        lap: laps_completed,
+                        time_s: t - lap_start_t,
+                    },
+                )?;
+                lap_start_t = t;
+                if !route.closed() && laps_completed < laps {
+                    // An open route starts again from its start pose.
+                    state = VehicleState {
+                        x_m: start.translation.x,
+                        y_m: start.translation.y,
+                        yaw_rad: start.rotation.angle(),
+                        ..Default::default()
+                    };
+                    (s_hint, s_total) = (s_start, 0.0);
+                    world.set_vehicle_pose(&state.world_from_vehicle(), t);
+                }
+            }
+            if step.is_multiple_of(100) {
+                let fraction = if route.closed() {
+                    s_total / total_m
+                } else {
+                    (laps_completed as f64 * length + s_now) / total_m
                 };
-                (s_hint, s_total) = (s_start, 0.0);
-                world.set_vehicle_pose(&state.world_from_vehicle(), t);
+                progress(Progress {
+                    sim_time_s: t,
+                    laps_completed,
+                    fraction: fraction.clamp(0.0, 1.0),
+                });
             }
         }
-        if step.is_multiple_of(100) {
-            let fraction = if route.closed() {
-                s_total / total_m
-            } else {
-                (laps_completed as f64 * length + s_now) / total_m
-            };
-            progress(Progress {
-                sim_time_s: t,
-                laps_completed,
-                fraction: fraction.clamp(0.0, 1.0),
-            });
-        }
-    }
+        Ok(())
+    })?;
     let wall_time_s = wall.elapsed().as_secs_f64();
     let every_pass_met = reports
         .iter()
