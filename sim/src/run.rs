@@ -405,18 +405,6 @@ pub fn run_observed(
     progress: &mut (dyn FnMut(Progress) + Send),
     observer: &mut (dyn Observer + Send),
 ) -> anyhow::Result<RunReport> {
-    // The loop itself runs on one of rayon's workers: its parallel stages then start where it
-    // runs instead of being handed to the pool and waited for from outside (a sleep and a
-    // wake-up of this thread each time).
-    rayon::scope(|_| run_on_worker(scenario, options, progress, observer))
-}
-
-fn run_on_worker(
-    scenario: &Scenario,
-    options: &RunOptions,
-    progress: &mut (dyn FnMut(Progress) + Send),
-    observer: &mut (dyn Observer + Send),
-) -> anyhow::Result<RunReport> {
     let wall = Instant::now();
     let laps = options.laps.unwrap_or(scenario.laps).max(1);
     let seed = options.seed.unwrap_or(scenario.seed);
@@ -562,8 +550,11 @@ fn run_on_worker(
     })?;
     let mut deviating = false;
     let mut contacts_seen = 0;
-    // With `overlap_sensing`, the last revolution's mapping in flight as a rayon task, holding
-    // the map: it runs beside the physics steps (nothing before the next plan needs it).
+    // The loop runs in a rayon scope, so on one of rayon's workers: its parallel stages start
+    // where it runs instead of being handed to the pool and waited for from outside (a sleep
+    // and a wake-up of this thread each time). With `overlap_sensing`, the last revolution's
+    // mapping is in flight as a task of that scope, holding the map: it runs beside the physics
+    // steps (nothing before the next plan needs it).
     let mut in_flight: Option<std::sync::mpsc::Receiver<anyhow::Result<Mapped>>> = None;
     let mut map = Some(map);
     rayon::scope(|tasks| -> anyhow::Result<()> {
