@@ -13,7 +13,7 @@
 //! pieces within `max_circles`, an exact multiple-choice knapsack).
 
 use nalgebra::Vector2;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::footprint::{ConvexPolygon, Disc, EPS_M, Footprint, min_enclosing_disc};
@@ -30,7 +30,7 @@ const OVERSHOOT_SAMPLES: usize = 64;
 
 /// How hard to fit. Either bound may be given; with both, the overshoot target is tried first
 /// and the circle budget wins if the target needs more circles.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FitOptions {
     /// Most circles in the whole model, all levels together. Default: no limit.

@@ -289,10 +289,7 @@ pub fn lidar_scene() -> crate::scene::Scene {
 
 /// The LiDAR figures: one HDL-32E revolution with the fast path and with Rapier's generic
 /// per-ray query, same scene, same run.
-pub fn lidar_figures(
-    samples: usize,
-    progress: &mut dyn FnMut(&str),
-) -> anyhow::Result<Vec<Figure>> {
+pub fn lidar_figures(samples: usize, progress: &mut dyn FnMut(&str)) -> crate::Result<Vec<Figure>> {
     use crate::lidar::{Lidar, LidarConfig, SweepPoses};
     progress("building the world");
     let scene = lidar_scene();
@@ -300,7 +297,7 @@ pub fn lidar_figures(
     let pose = nalgebra::Isometry2::new(nalgebra::Vector2::new(0.0, -3.0), 0.1);
     let world = crate::world::World::new(&scene, true, &vehicle, &pose);
     let lidar = Lidar::new(LidarConfig::default(), vehicle.vehicle_from_lidar())
-        .map_err(anyhow::Error::msg)?;
+        .map_err(crate::Error::Invalid)?;
     let sweep = SweepPoses::still(pose);
     progress("generic cast");
     let generic = median_seconds(samples.min(7), 1, || {
@@ -342,23 +339,27 @@ pub fn loop_figures(
     scenario: &std::path::Path,
     laps: u32,
     progress: &mut dyn FnMut(&str),
-) -> anyhow::Result<Vec<Figure>> {
+) -> crate::Result<Vec<Figure>> {
     let scenario = crate::scenario::Scenario::from_file(scenario)?;
     let map_dir = &crate::mapping::default_map_dir(&scenario);
-    if crate::mapping::fresh_manifest(&scenario, map_dir)?.is_none() {
+    let config = crate::config::RunConfig::default();
+    if crate::mapping::fresh_manifest(&scenario, &config, map_dir)?.is_none() {
         progress("mapping drive");
-        crate::mapping::map_drive(&scenario, map_dir, &mut |_, _| {})?;
+        crate::mapping::map_drive(&scenario, &config, map_dir, &mut |_, _| {})?;
     }
     // The straightforward way first: each revolution mapped and planned the instant it is taken.
     progress("closed loop, sequential");
-    let options = |overlap_sensing| crate::run::RunOptions {
+    let setup = |schedule| crate::run::RunSetup {
         laps: (laps > 0).then_some(laps),
-        overlap_sensing,
-        ..crate::run::RunOptions::new(map_dir.to_path_buf())
+        config: crate::config::RunConfig {
+            schedule,
+            ..config.clone()
+        },
+        ..crate::run::RunSetup::new(map_dir.to_path_buf())
     };
-    let sequential = crate::run::run(&scenario, &options(false), &mut |_| {})?;
+    let sequential = crate::run::run(&scenario, &setup(crate::config::Schedule::Sequential))?;
     progress("closed loop");
-    let report = crate::run::run(&scenario, &options(true), &mut |_| {})?;
+    let report = crate::run::run(&scenario, &setup(crate::config::Schedule::Overlapped))?;
     let scans = sequential.sim_time_s / 0.1;
     let per_scan = |seconds: f64| seconds / scans.max(1.0);
     let name = |what: &str| {

@@ -7,7 +7,6 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::Context as _;
 use mapper::export::{
     TrinaryThresholds, write_distance_png, write_npy, write_occupancy_png, write_ros_map,
 };
@@ -54,9 +53,12 @@ pub struct DemoSummary {
 pub fn run(
     options: &DemoOptions,
     progress: &mut dyn FnMut(usize, usize),
-) -> anyhow::Result<DemoSummary> {
-    std::fs::create_dir_all(&options.out)
-        .with_context(|| format!("creating {}", options.out.display()))?;
+) -> crate::Result<DemoSummary> {
+    std::fs::create_dir_all(&options.out).map_err(|source| crate::Error::Io {
+        what: "creating the demo's output directory",
+        path: options.out.clone(),
+        source,
+    })?;
     let blocks_dir = options.out.join("blocks");
     let scene = workloads::parking_lot_scene();
     let car = workloads::fake_wing_car();
@@ -108,7 +110,9 @@ pub fn run(
         .len()
         .saturating_sub(summary.blocks);
     for k in 0..map.levels().count() {
-        let grid = map.probability_grid(k).context("level grid")?;
+        let grid = map
+            .probability_grid(k)
+            .ok_or_else(|| crate::Error::Invalid(format!("level {k}: no grid")))?;
         let occupied = grid.data().iter().filter(|&&p| p > 0.5).count();
         summary.levels.push((map.levels().heights_m()[k], occupied));
         let file = |name: String| options.out.join(name);

@@ -4,10 +4,7 @@
 //! The only place that knows the terminal: progress bars, tables, exit codes (0 success,
 //! 2 bad input or failure; clap's own usage errors also exit 2).
 
-mod check_cli;
-mod model_cli;
-mod run_cli;
-mod scan_cli;
+mod cli;
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -60,22 +57,24 @@ enum Command {
     },
     /// Run a scenario in closed loop (builds its offline map first when missing or stale).
     /// Exit code 0 when every expectation held, 1 when one did not, 2 on bad input.
-    Run(run_cli::RunArgs),
+    Run(cli::run::RunArgs),
     /// The mapping drive: build a scenario's offline multi-height map.
-    Map(run_cli::MapArgs),
+    Map(cli::run::MapArgs),
     /// Validate a scenario file and print a summary.
-    Check(check_cli::CheckArgs),
+    Check(cli::check::CheckArgs),
     /// Write one LiDAR revolution of a scenario's world as PLY.
-    Scan(scan_cli::ScanArgs),
+    Scan(cli::scan::ScanArgs),
     /// Vehicle collision models.
     #[command(subcommand)]
     Model(ModelCommand),
+    /// Print the default run configuration as TOML (a starting point for `run --config`).
+    Config,
 }
 
 #[derive(Subcommand)]
 enum ModelCommand {
     /// Fit a vehicle's height-tagged circle model and print coverage per level.
-    Fit(model_cli::ModelFitArgs),
+    Fit(cli::model::ModelFitArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -117,7 +116,7 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
-        Command::Run(args) => run_cli::run_cmd(&args).map(|met| {
+        Command::Run(args) => cli::run::run_cmd(&args).map(|met| {
             if met {
                 ExitCode::SUCCESS
             } else {
@@ -138,11 +137,12 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
             scenario,
             laps,
         } => bench(what, json, samples, &scenario, laps),
-        Command::Model(ModelCommand::Fit(args)) => model_cli::run(&args),
-        Command::Check(args) => check_cli::run(&args),
-        Command::Map(args) => run_cli::map(&args),
+        Command::Model(ModelCommand::Fit(args)) => cli::model::run(&args),
+        Command::Check(args) => cli::check::run(&args),
+        Command::Map(args) => cli::run::map(&args),
         Command::Run(_) => unreachable!("dispatched in run"),
-        Command::Scan(args) => scan_cli::run(&args),
+        Command::Scan(args) => cli::scan::run(&args),
+        Command::Config => emit(&sim::config::RunConfig::default().to_toml()),
     }
 }
 

@@ -8,13 +8,14 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context as _;
+use autonomy::RoutePath;
 use mapper::export::{TrinaryThresholds, write_occupancy_png, write_ros_map};
 use mapper::{BlockStore, Grid, GridGeometry, Levels, MapConfig, MultiHeightMap};
 use nalgebra::{Isometry2, Point2};
 
-use crate::autonomy::RoutePath;
-use crate::lidar::{Lidar, LidarConfig, SweepPoses};
+use crate::config::RunConfig;
+use crate::error::{Error, Result};
+use crate::lidar::{Lidar, SweepPoses};
 use crate::scenario::Scenario;
 use crate::world::World;
 
@@ -40,80 +41,91 @@ pub struct MapManifest {
     pub occupied_cells: Vec<usize>,
 }
 
-/// The map settings the simulator uses (the mapper's defaults).
-pub fn map_config() -> MapConfig {
-    MapConfig {
-        self_hit_margin_m: 1.5,
-        ..MapConfig::default()
-    }
+/// The map settings of a configuration's mapping drive (its mapping settings as they are).
+pub fn map_config(config: &RunConfig) -> MapConfig {
+    config.mapping.map
 }
 
-/// Fingerprint of a scenario's offline map inputs.
-pub fn fingerprint(scenario: &Scenario) -> anyhow::Result<String> {
+/// Fingerprint of a scenario's offline map inputs: the scenario and vehicle files, the map and
+/// LiDAR settings of `config`, the format.
+pub fn fingerprint(scenario: &Scenario, config: &RunConfig) -> Result<String> {
     let mut h = crc32fast::Hasher::new();
-    h.update(
-        &std::fs::read(&scenario.path)
-            .with_context(|| format!("reading {}", scenario.path.display()))?,
-    );
+    h.update(&std::fs::read(&scenario.path).map_err(|source| Error::Io {
+        what: "reading the scenario",
+        path: scenario.path.clone(),
+        source,
+    })?);
     h.update(format!("{:?}", scenario.vehicle.vehicle).as_bytes());
-    h.update(format!("{:?}{:?}{MAP_FORMAT}", map_config(), LidarConfig::default()).as_bytes());
+    h.update(format!("{:?}{:?}{MAP_FORMAT}", map_config(config), config.lidar).as_bytes());
     Ok(format!("{:08x}", h.finalize()))
 }
 
-/// The manifest of the map in `dir`, if it exists and matches `scenario`.
-pub fn fresh_manifest(scenario: &Scenario, dir: &Path) -> anyhow::Result<Option<MapManifest>> {
+/// The manifest of the map in `dir`, if it exists and matches `scenario` and `config`.
+pub fn fresh_manifest(
+    scenario: &Scenario,
+    config: &RunConfig,
+    dir: &Path,
+) -> Result<Option<MapManifest>> {
     let Ok(text) = std::fs::read_to_string(dir.join("manifest.json")) else {
         return Ok(None);
     };
     let Ok(manifest) = serde_json::from_str::<MapManifest>(&text) else {
         return Ok(None);
     };
-    Ok((manifest.fingerprint == fingerprint(scenario)?).then_some(manifest))
+    Ok((manifest.fingerprint == fingerprint(scenario, config)?).then_some(manifest))
 }
 
 /// The circles the LiDAR self-hit filter uses: every part at its own level (the banded fit keeps
 /// the parts a cumulative fit drops because they lie over a lower level's parts, such as a wing
 /// root over the fuselage), so returns off the vehicle's own wing are dropped while a cone under
 /// the wing is not.
-pub fn self_filter_model(vehicle: &aircraft::Vehicle) -> anyhow::Result<mapper::CollisionModel> {
+pub fn self_filter_model(vehicle: &aircraft::Vehicle) -> Result<mapper::CollisionModel> {
     let options = aircraft::FitOptions {
         banded_maps: true,
         ..vehicle.spec.fit.clone()
     };
     Ok(vehicle
-        .fit_with(&vehicle.spec.heights_of_interest_m, &options)
-        .context("fitting the self-hit filter's circles")?
+        .fit_with(&vehicle.spec.heights_of_interest_m, &options)?
         .model)
 }
 
 /// The levels a scenario's vehicle asks for (its heights of interest, cumulative).
-pub fn levels_of(scenario: &Scenario) -> anyhow::Result<Levels> {
+pub fn levels_of(scenario: &Scenario) -> Result<Levels> {
     Ok(Levels::cumulative(
         scenario.vehicle.vehicle.spec.heights_of_interest_m.clone(),
     )?)
 }
 
-/// Drives the route once and writes the offline map into `out`. `progress(done, total)` after each scan.
+/// Drives the route once with the LiDAR and map settings of `config` and writes the offline map
+/// into `out`. `progress(done, total)` after each scan.
 pub fn map_drive(
     scenario: &Scenario,
+    config: &RunConfig,
     out: &Path,
     progress: &mut dyn FnMut(usize, usize),
-) -> anyhow::Result<MapManifest> {
+) -> Result<MapManifest> {
     let vehicle = &scenario.vehicle.vehicle;
     let self_filter = self_filter_model(vehicle)?;
     let levels = levels_of(scenario)?;
     let blocks_dir = out.join("blocks");
     if blocks_dir.exists() {
-        std::fs::remove_dir_all(&blocks_dir)
-            .with_context(|| format!("clearing {}", blocks_dir.display()))?;
+        std::fs::remove_dir_all(&blocks_dir).map_err(|source| Error::Io {
+            what: "clearing the old map blocks",
+            path: blocks_dir.clone(),
+            source,
+        })?;
     }
     let route = RoutePath::new(&scenario.route.waypoints_m, scenario.route.closed);
     let start = scenario.vehicle.world_from_start;
     let mut world = World::new(&scenario.scene(false), false, vehicle, &start);
-    let lidar = Lidar::new(LidarConfig::default(), vehicle.vehicle_from_lidar())
-        .map_err(anyhow::Error::msg)?;
+    let lidar = Lidar::new(config.lidar.clone(), vehicle.vehicle_from_lidar()).map_err(|e| {
+        Error::Config {
+            origin: "lidar".into(),
+            message: e.to_string(),
+        }
+    })?;
     let mut map = MultiHeightMap::with_stores(
-        map_config(),
+        map_config(config),
         levels.clone(),
         Point2::from(start.translation.vector),
         None,
@@ -137,7 +149,7 @@ pub fn map_drive(
     let blocks = store.list()?.len();
     let occupied_cells = export_levels(&store, &levels, &route, out)?;
     let manifest = MapManifest {
-        fingerprint: fingerprint(scenario)?,
+        fingerprint: fingerprint(scenario, config)?,
         scenario: scenario.name.clone(),
         scans,
         route_m: route.length_m(),
@@ -158,7 +170,7 @@ fn export_levels(
     levels: &Levels,
     _route: &RoutePath,
     out: &Path,
-) -> anyhow::Result<Vec<usize>> {
+) -> Result<Vec<usize>> {
     let spec = store.spec().clone();
     let indices = store.list()?;
     let (Some(x0), Some(x1), Some(y0), Some(y1)) = (

@@ -9,6 +9,8 @@
 use aircraft::spec::MotionLimits;
 use nalgebra::Isometry2;
 
+pub use autonomy::{Command, wrap_angle};
+
 /// Planar state of the vehicle.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct VehicleState {
@@ -29,15 +31,6 @@ impl VehicleState {
     pub fn world_from_vehicle(&self) -> Isometry2<f64> {
         Isometry2::new(nalgebra::Vector2::new(self.x_m, self.y_m), self.yaw_rad)
     }
-}
-
-/// What the controller asks for.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Command {
-    /// Target speed, m/s.
-    pub speed_m_s: f64,
-    /// Target steering angle, radians.
-    pub steering_rad: f64,
 }
 
 /// The kinematic bicycle of one vehicle.
@@ -92,16 +85,6 @@ impl Bicycle {
             state.y_m += (c0 - c1) / curvature;
         }
         state.yaw_rad = wrap_angle(state.yaw_rad + dyaw);
-    }
-}
-
-/// An angle wrapped to (-pi, pi].
-pub fn wrap_angle(a: f64) -> f64 {
-    let w = a.rem_euclid(std::f64::consts::TAU);
-    if w > std::f64::consts::PI {
-        w - std::f64::consts::TAU
-    } else {
-        w
     }
 }
 

@@ -50,7 +50,7 @@ pub fn encode(scan: &LidarScan, frame: Frame) -> Vec<u8> {
 }
 
 /// Writes a scan as PLY, atomically.
-pub fn write(scan: &LidarScan, frame: Frame, path: &Path) -> anyhow::Result<()> {
+pub fn write(scan: &LidarScan, frame: Frame, path: &Path) -> crate::Result<()> {
     Ok(mapper::write_atomically(path, &encode(scan, frame))?)
 }
 
@@ -68,30 +68,33 @@ pub struct PlyPoint {
 }
 
 /// Reads the points of a PLY written by [`encode`] (for tests and tools).
-pub fn decode(bytes: &[u8]) -> anyhow::Result<Vec<PlyPoint>> {
+pub fn decode(bytes: &[u8]) -> crate::Result<Vec<PlyPoint>> {
     const END: &[u8] = b"end_header\n";
+    let bad = |m: String| crate::Error::Invalid(format!("PLY: {m}"));
     let header_end = bytes
         .windows(END.len())
         .position(|w| w == END)
-        .ok_or_else(|| anyhow::anyhow!("no end_header"))?
+        .ok_or_else(|| bad("no end_header".into()))?
         + END.len();
-    let header = std::str::from_utf8(&bytes[..header_end])?;
-    anyhow::ensure!(
-        header.starts_with("ply\nformat binary_little_endian 1.0\n"),
-        "not a binary little-endian PLY"
-    );
+    let header = std::str::from_utf8(&bytes[..header_end])
+        .map_err(|e| bad(format!("header is not UTF-8: {e}")))?;
+    if !header.starts_with("ply\nformat binary_little_endian 1.0\n") {
+        return Err(bad("not a binary little-endian PLY".into()));
+    }
     let n: usize = header
         .lines()
         .find_map(|l| l.strip_prefix("element vertex "))
-        .ok_or_else(|| anyhow::anyhow!("no vertex count"))?
+        .ok_or_else(|| bad("no vertex count".into()))?
         .trim()
-        .parse()?;
+        .parse()
+        .map_err(|e| bad(format!("vertex count: {e}")))?;
     let body = &bytes[header_end..];
-    anyhow::ensure!(
-        body.len() == n * 20,
-        "{} bytes for {n} vertices of 20 bytes",
-        body.len()
-    );
+    if body.len() != n * 20 {
+        return Err(bad(format!(
+            "{} bytes for {n} vertices of 20 bytes",
+            body.len()
+        )));
+    }
     Ok(body
         .chunks_exact(20)
         .map(|c| {

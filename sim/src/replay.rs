@@ -27,7 +27,6 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context as _;
 use mapper::{Levels, MultiHeightMap};
 use nalgebra::{Isometry2, Isometry3, Point2, UnitQuaternion, Vector3};
 use rerun::RecordingStream;
@@ -39,7 +38,48 @@ use rerun::components::{Colormap, FillMode, TextLogLevel};
 use rerun::datatypes::{ChannelDatatype, ColorModel, Quaternion, Rgba32};
 use rerun::sink::{FileSink, GrpcSink, LogSink};
 
-use crate::run::{Event, Observer, RunReport, RunStart, ScanFrame, StepFrame};
+use crate::error::Error;
+use crate::observer::{Event, Observer, RunStart, ScanFrame, StepFrame};
+use crate::report::RunReport;
+
+type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// A bad option: the message names the flag.
+macro_rules! invalid {
+    ($($arg:tt)*) => { Error::Invalid(format!($($arg)*)) };
+}
+
+/// Returns a bad-option error unless `cond` holds.
+macro_rules! ensure {
+    ($cond:expr, $($arg:tt)*) => {
+        if !$cond {
+            return Err(invalid!($($arg)*));
+        }
+    };
+}
+
+/// A failure of Rerun or of the recording's file, with what was being done.
+trait Context<T> {
+    fn ctx<S: std::fmt::Display>(self, what: impl FnOnce() -> S) -> Result<T>;
+}
+
+impl<T, E: std::fmt::Display> Context<T> for std::result::Result<T, E> {
+    fn ctx<S: std::fmt::Display>(self, what: impl FnOnce() -> S) -> Result<T> {
+        self.map_err(|e| Error::Replay(format!("{}: {e}", what())))
+    }
+}
+
+impl From<rerun::RecordingStreamError> for Error {
+    fn from(e: rerun::RecordingStreamError) -> Self {
+        Error::Replay(e.to_string())
+    }
+}
+
+impl From<rerun::sink::SinkFlushError> for Error {
+    fn from(e: rerun::sink::SinkFlushError) -> Self {
+        Error::Replay(format!("flushing the recording: {e}"))
+    }
+}
 use crate::scene::{ObjectKind, Solid, SolidShape};
 use crate::world::Owner;
 
@@ -95,34 +135,34 @@ impl ReplayOptions {
     }
 
     /// Checks the options; errors name the command-line flag.
-    pub fn validate(&self) -> anyhow::Result<()> {
-        anyhow::ensure!(
+    pub fn validate(&self) -> Result<()> {
+        ensure!(
             self.scan_every >= 1,
             "--replay-scan-every {}: must be at least 1",
             self.scan_every
         );
-        anyhow::ensure!(
+        ensure!(
             self.point_stride >= 1,
             "--replay-point-stride {}: must be at least 1",
             self.point_stride
         );
-        anyhow::ensure!(
+        ensure!(
             self.maps_hz.is_finite() && self.maps_hz >= 0.0,
             "--replay-maps-hz {}: must be >= 0 (0: no maps)",
             self.maps_hz
         );
-        anyhow::ensure!(
+        ensure!(
             self.map_half_m.is_finite() && self.map_half_m > 0.0 && self.map_half_m <= 500.0,
             "--replay-map-half-m {}: must be in (0, 500] metres",
             self.map_half_m
         );
-        anyhow::ensure!(
+        ensure!(
             self.steps_hz.is_finite() && self.steps_hz > 0.0,
             "--replay-steps-hz {}: must be > 0",
             self.steps_hz
         );
         if let Some(path) = &self.record {
-            anyhow::ensure!(
+            ensure!(
                 path.file_name().is_some(),
                 "--record {}: not a file name",
                 path.display()
@@ -136,14 +176,14 @@ impl ReplayOptions {
 }
 
 /// The gRPC proxy URL of a `--connect` address.
-fn proxy_url(addr: &str) -> anyhow::Result<String> {
+fn proxy_url(addr: &str) -> Result<String> {
     let url = if addr.contains("://") {
         addr.to_string()
     } else {
         format!("rerun+http://{addr}/proxy")
     };
     url.parse::<rerun::external::re_uri::ProxyUri>()
-        .map_err(|e| anyhow::anyhow!("--connect {addr}: not a viewer address ({e}); expected host:port or rerun+http://host:port/proxy"))?;
+        .map_err(|e| invalid!("--connect {addr}: not a viewer address ({e}); expected host:port or rerun+http://host:port/proxy"))?;
     Ok(url)
 }
 
@@ -252,7 +292,7 @@ fn log_solid(
     solid: &Solid,
     local: bool,
     is_static: bool,
-) -> anyhow::Result<()> {
+) -> Result<()> {
     let color = kind_color(solid.kind);
     let (x, y, z0, yaw) = if local {
         (0.0, 0.0, solid.z_min_m, 0.0)
@@ -261,7 +301,7 @@ fn log_solid(
     };
     let h = solid.shape.height_m();
     let center = [x as f32, y as f32, (z0 + 0.5 * h) as f32];
-    let log = |what: &dyn rerun::AsComponents| -> anyhow::Result<()> {
+    let log = |what: &dyn rerun::AsComponents| -> Result<()> {
         if is_static {
             rec.log_static(path, what)?;
         } else {
@@ -316,12 +356,7 @@ fn cone_vertices(radius_m: f64, height_m: f64, x: f64, y: f64, z0: f64) -> Vec<[
 }
 
 /// A vehicle part (URDF collision primitive) in the vehicle frame.
-fn log_part(
-    rec: &RecordingStream,
-    path: &str,
-    part: &aircraft::Part,
-    color: Rgba32,
-) -> anyhow::Result<()> {
+fn log_part(rec: &RecordingStream, path: &str, part: &aircraft::Part, color: Rgba32) -> Result<()> {
     let pose: &Isometry3<f64> = &part.vehicle_from_part;
     let center = v3(&pose.translation.vector);
     let q = quat(&pose.rotation);
@@ -441,6 +476,8 @@ pub struct Replay {
     summary: ReplaySummary,
     levels: Option<Levels>,
     level_heights_m: Vec<f64>,
+    /// The run's obstacle test (to class the LiDAR's points as the mapper does).
+    obstacle_test: mapper::ObstacleTestParams,
     first_obstacle: usize,
     /// Last logged (active, x, y, yaw) of each run-time obstacle.
     obstacles: Vec<Option<(f64, f64, f64)>>,
@@ -453,7 +490,7 @@ pub struct Replay {
 
 impl Replay {
     /// Opens the recording file and/or the live viewer. Errors name the flag at fault.
-    pub fn new(options: &ReplayOptions, name: &str) -> anyhow::Result<Self> {
+    pub fn new(options: &ReplayOptions, name: &str) -> Result<Self> {
         options.validate()?;
         let mut sinks: Vec<Box<dyn LogSink>> = Vec::new();
         let mut file = None;
@@ -462,14 +499,13 @@ impl Replay {
                 Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
                 _ => PathBuf::from("."),
             };
-            std::fs::create_dir_all(&dir).with_context(|| {
-                format!("--record {}: creating {}", path.display(), dir.display())
-            })?;
+            std::fs::create_dir_all(&dir)
+                .ctx(|| format!("--record {}: creating {}", path.display(), dir.display()))?;
             let tmp = tempfile::Builder::new()
                 .prefix(".taxi-sim-replay-")
                 .suffix(".rrd.part")
                 .tempfile_in(&dir)
-                .with_context(|| {
+                .ctx(|| {
                     format!(
                         "--record {}: creating a file in {}",
                         path.display(),
@@ -478,7 +514,7 @@ impl Replay {
                 })?
                 .into_temp_path();
             let sink = FileSink::new(tmp.to_path_buf())
-                .with_context(|| format!("--record {}: opening the recording", path.display()))?;
+                .ctx(|| format!("--record {}: opening the recording", path.display()))?;
             sinks.push(Box::new(sink));
             file = Some((tmp, path.clone()));
         }
@@ -486,7 +522,7 @@ impl Replay {
         if options.spawn {
             let spawn = rerun::SpawnOptions::default();
             let info = rerun::spawn(&spawn).map_err(|e| {
-                anyhow::anyhow!(
+                invalid!(
                     "--spawn: could not start the Rerun viewer ({e}); install it with `pip install rerun-sdk=={}.*` (the viewer must match Rerun {RERUN_VERSION}) or use --record",
                     RERUN_VERSION
                 )
@@ -500,7 +536,7 @@ impl Replay {
             sinks.push(Box::new(grpc_sink(&url)?));
             streamed_to = Some(url);
         }
-        anyhow::ensure!(
+        ensure!(
             !sinks.is_empty(),
             "the replay needs --record, --spawn or --connect"
         );
@@ -520,7 +556,7 @@ impl Replay {
             .enabled(true)
             .batcher_config(batcher)
             .set_sinks(sinks)
-            .context("starting the Rerun recording")?;
+            .ctx(|| "starting the Rerun recording")?;
         Ok(Replay {
             options: options.clone(),
             rec,
@@ -531,6 +567,7 @@ impl Replay {
             },
             levels: None,
             level_heights_m: Vec::new(),
+            obstacle_test: mapper::ObstacleTestParams::default(),
             first_obstacle: 0,
             obstacles: Vec::new(),
             obstacle_paths: Vec::new(),
@@ -607,7 +644,7 @@ impl Replay {
     /// Sends the layout as the active blueprint, with the 3D view's camera behind the vehicle
     /// and following it. The Rust blueprint API cannot set a view's camera yet, so its messages
     /// are rendered into memory first and the camera is added to the same blueprint store.
-    fn send_blueprint(&self, levels: usize, start: &Isometry2<f64>) -> anyhow::Result<()> {
+    fn send_blueprint(&self, levels: usize, start: &Isometry2<f64>) -> Result<()> {
         use rerun::external::re_sdk_types::blueprint::archetypes::EyeControls3D;
         let (blueprint, world_path) = Self::blueprint(levels);
         let activation = rerun::blueprint::BlueprintActivation {
@@ -657,7 +694,7 @@ impl Replay {
         Ok(())
     }
 
-    fn log_static_world(&mut self, run: &RunStart<'_>) -> anyhow::Result<()> {
+    fn log_static_world(&mut self, run: &RunStart<'_>) -> Result<()> {
         let rec = &self.rec;
         rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
         let scene = run.scene;
@@ -816,7 +853,7 @@ impl Replay {
         Ok(())
     }
 
-    fn log_obstacles(&mut self, world: &crate::world::World) -> anyhow::Result<()> {
+    fn log_obstacles(&mut self, world: &crate::world::World) -> Result<()> {
         for (k, last) in self.obstacles.iter_mut().enumerate() {
             let i = self.first_obstacle + k;
             let path = &self.obstacle_paths[k];
@@ -851,13 +888,13 @@ impl Replay {
         Ok(())
     }
 
-    fn log_lidar(&mut self, frame: &ScanFrame<'_>) -> anyhow::Result<()> {
+    fn log_lidar(&mut self, frame: &ScanFrame<'_>) -> Result<()> {
         let Some(levels) = &self.levels else {
             return Ok(());
         };
-        let scan = &frame.lidar.scan;
+        let scan = &frame.revolution.scan;
         let beams = scan.beams();
-        let params = crate::mapping::map_config().obstacle_test;
+        let params = self.obstacle_test;
         let (mut positions, mut classes) = (Vec::new(), Vec::new());
         for (c, column) in scan
             .columns()
@@ -871,7 +908,7 @@ impl Replay {
                 let Some(r) = r else { continue };
                 let p = r.point_in_world;
                 positions.push([p.x as f32, p.y as f32, p.z as f32]);
-                let owner = frame.lidar.owners.get(c * beams + b).copied().flatten();
+                let owner = frame.owners.get(c * beams + b).copied().flatten();
                 let range_xy = (p.x - sensor.x).hypot(p.y - sensor.y);
                 let class = if matches!(owner, Some(Owner::VehiclePart(_))) {
                     CLASS_VEHICLE
@@ -913,7 +950,7 @@ impl Replay {
         Ok(())
     }
 
-    fn log_plan(&mut self, frame: &ScanFrame<'_>, candidates: bool) -> anyhow::Result<()> {
+    fn log_plan(&mut self, frame: &ScanFrame<'_>, candidates: bool) -> Result<()> {
         let strip = |poses: &[Isometry2<f64>], every: usize| -> Vec<[f32; 3]> {
             let mut out: Vec<[f32; 3]> = poses
                 .iter()
@@ -962,7 +999,7 @@ impl Replay {
         Ok(())
     }
 
-    fn log_maps(&mut self, map: &MultiHeightMap, center: Point2<f64>) -> anyhow::Result<()> {
+    fn log_maps(&mut self, map: &MultiHeightMap, center: Point2<f64>) -> Result<()> {
         let half_m = self.options.map_half_m;
         let merge = map.config().merge;
         for k in 0..map.levels().count() {
@@ -1037,7 +1074,7 @@ impl Replay {
     }
 
     /// Writes the footer of the recording, renames it into place and flushes the live viewer.
-    fn close(&mut self) -> anyhow::Result<()> {
+    fn close(&mut self) -> Result<()> {
         self.rec.finalize_deferred_sinks();
         if self.summary.streamed_to.is_some()
             && let Err(e) = self
@@ -1050,15 +1087,15 @@ impl Replay {
         }
         if let Some((tmp, dest)) = self.file.take() {
             let size = std::fs::metadata(&tmp)
-                .with_context(|| format!("--record {}: the recording vanished", dest.display()))?
+                .ctx(|| format!("--record {}: the recording vanished", dest.display()))?
                 .len();
-            anyhow::ensure!(
+            ensure!(
                 size > 0,
                 "--record {}: Rerun wrote nothing (see its messages above)",
                 dest.display()
             );
             set_readable(&tmp);
-            tmp.persist(&dest).with_context(|| {
+            tmp.persist(&dest).ctx(|| {
                 format!(
                     "--record {}: moving the recording into place",
                     dest.display()
@@ -1081,18 +1118,19 @@ fn set_readable(path: &Path) {
     let _ = path;
 }
 
-fn grpc_sink(url: &str) -> anyhow::Result<GrpcSink> {
+fn grpc_sink(url: &str) -> Result<GrpcSink> {
     let uri = url
         .parse::<rerun::external::re_uri::ProxyUri>()
-        .map_err(|e| anyhow::anyhow!("viewer address {url}: {e}"))?;
+        .map_err(|e| invalid!("viewer address {url}: {e}"))?;
     Ok(GrpcSink::new(uri))
 }
 
 impl Observer for Replay {
-    fn start(&mut self, run: &RunStart<'_>) -> anyhow::Result<()> {
+    fn start(&mut self, run: &RunStart<'_>) -> Result<()> {
         let levels = crate::mapping::levels_of(run.scenario)?;
         self.level_heights_m = levels.heights_m().to_vec();
         self.levels = Some(levels);
+        self.obstacle_test = run.config.mapping.map.obstacle_test;
         self.first_obstacle = run.first_obstacle;
         let obstacles = run.scene.solids.len().saturating_sub(run.first_obstacle);
         self.obstacles = vec![None; obstacles];
@@ -1120,7 +1158,7 @@ impl Observer for Replay {
         Ok(())
     }
 
-    fn scan(&mut self, frame: &ScanFrame<'_>) -> anyhow::Result<()> {
+    fn scan(&mut self, frame: &ScanFrame<'_>) -> Result<()> {
         self.time(frame.t_s);
         let full = self
             .scans_seen
@@ -1142,7 +1180,7 @@ impl Observer for Replay {
         Ok(())
     }
 
-    fn step(&mut self, frame: &StepFrame<'_>) -> anyhow::Result<()> {
+    fn step(&mut self, frame: &StepFrame<'_>) -> Result<()> {
         if frame.t_s + 1e-9 < self.next_step_t {
             return Ok(());
         }
@@ -1179,7 +1217,7 @@ impl Observer for Replay {
         Ok(())
     }
 
-    fn event(&mut self, t_s: f64, event: &Event) -> anyhow::Result<()> {
+    fn event(&mut self, t_s: f64, event: &Event) -> Result<()> {
         self.time(t_s);
         let (text, level) = match event {
             Event::Stop { route_s_m } => (
@@ -1218,7 +1256,7 @@ impl Observer for Replay {
         Ok(())
     }
 
-    fn finish(&mut self, report: &RunReport) -> anyhow::Result<()> {
+    fn finish(&mut self, report: &RunReport) -> Result<()> {
         self.time(report.sim_time_s);
         self.rec.log(
             "events",
@@ -1232,10 +1270,10 @@ impl Observer for Replay {
                 } else {
                     "expectations not met"
                 },
-                if report.interrupted {
-                    " (interrupted)"
-                } else {
-                    ""
+                match report.end {
+                    crate::judge::EndReason::Completed => "",
+                    crate::judge::EndReason::TimedOut => " (timed out)",
+                    crate::judge::EndReason::Interrupted => " (interrupted)",
                 }
             ))
             .with_level(if report.expectations_met {

@@ -84,7 +84,7 @@ impl ScenarioError {
     }
 
     /// An error from toml's deserializer: the field is read off the text around the span.
-    fn toml(file: &str, text: &str, err: &toml::de::Error) -> Self {
+    pub(crate) fn toml(file: &str, text: &str, err: &toml::de::Error) -> Self {
         let span = err.span().unwrap_or(0..0);
         let start = floor_boundary(text, span.start);
         let field = field_at(text, start);
@@ -552,7 +552,7 @@ pub struct RowSpec {
 pub const MAX_ROW_OBJECTS: usize = 10_000;
 
 /// What the vehicle must do about a run-time obstacle.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Expectation {
     /// Drive on with a part passing over it (a short cone under a wing), without contact.
@@ -563,6 +563,12 @@ pub enum Expectation {
     Stop,
     /// Anything, as long as nothing touches it.
     NoContact,
+}
+
+impl std::fmt::Display for Expectation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.as_str())
+    }
 }
 
 impl Expectation {

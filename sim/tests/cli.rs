@@ -79,3 +79,62 @@ fn scan_writes_a_ply_from_a_point_of_the_route() {
     assert_eq!(code, 2);
     assert!(stderr.contains("route is only"), "{stderr}");
 }
+
+/// `--laps 0` used to run one lap and exit 0 (`laps = 0` in a file exits 2): it is refused.
+#[test]
+fn run_with_laps_0_exits_2() {
+    let (code, _, stderr) = taxi_sim(&[
+        "run",
+        "../scenarios/straight_cone_under_wing.toml",
+        "--laps",
+        "0",
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("--laps 0"), "{stderr}");
+}
+
+/// `taxi-sim config` prints the defaults as TOML, which `--config` reads back; a mistake in a
+/// configuration file names the file, the line and the field, or the field and what is wrong.
+#[test]
+fn the_printed_default_configuration_reads_back_and_mistakes_are_located() {
+    let (code, stdout, stderr) = taxi_sim(&["config"]);
+    assert_eq!(code, 0, "{stderr}");
+    let parsed = sim::config::RunConfig::from_toml(&stdout, "printed").unwrap();
+    assert_eq!(parsed, sim::config::RunConfig::default());
+    assert!(stdout.contains("[pose_source]") && stdout.contains("schedule = \"overlapped\""));
+
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("run.toml");
+    std::fs::write(
+        &file,
+        "scan_hz = 10.0\n\n[autonomy]\nhorizon_m = 30.0\nhorizn = 3\n",
+    )
+    .unwrap();
+    let (code, _, stderr) = taxi_sim(&[
+        "run",
+        "../scenarios/straight_cone_under_wing.toml",
+        "--config",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("run.toml:5:") && stderr.contains("horizn"),
+        "{stderr}"
+    );
+    std::fs::write(
+        &file,
+        "[pose_source]\nkind = \"noisy_truth\"\nrate_hz = -5.0\n",
+    )
+    .unwrap();
+    let (code, _, stderr) = taxi_sim(&[
+        "run",
+        "../scenarios/straight_cone_under_wing.toml",
+        "--config",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("run.toml") && stderr.contains("pose_source.rate_hz = -5"),
+        "{stderr}"
+    );
+}

@@ -3,12 +3,14 @@
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::Ordering;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rerun::external::re_log_encoding::rrd::DecoderApp;
 use rerun::log::{Chunk, LogMsg};
+use sim::config::RunConfig;
+use sim::judge::EndReason;
 use sim::replay::{Replay, ReplayOptions};
-use sim::run::{RunOptions, run_observed};
+use sim::run::{RunHandles, RunSetup, run_with};
 use sim::scenario::Scenario;
 
 fn scenario(name: &str) -> Scenario {
@@ -47,10 +49,10 @@ fn a_short_run_is_recorded_completely_with_every_entity_path() {
     let s = scenario("straight_cone_under_wing");
     let dir = tempfile::tempdir().unwrap();
     let map_dir = dir.path().join("map");
-    sim::mapping::map_drive(&s, &map_dir, &mut |_, _| {}).unwrap();
+    sim::mapping::map_drive(&s, &RunConfig::default(), &map_dir, &mut |_, _| {}).unwrap();
     let out = dir.path().join("replay");
     let rrd = out.join("run.rrd");
-    let options = RunOptions::new(map_dir);
+    let setup = RunSetup::new(map_dir);
     let mut replay = Replay::new(
         &ReplayOptions {
             record: Some(rrd.clone()),
@@ -60,20 +62,23 @@ fn a_short_run_is_recorded_completely_with_every_entity_path() {
     )
     .unwrap();
     // 18 s of simulated time: past the cone (x = 60 m at 5 m/s), then Ctrl-C as a user would.
-    let stop = options.stop.clone();
-    let report = run_observed(
+    let stop = AtomicBool::new(false);
+    let report = run_with(
         &s,
-        &options,
-        &mut |p| {
-            if p.sim_time_s >= 18.0 {
-                stop.store(true, Ordering::Relaxed);
-            }
+        &setup,
+        RunHandles {
+            stop: Some(&stop),
+            progress: &mut |p| {
+                if p.sim_time_s >= 18.0 {
+                    stop.store(true, Ordering::Relaxed);
+                }
+            },
+            observer: &mut replay,
         },
-        &mut replay,
     )
     .unwrap();
     assert!(
-        report.interrupted && report.sim_time_s >= 18.0,
+        report.end == EndReason::Interrupted && report.sim_time_s >= 18.0,
         "{report:?}"
     );
     let (written, bytes) = replay.summary().recorded.clone().expect("a recording");

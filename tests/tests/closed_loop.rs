@@ -3,7 +3,10 @@
 
 use std::path::{Path, PathBuf};
 
-use sim::run::{RunOptions, RunReport, run};
+use sim::config::{RunConfig, Schedule};
+use sim::judge::EndReason;
+use sim::report::RunReport;
+use sim::run::{RunSetup, run};
 use sim::scenario::Scenario;
 
 fn scenario(name: &str) -> Scenario {
@@ -18,21 +21,21 @@ fn run_scenario(name: &str, map_dir: &Path) -> RunReport {
     run_scenario_with(name, map_dir, |o| o)
 }
 
-/// Like [`run_scenario`], with the run's options changed by `adjust`.
+/// Like [`run_scenario`], with the run's configuration changed by `adjust`.
 fn run_scenario_with(
     name: &str,
     map_dir: &Path,
-    adjust: impl FnOnce(RunOptions) -> RunOptions,
+    adjust: impl FnOnce(RunConfig) -> RunConfig,
 ) -> RunReport {
     let s = scenario(name);
-    sim::mapping::map_drive(&s, map_dir, &mut |_, _| {})
+    let config = adjust(RunConfig::default());
+    sim::mapping::map_drive(&s, &config, map_dir, &mut |_, _| {})
         .unwrap_or_else(|e| panic!("{name}: mapping drive: {e:#}"));
-    run(
-        &s,
-        &adjust(RunOptions::new(map_dir.to_path_buf())),
-        &mut |_| {},
-    )
-    .unwrap_or_else(|e| panic!("{name}: {e:#}"))
+    let setup = RunSetup {
+        config,
+        ..RunSetup::new(map_dir.to_path_buf())
+    };
+    run(&s, &setup).unwrap_or_else(|e| panic!("{name}: {e:#}"))
 }
 
 fn outcomes(r: &RunReport) -> Vec<(String, String)> {
@@ -41,7 +44,7 @@ fn outcomes(r: &RunReport) -> Vec<(String, String)> {
         .flat_map(|o| {
             o.passes
                 .iter()
-                .map(move |p| (o.id.clone(), p.outcome.clone()))
+                .map(move |p| (o.id.clone(), p.outcome.as_str().to_string()))
         })
         .collect()
 }
@@ -90,9 +93,9 @@ fn the_car_deviates_around_a_cone_in_its_path() {
 #[test]
 fn the_car_deviates_around_a_cone_in_its_path_with_sequential_sensing() {
     let dir = tempfile::tempdir().unwrap();
-    let r = run_scenario_with("cone_in_path_car", dir.path(), |o| RunOptions {
-        overlap_sensing: false,
-        ..o
+    let r = run_scenario_with("cone_in_path_car", dir.path(), |c| RunConfig {
+        schedule: Schedule::Sequential,
+        ..c
     });
     assert!(r.expectations_met, "{r:#?}");
     assert!(outcomes(&r).iter().all(|(_, o)| o == "deviated"), "{r:#?}");
@@ -136,7 +139,7 @@ fn the_jet_stops_for_a_cone_on_the_centreline_and_resumes_when_it_is_removed() {
 
 /// The car crosses 8 m ahead of the nose pod and drives on out of view; the cells it left just
 /// ahead of the left wing are hidden from the nose sensor by the airframe, so only forgetting
-/// (`RunOptions::forget_time_constant_s`) clears them and lets the jet go on.
+/// (`mapping.forgetting.time_constant_s`) clears them and lets the jet go on.
 #[test]
 fn a_crossing_vehicle_stops_the_jet_which_resumes_once_it_has_gone() {
     let dir = tempfile::tempdir().unwrap();
@@ -158,14 +161,17 @@ fn a_crossing_vehicle_stops_the_jet_which_resumes_once_it_has_gone() {
 #[test]
 fn without_forgetting_the_jet_waits_for_the_crossing_cars_hidden_trail() {
     let dir = tempfile::tempdir().unwrap();
-    let r = run_scenario_with("crossing_vehicle", dir.path(), |o| RunOptions {
-        forget_time_constant_s: None,
-        ..o
+    let r = run_scenario_with("crossing_vehicle", dir.path(), |mut c| {
+        c.mapping.forgetting.enabled = false;
+        c
     });
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     assert_eq!(r.stops.len(), 1);
     assert_eq!(r.stops[0].end_s, None, "never resumes");
-    assert!(!r.expectations_met && r.interrupted && r.laps_completed == 0);
+    assert!(!r.expectations_met && r.laps_completed == 0);
+    // It waited until the time limit: timed out, not interrupted (the bug: both were
+    // `interrupted`).
+    assert_eq!(r.end, EndReason::TimedOut);
 }
 
 #[test]
@@ -174,8 +180,7 @@ fn a_run_is_identical_for_the_same_seed() {
     let a = run_scenario("cone_in_path_car", dir.path());
     let b = run(
         &scenario("cone_in_path_car"),
-        &RunOptions::new(dir.path().to_path_buf()),
-        &mut |_| {},
+        &RunSetup::new(dir.path().to_path_buf()),
     )
     .unwrap();
     let strip = |r: &RunReport| {

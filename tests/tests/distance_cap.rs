@@ -3,10 +3,10 @@
 //! planner and the avoider choose the same paths and speeds as over maps of the whole area capped
 //! at 30 m.
 
+use autonomy::{AutonomyConfig, Behaviour, RoutePath, avoid, plan};
 use mapper::edt::EdtScratch;
 use mapper::{DistanceMap, DistanceMaps, GridGeometry};
 use nalgebra::Point2;
-use sim::autonomy::{AutonomyConfig, Behaviour, RoutePath, avoid, plan};
 
 const W: usize = 1250;
 const H: usize = 500;

@@ -8,7 +8,11 @@
 use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
-use sim::run::{RunOptions, RunReport, run};
+use sim::config::RunConfig;
+use sim::judge::PassOutcome;
+use sim::report::RunReport;
+use sim::run::{RunSetup, run};
+use sim::scenario::Expectation;
 use sim::scenario::Scenario;
 
 fn scenario(name: &str) -> Scenario {
@@ -19,13 +23,13 @@ fn scenario(name: &str) -> Scenario {
 }
 
 fn run_scenario(s: &Scenario, map_dir: &Path, laps: Option<u32>) -> RunReport {
-    sim::mapping::map_drive(s, map_dir, &mut |_, _| {})
+    sim::mapping::map_drive(s, &RunConfig::default(), map_dir, &mut |_, _| {})
         .unwrap_or_else(|e| panic!("{}: mapping drive: {e:#}", s.name));
-    let options = RunOptions {
+    let setup = RunSetup {
         laps,
-        ..RunOptions::new(map_dir.to_path_buf())
+        ..RunSetup::new(map_dir.to_path_buf())
     };
-    run(s, &options, &mut |_| {}).unwrap_or_else(|e| panic!("{}: {e:#}", s.name))
+    run(s, &setup).unwrap_or_else(|e| panic!("{}: {e:#}", s.name))
 }
 
 /// Rounds to a multiple of `step` (a summary must not change with the last bits of a float).
@@ -59,7 +63,7 @@ fn summary(r: &RunReport) -> Value {
             "passes": o.passes.iter().map(|p| format!(
                 "lap {} {} offset {} clearance {} {}",
                 p.lap,
-                p.outcome,
+                p.outcome.as_str(),
                 round(p.max_offset_m, 0.05),
                 p.min_clearance_m.iter().map(|d| round(*d, 0.05).to_string()).collect::<Vec<_>>().join("/"),
                 if p.met { "met" } else { "NOT MET" },
@@ -124,13 +128,16 @@ fn parking_lot_seven_laps_42_passes_no_contact() {
             match o.expected.as_str() {
                 // The wing passes over the short cones beside the path: no deviation.
                 "pass_under" => {
-                    assert!(p.outcome == "passed" && p.max_offset_m < 0.5, "{what}");
+                    assert!(
+                        p.outcome == PassOutcome::Passed && p.max_offset_m < 0.5,
+                        "{what}"
+                    );
                     assert!(
                         p.min_clearance_m[1] > 0.1,
                         "the wing clears the cone: {what}"
                     );
                 }
-                "deviate" => assert_eq!(p.outcome, "deviated", "{what}"),
+                "deviate" => assert_eq!(p.outcome, PassOutcome::Deviated, "{what}"),
                 other => panic!("unexpected expectation {other}"),
             }
         }
@@ -151,9 +158,12 @@ fn aerodrome_two_laps_wings_over_cones_stop_for_the_car_and_resume() {
         for p in &o.passes {
             let what = format!("{} lap {}: {p:?}", o.id, p.lap);
             assert!(p.met, "{what}");
-            if o.expected == "pass_under" {
+            if o.expected == Expectation::PassUnder {
                 // The jet never deviates: the wings pass over.
-                assert!(p.outcome == "passed" && p.max_offset_m < 0.5, "{what}");
+                assert!(
+                    p.outcome == PassOutcome::Passed && p.max_offset_m < 0.5,
+                    "{what}"
+                );
             }
         }
     }

@@ -2,12 +2,17 @@
 //! the report table and the JSON report.
 
 use std::path::PathBuf;
-use std::sync::atomic::Ordering;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context as _;
+use sim::config::{NoisyTruthConfig, PoseSourceConfig, RunConfig, Schedule};
+use sim::judge::EndReason;
 use sim::mapping::{default_map_dir, fresh_manifest, map_drive};
+use sim::observer::{NoObserver, Observer};
 use sim::replay::{Replay, ReplayOptions};
-use sim::run::{NoObserver, Observer, RunOptions, RunReport, run_observed};
+use sim::report::RunReport;
+use sim::run::{RunHandles, RunSetup, run_with};
 use sim::scenario::Scenario;
 
 /// Arguments of `taxi-sim map`.
@@ -18,6 +23,9 @@ pub struct MapArgs {
     /// Output directory (default: out/maps/<scenario file name>).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Run configuration (TOML) whose LiDAR and mapping settings the map is built with.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
 }
 
 /// Arguments of `taxi-sim run`.
@@ -25,9 +33,12 @@ pub struct MapArgs {
 pub struct RunArgs {
     /// The scenario file.
     pub scenario: PathBuf,
-    /// Laps (default: the scenario's).
+    /// Laps (default: the scenario's; at least 1).
     #[arg(long)]
     pub laps: Option<u32>,
+    /// Run configuration (TOML; `taxi-sim config` prints the defaults). Flags below override it.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
     /// Seed (default: the scenario's).
     #[arg(long)]
     pub seed: Option<u64>,
@@ -37,12 +48,13 @@ pub struct RunArgs {
     /// The offline map (default: out/maps/<scenario file name>; built there when missing or stale).
     #[arg(long)]
     pub map_dir: Option<PathBuf>,
-    /// Standard deviation of the pose noise given to the autonomy: position in metres.
-    #[arg(long, default_value_t = 0.0)]
-    pub pose_noise_m: f64,
-    /// Standard deviation of the pose noise given to the autonomy: heading in radians.
-    #[arg(long, default_value_t = 0.0)]
-    pub pose_noise_rad: f64,
+    /// Pose source `noisy_truth` with this white noise in position, metres (standard deviation,
+    /// each axis, at the source's rate); the configuration's other noisy-truth settings are kept.
+    #[arg(long)]
+    pub pose_noise_m: Option<f64>,
+    /// Pose source `noisy_truth` with this white noise in heading, radians (standard deviation).
+    #[arg(long)]
+    pub pose_noise_rad: Option<f64>,
     /// Map and plan each revolution the instant it is taken (no latency; slower), instead of
     /// while the LiDAR takes the next one.
     #[arg(long)]
@@ -88,12 +100,21 @@ impl RunArgs {
     }
 }
 
+/// The configuration in `path`, or the defaults.
+fn read_config(path: Option<&std::path::Path>) -> anyhow::Result<RunConfig> {
+    Ok(match path {
+        Some(p) => RunConfig::from_file(p)?,
+        None => RunConfig::default(),
+    })
+}
+
 fn build_map(
     scenario: &Scenario,
+    config: &RunConfig,
     dir: &std::path::Path,
 ) -> anyhow::Result<sim::mapping::MapManifest> {
     let progress = crate::bar(0, "mapping");
-    let manifest = map_drive(scenario, dir, &mut |done, total| {
+    let manifest = map_drive(scenario, config, dir, &mut |done, total| {
         progress.set_length(total as u64);
         progress.set_position(done as u64);
     })?;
@@ -108,7 +129,8 @@ pub fn map(args: &MapArgs) -> anyhow::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| default_map_dir(&scenario));
-    let m = build_map(&scenario, &dir)?;
+    let config = read_config(args.config.as_deref())?;
+    let m = build_map(&scenario, &config, &dir)?;
     crate::emit(&format!(
         "{}: mapped {:.0} m with {} revolutions into {} blocks; occupied cells per level {:?} (levels at {:?} m)\nwrote {}\n",
         scenario.name,
@@ -123,38 +145,35 @@ pub fn map(args: &MapArgs) -> anyhow::Result<()> {
 
 /// Runs `taxi-sim run`; returns whether every expectation held.
 pub fn run_cmd(args: &RunArgs) -> anyhow::Result<bool> {
+    anyhow::ensure!(
+        args.laps != Some(0),
+        "--laps 0: a run drives at least one lap"
+    );
     let scenario = Scenario::from_file(&args.scenario)?;
-    anyhow::ensure!(
-        args.pose_noise_m.is_finite() && args.pose_noise_m >= 0.0,
-        "--pose-noise-m {}: must be >= 0",
-        args.pose_noise_m
-    );
-    anyhow::ensure!(
-        args.pose_noise_rad.is_finite() && args.pose_noise_rad >= 0.0,
-        "--pose-noise-rad {}: must be >= 0",
-        args.pose_noise_rad
-    );
+    let config = run_config(args)?;
     let replay_options = args.replay_options();
     replay_options.validate()?;
     let dir = args
         .map_dir
         .clone()
         .unwrap_or_else(|| default_map_dir(&scenario));
-    if fresh_manifest(&scenario, &dir)?.is_none() {
+    if fresh_manifest(&scenario, &config, &dir)?.is_none() {
         eprintln!(
             "offline map {} is missing or stale: building it (mapping drive)",
             dir.display()
         );
-        build_map(&scenario, &dir)?;
+        build_map(&scenario, &config, &dir)?;
     }
-    let mut options = RunOptions::new(dir);
-    options.laps = args.laps;
-    options.seed = args.seed;
-    options.pose_noise = (args.pose_noise_m, args.pose_noise_rad);
-    options.overlap_sensing = !args.sequential_sensing;
-    let stop = options.stop.clone();
+    let setup = RunSetup {
+        laps: args.laps,
+        seed: args.seed,
+        config,
+        ..RunSetup::new(dir)
+    };
+    let stop = Arc::new(AtomicBool::new(false));
+    let stop_flag = stop.clone();
     // A second Ctrl-C falls through to the default handler only if this one could not be set.
-    let _ = ctrlc::set_handler(move || stop.store(true, Ordering::Relaxed));
+    let _ = ctrlc::set_handler(move || stop_flag.store(true, Ordering::Relaxed));
     let mut replay = if replay_options.enabled() {
         Some(Replay::new(&replay_options, &scenario.name)?)
     } else {
@@ -166,18 +185,21 @@ pub fn run_cmd(args: &RunArgs) -> anyhow::Result<bool> {
         None => &mut no_observer,
     };
     let progress = crate::bar(1000, "running");
-    let report = run_observed(
+    let report = run_with(
         &scenario,
-        &options,
-        &mut |p| {
-            progress.set_position((p.fraction * 1000.0) as u64);
-            progress.set_message(format!(
-                "lap {} t={:.0}s",
-                p.laps_completed + 1,
-                p.sim_time_s
-            ));
+        &setup,
+        RunHandles {
+            stop: Some(&stop),
+            progress: &mut |p| {
+                progress.set_position((p.fraction * 1000.0) as u64);
+                progress.set_message(format!(
+                    "lap {} t={:.0}s",
+                    p.laps_completed + 1,
+                    p.sim_time_s
+                ));
+            },
+            observer,
         },
-        observer,
     )?;
     progress.finish_and_clear();
     if let Some(replay) = &replay {
@@ -203,6 +225,31 @@ pub fn run_cmd(args: &RunArgs) -> anyhow::Result<bool> {
     }
     crate::emit(&table(&report))?;
     Ok(report.expectations_met)
+}
+
+/// The run's configuration: the file's (or the defaults), with the flags' overrides.
+fn run_config(args: &RunArgs) -> anyhow::Result<RunConfig> {
+    let mut config = read_config(args.config.as_deref())?;
+    if args.sequential_sensing {
+        config.schedule = Schedule::Sequential;
+    }
+    if args.pose_noise_m.is_some() || args.pose_noise_rad.is_some() {
+        let mut noisy = match &config.pose_source {
+            PoseSourceConfig::NoisyTruth(n) => n.clone(),
+            PoseSourceConfig::Truth => NoisyTruthConfig::default(),
+        };
+        if let Some(m) = args.pose_noise_m {
+            noisy.white_sigma_m = m;
+        }
+        if let Some(rad) = args.pose_noise_rad {
+            noisy.white_sigma_rad = rad;
+        }
+        config.pose_source = PoseSourceConfig::NoisyTruth(noisy);
+    }
+    config
+        .validate()
+        .map_err(|m| anyhow::anyhow!("run configuration (with the flags): {m}"))?;
+    Ok(config)
 }
 
 /// The human summary of a run.
@@ -231,7 +278,11 @@ pub fn table(r: &RunReport) -> String {
             .collect::<Vec<_>>(),
         r.stops.len(),
         r.contacts.len(),
-        if r.interrupted { "  (interrupted)" } else { "" }
+        match r.end {
+            EndReason::Completed => "",
+            EndReason::TimedOut => "  (timed out)",
+            EndReason::Interrupted => "  (interrupted)",
+        }
     );
     let _ = writeln!(
         t,

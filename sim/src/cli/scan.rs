@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::Context as _;
 use nalgebra::{Isometry2, Vector2};
-use sim::lidar::{Lidar, LidarConfig, SweepPoses};
+use sim::config::RunConfig;
+use sim::lidar::{Lidar, SweepPoses};
 use sim::ply::Frame;
 use sim::scenario::Scenario;
 use sim::world::World;
@@ -26,6 +27,9 @@ pub struct ScanArgs {
     /// Leave out the run-time obstacles (the world of the mapping drive).
     #[arg(long)]
     pub static_only: bool,
+    /// Run configuration (TOML) whose `[lidar]` settings to use (default: the defaults).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
 }
 
 /// Runs `taxi-sim scan`.
@@ -48,8 +52,12 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<()> {
         vehicle,
         &pose,
     );
-    let lidar = Lidar::new(LidarConfig::default(), vehicle.vehicle_from_lidar())
-        .map_err(anyhow::Error::msg)?;
+    let config = match &args.config {
+        Some(path) => RunConfig::from_file(path)?,
+        None => RunConfig::default(),
+    };
+    let lidar =
+        Lidar::new(config.lidar, vehicle.vehicle_from_lidar()).map_err(anyhow::Error::msg)?;
     let scan = lidar.scan(&world, &SweepPoses::still(pose), 0, scenario.seed);
     sim::ply::write(&scan, args.frame, &args.out)
         .with_context(|| format!("writing {}", args.out.display()))?;

@@ -1,0 +1,316 @@
+//! The driver of the stack under test: it holds the latest pose estimate (dead-reckoned from
+//! odometry between estimates), tracks its own progress along the route from that estimate,
+//! plans over the online map's distance maps, and turns the plan into a command.
+
+use mapper::{CollisionModel, MapError};
+use nalgebra::{Isometry2, Point2, Vector2};
+
+use crate::messages::{Command, Odometry, PoseEstimate};
+use crate::online_map::OnlineMap;
+use crate::planner::{AutonomyConfig, Behaviour, Plan, avoid, plan, pure_pursuit};
+use crate::route::{RoutePath, wrap_angle};
+
+/// Half length of the stretch of route searched around the last progress when the estimate is
+/// projected onto it, metres (so a circuit that passes near itself is followed in order).
+const PROGRESS_WINDOW_M: f64 = 30.0;
+
+/// The vehicle the driver drives, as the stack knows it.
+#[derive(Clone, Debug)]
+pub struct VehicleModel {
+    /// The height-tagged circles checked against the distance maps.
+    pub collision: CollisionModel,
+    /// Wheelbase, metres (pure pursuit and dead reckoning).
+    pub wheelbase_m: f64,
+    /// Braking the avoider counts on, m/s^2.
+    pub deceleration_m_s2: f64,
+    /// What the vehicle does about an obstacle in its way.
+    pub behaviour: Behaviour,
+}
+
+/// Wall time of a plan's two stages, seconds (for the run's time split).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PlanTimes {
+    /// Distance maps brought up to date around the estimate.
+    pub distance_maps_s: f64,
+    /// Planner and avoider.
+    pub planning_s: f64,
+}
+
+/// Planner, avoider, behaviour and follower over a route.
+pub struct Driver {
+    route: RoutePath,
+    vehicle: VehicleModel,
+    config: AutonomyConfig,
+    wanted_speed_m_s: f64,
+    /// Half side of the square of distance maps kept up to date around the estimate, metres.
+    distance_map_half_size_m: f64,
+    estimate: Option<PoseEstimate>,
+    last_odometry: Option<Odometry>,
+    /// Arc length of the estimate's projection onto the route at the last plan, metres (`None`:
+    /// not planned yet, the whole route is searched).
+    route_s_m: Option<f64>,
+    plan: Option<Plan>,
+    speed_command_m_s: f64,
+}
+
+impl Driver {
+    /// A driver of `vehicle` along `route` at `wanted_speed_m_s`, keeping the distance maps up
+    /// to date over a square of half side `distance_map_half_size_m` around its estimate.
+    pub fn new(
+        route: RoutePath,
+        vehicle: VehicleModel,
+        config: AutonomyConfig,
+        wanted_speed_m_s: f64,
+        distance_map_half_size_m: f64,
+    ) -> Self {
+        Driver {
+            route,
+            vehicle,
+            config,
+            wanted_speed_m_s,
+            distance_map_half_size_m,
+            estimate: None,
+            last_odometry: None,
+            route_s_m: None,
+            plan: None,
+            speed_command_m_s: 0.0,
+        }
+    }
+
+    /// A new pose estimate: it replaces the dead-reckoned one.
+    pub fn on_pose(&mut self, estimate: PoseEstimate) {
+        self.estimate = Some(estimate);
+    }
+
+    /// New odometry: the estimate is carried forward along the arc the last odometry describes
+    /// (kinematic bicycle), until the next pose estimate replaces it.
+    pub fn on_odometry(&mut self, odometry: Odometry) {
+        if let (Some(last), Some(est)) = (self.last_odometry, self.estimate.as_mut()) {
+            let dt = odometry.t_s - last.t_s;
+            if dt > 0.0 && est.t_s < odometry.t_s {
+                let ds = last.speed_m_s * dt;
+                let dyaw = ds * last.steering_rad.tan() / self.vehicle.wheelbase_m;
+                let p = est.world_from_vehicle;
+                let yaw = p.rotation.angle();
+                let mid = yaw + 0.5 * dyaw;
+                let step = Vector2::new(mid.cos(), mid.sin()) * ds;
+                est.world_from_vehicle =
+                    Isometry2::new(p.translation.vector + step, wrap_angle(yaw + dyaw));
+                est.t_s = odometry.t_s;
+            }
+        }
+        self.last_odometry = Some(odometry);
+    }
+
+    /// The vehicle was put back at the start of an open route (a new lap): progress and estimate
+    /// start over.
+    pub fn restart(&mut self) {
+        self.route_s_m = None;
+        self.estimate = None;
+        self.last_odometry = None;
+    }
+
+    /// Plans from the current estimate over `map`'s distance maps (brought up to date around the
+    /// estimate first): the planner's candidates and choice, then the avoider's speed. Without an
+    /// estimate the vehicle is held (speed 0).
+    pub fn plan(&mut self, map: &mut OnlineMap) -> Result<PlanTimes, MapError> {
+        let Some(estimate) = self.estimate else {
+            self.speed_command_m_s = 0.0;
+            return Ok(PlanTimes::default());
+        };
+        let t0 = std::time::Instant::now();
+        let here = Point2::from(estimate.world_from_vehicle.translation.vector);
+        map.map_mut()
+            .update_distance_maps_around(here, self.distance_map_half_size_m);
+        let t1 = std::time::Instant::now();
+        let (s, d) = match self.route_s_m {
+            Some(hint) => self.route.project(&here, hint, PROGRESS_WINDOW_M),
+            None => self.route.project(&here, 0.0, f64::INFINITY),
+        };
+        self.route_s_m = Some(s);
+        let checker = self.vehicle.collision.checker(map.map().distance_maps())?;
+        let previous = self.plan.as_ref().map_or(0.0, |p| p.chosen().offset_m);
+        let p = plan(
+            &checker,
+            &self.route,
+            s,
+            d,
+            previous,
+            self.vehicle.behaviour,
+            &self.config,
+        );
+        let (v, _) = avoid(
+            p.chosen(),
+            self.wanted_speed_m_s,
+            self.vehicle.deceleration_m_s2,
+            &self.config,
+        );
+        self.speed_command_m_s = v;
+        self.plan = Some(p);
+        Ok(PlanTimes {
+            distance_maps_s: (t1 - t0).as_secs_f64(),
+            planning_s: t1.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// The command now: the avoider's speed, and pure pursuit's steering onto the chosen path
+    /// from the current estimate (straight ahead before the first plan).
+    pub fn command(&self) -> Command {
+        let speed = self.last_odometry.map_or(0.0, |o| o.speed_m_s);
+        let steering = match (&self.plan, &self.estimate) {
+            (Some(p), Some(e)) => pure_pursuit(
+                &e.world_from_vehicle,
+                p.chosen(),
+                speed,
+                self.vehicle.wheelbase_m,
+                &self.config,
+            ),
+            _ => 0.0,
+        };
+        Command {
+            speed_m_s: self.speed_command_m_s,
+            steering_rad: steering,
+        }
+    }
+
+    /// The last plan (`None` before the first).
+    pub fn last_plan(&self) -> Option<&Plan> {
+        self.plan.as_ref()
+    }
+
+    /// The speed the avoider commands, m/s.
+    pub fn speed_command_m_s(&self) -> f64 {
+        self.speed_command_m_s
+    }
+
+    /// The current pose estimate (dead-reckoned since the last one).
+    pub fn estimate(&self) -> Option<&PoseEstimate> {
+        self.estimate.as_ref()
+    }
+
+    /// The route progress the driver tracks from its estimate, metres (`None` before the first
+    /// plan).
+    pub fn route_s_m(&self) -> Option<f64> {
+        self.route_s_m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::online_map::ForgettingConfig;
+    use mapper::{Circle, Levels, MapConfig, MultiHeightMap};
+
+    fn driver() -> Driver {
+        let route = RoutePath::new(&[Point2::new(0.0, 0.0), Point2::new(200.0, 0.0)], false);
+        let circle = |x_m| Circle {
+            x_m,
+            y_m: 0.0,
+            radius_m: 1.0,
+            level: 0,
+        };
+        let collision = CollisionModel::new(vec![circle(0.0), circle(2.0)], vec![0.0]).unwrap();
+        Driver::new(
+            route,
+            VehicleModel {
+                collision,
+                wheelbase_m: 2.5,
+                deceleration_m_s2: 3.0,
+                behaviour: Behaviour::Deviate,
+            },
+            AutonomyConfig::default(),
+            5.0,
+            40.0,
+        )
+    }
+
+    fn empty_map() -> OnlineMap {
+        let config = MapConfig {
+            block_cells: 100,
+            max_distance_m: 5.0,
+            ..MapConfig::default()
+        };
+        let levels = Levels::cumulative(vec![0.0]).unwrap();
+        let map = MultiHeightMap::new(config, levels, Point2::new(20.0, 0.0)).unwrap();
+        let self_filter = CollisionModel::new(
+            vec![mapper::Circle {
+                x_m: 1.0,
+                y_m: 0.0,
+                radius_m: 1.5,
+                level: 0,
+            }],
+            vec![0.0],
+        )
+        .unwrap();
+        OnlineMap::new(map, self_filter, ForgettingConfig::default(), 0.1)
+    }
+
+    fn at(t_s: f64, x: f64, y: f64, yaw: f64) -> PoseEstimate {
+        PoseEstimate {
+            t_s,
+            world_from_vehicle: Isometry2::new(Vector2::new(x, y), yaw),
+        }
+    }
+
+    #[test]
+    fn without_an_estimate_the_vehicle_is_held() {
+        let mut d = driver();
+        let mut map = empty_map();
+        d.plan(&mut map).unwrap();
+        assert!(d.last_plan().is_none());
+        assert_eq!(d.command(), Command::default());
+    }
+
+    /// The plan starts where the estimate is, and the route progress is the estimate's: the
+    /// driver has nothing else to go by (before, progress came from the true pose every step).
+    #[test]
+    fn plans_and_tracks_route_progress_from_its_estimate() {
+        let mut d = driver();
+        let mut map = empty_map();
+        d.on_pose(at(0.0, 10.0, 1.0, 0.0));
+        d.plan(&mut map).unwrap();
+        assert!((d.route_s_m().unwrap() - 10.0).abs() < 1e-9);
+        let first = d.last_plan().unwrap().chosen().poses[0];
+        assert!(
+            (first.translation.y - 1.0).abs() < 1e-9,
+            "starts at the estimate's offset: {first}"
+        );
+        assert_eq!(d.speed_command_m_s(), 5.0, "nothing in the way");
+        d.on_pose(at(0.1, 12.5, -0.5, 0.0));
+        d.plan(&mut map).unwrap();
+        assert!((d.route_s_m().unwrap() - 12.5).abs() < 1e-9);
+        // Steering back towards the route from the left: to the right (negative).
+        d.on_pose(at(0.2, 13.0, 1.0, 0.0));
+        d.plan(&mut map).unwrap();
+        d.on_odometry(Odometry {
+            t_s: 0.2,
+            speed_m_s: 5.0,
+            steering_rad: 0.0,
+        });
+        let c = d.command();
+        assert!(c.speed_m_s == 5.0 && c.steering_rad < 0.0, "{c:?}");
+    }
+
+    /// Between estimates the driver carries its estimate forward on odometry (a localizer slower
+    /// than the control loop); a new estimate replaces it.
+    #[test]
+    fn between_estimates_the_pose_is_dead_reckoned_on_odometry() {
+        let mut d = driver();
+        d.on_pose(at(0.0, 0.0, 0.0, 0.0));
+        let odo = |t_s, steering_rad| Odometry {
+            t_s,
+            speed_m_s: 2.0,
+            steering_rad,
+        };
+        d.on_odometry(odo(0.0, 0.0));
+        d.on_odometry(odo(0.5, 0.2));
+        let e = d.estimate().unwrap();
+        assert!((e.world_from_vehicle.translation.x - 1.0).abs() < 1e-12 && e.t_s == 0.5);
+        // 0.5 s more on the arc of steering 0.2: yaw grows by v t tan(0.2) / wheelbase.
+        d.on_odometry(odo(1.0, 0.2));
+        let yaw = d.estimate().unwrap().world_from_vehicle.rotation.angle();
+        assert!((yaw - 1.0 * 0.2f64.tan() / 2.5).abs() < 1e-12, "{yaw}");
+        d.on_pose(at(1.0, 7.0, 0.0, 0.0));
+        assert_eq!(d.estimate().unwrap().world_from_vehicle.translation.x, 7.0);
+    }
+}

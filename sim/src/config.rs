@@ -1,0 +1,338 @@
+//! The run configuration: everything that decides what a run does besides the scenario and the
+//! seed - rates, the LiDAR, mapping and forgetting, the planner and avoider, the pose source, the
+//! collision model, faults - as one typed value, read from and written to TOML (`taxi-sim run
+//! --config FILE`, `taxi-sim config`). A report records the configuration it ran with.
+
+use autonomy::{AutonomyConfig, ForgettingConfig};
+use mapper::{Circle, CollisionModel, MapConfig};
+use serde::{Deserialize, Serialize};
+
+use crate::error::Error;
+use crate::lidar::LidarConfig;
+
+/// One run's configuration. Every field has a documented default (`RunConfig::default()`), so a
+/// file need only hold what it changes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RunConfig {
+    /// Physics rate (vehicle motion, ground truth, moving obstacles), Hz. Default 100.
+    pub physics_hz: f64,
+    /// LiDAR revolution, map update and planning rate, Hz. Default 10.
+    pub scan_hz: f64,
+    /// When a revolution is mapped and planned from. Default `overlapped`.
+    pub schedule: Schedule,
+    /// The synthetic HDL-32E.
+    pub lidar: LidarConfig,
+    /// The online map, its distance maps and forgetting.
+    pub mapping: MappingConfig,
+    /// Planner, avoider and follower.
+    pub autonomy: AutonomyConfig,
+    /// Where the stack's pose estimate comes from. Default `truth`.
+    pub pose_source: PoseSourceConfig,
+    /// The vehicle's circle model the stack checks. Default: the vehicle's own fit.
+    pub collision_model: CollisionModelConfig,
+    /// Faults injected into the loop. None are modelled yet: the table exists so that files and
+    /// reports keep their shape when they are.
+    pub faults: FaultsConfig,
+}
+
+impl Default for RunConfig {
+    fn default() -> Self {
+        RunConfig {
+            physics_hz: 100.0,
+            scan_hz: 10.0,
+            schedule: Schedule::Overlapped,
+            lidar: LidarConfig::default(),
+            mapping: MappingConfig::default(),
+            autonomy: AutonomyConfig::default(),
+            pose_source: PoseSourceConfig::Truth,
+            collision_model: CollisionModelConfig::Vehicle,
+            faults: FaultsConfig::default(),
+        }
+    }
+}
+
+/// When each revolution is mapped and planned from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Schedule {
+    /// As on the vehicle: a revolution is mapped while the next ten physics steps run and the
+    /// LiDAR takes the next one; the plan is made from the pose now over a map one revolution
+    /// (0.1 s) old.
+    #[default]
+    Overlapped,
+    /// Each revolution mapped and planned the instant it is taken (no latency; slower).
+    Sequential,
+}
+
+/// The online map, its distance maps and forgetting.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MappingConfig {
+    /// The map (cells, blocks, log-odds, obstacle test, self-hit margin). Default: the mapper's
+    /// defaults with a 1.5 m self-hit margin. The offline map is built with the same settings;
+    /// its fingerprint holds them. `max_distance_m` is set by the run from the vehicle and planner
+    /// (`run::distance_cap_m`).
+    pub map: MapConfig,
+    /// Distance maps are kept over a square of this half side around the estimate, metres.
+    /// Default `None`: `run::distance_map_half_size_m` of the vehicle and planner.
+    pub distance_map_half_size_m: Option<f64>,
+    /// How live occupancy no longer seen fades to the offline map.
+    pub forgetting: ForgettingConfig,
+}
+
+impl Default for MappingConfig {
+    fn default() -> Self {
+        MappingConfig {
+            map: MapConfig {
+                self_hit_margin_m: 1.5,
+                ..MapConfig::default()
+            },
+            distance_map_half_size_m: None,
+            forgetting: ForgettingConfig::default(),
+        }
+    }
+}
+
+/// Where the stack's pose estimate comes from.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum PoseSourceConfig {
+    /// The true pose at every physics step.
+    #[default]
+    Truth,
+    /// The true pose with a seeded error, published at a localizer's rate: a first-order
+    /// Gauss-Markov drift (the slowly wandering error of a localizer) plus white noise (its
+    /// jitter), both in the vehicle frame (along track, across track, heading).
+    NoisyTruth(NoisyTruthConfig),
+}
+
+/// The noisy-truth pose source's error model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NoisyTruthConfig {
+    /// Publication rate, Hz. Default 20 (between estimates the stack dead-reckons on odometry).
+    pub rate_hz: f64,
+    /// Steady-state standard deviation of the drift in position, metres (each axis). Default 0.
+    pub drift_sigma_m: f64,
+    /// Steady-state standard deviation of the drift in heading, radians. Default 0.
+    pub drift_sigma_rad: f64,
+    /// Correlation time of the drift, seconds. Default 5.
+    pub drift_time_constant_s: f64,
+    /// Standard deviation of the white noise in position, metres (each axis). Default 0.
+    pub white_sigma_m: f64,
+    /// Standard deviation of the white noise in heading, radians. Default 0.
+    pub white_sigma_rad: f64,
+}
+
+impl Default for NoisyTruthConfig {
+    fn default() -> Self {
+        NoisyTruthConfig {
+            rate_hz: 20.0,
+            drift_sigma_m: 0.0,
+            drift_sigma_rad: 0.0,
+            drift_time_constant_s: 5.0,
+            white_sigma_m: 0.0,
+            white_sigma_rad: 0.0,
+        }
+    }
+}
+
+/// The vehicle's circle model the stack checks against the distance maps.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "source", rename_all = "snake_case", deny_unknown_fields)]
+pub enum CollisionModelConfig {
+    /// Fitted from the vehicle's URDF with its sidecar's fit options.
+    #[default]
+    Vehicle,
+    /// Fitted from the vehicle's URDF with these options (a tuning run's, without editing the
+    /// vehicle's files).
+    Fit {
+        /// The fit options.
+        options: aircraft::FitOptions,
+    },
+    /// These circles as they are, at the vehicle's heights of interest.
+    Circles {
+        /// `x_m`, `y_m`, `radius_m`, `level` each.
+        circles: Vec<Circle>,
+    },
+}
+
+/// Faults injected into the loop: none are modelled yet.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FaultsConfig {}
+
+impl RunConfig {
+    /// Reads a configuration from TOML text; `origin` names it in errors (a file's path), which
+    /// give the line, column and field.
+    pub fn from_toml(text: &str, origin: &str) -> Result<Self, Error> {
+        let config: RunConfig = toml::from_str(text)
+            .map_err(|e| crate::scenario::ScenarioError::toml(origin, text, &e))?;
+        config.validate().map_err(|message| Error::Config {
+            origin: origin.to_string(),
+            message,
+        })?;
+        Ok(config)
+    }
+
+    /// Reads a configuration file.
+    pub fn from_file(path: &std::path::Path) -> Result<Self, Error> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            what: "reading the run configuration",
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_toml(&text, &path.display().to_string())
+    }
+
+    /// The configuration as TOML.
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).unwrap_or_else(|e| format!("# not representable: {e}\n"))
+    }
+
+    /// Checks the values a run relies on; the message names the field.
+    pub fn validate(&self) -> Result<(), String> {
+        let positive = |field: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{field} = {v}: must be a finite number > 0"))
+            }
+        };
+        let non_negative = |field: &str, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{field} = {v}: must be a finite number >= 0"))
+            }
+        };
+        positive("physics_hz", self.physics_hz)?;
+        positive("scan_hz", self.scan_hz)?;
+        if self.scan_hz > self.physics_hz {
+            return Err(format!(
+                "scan_hz = {} is above physics_hz = {}: a revolution needs at least one physics step",
+                self.scan_hz, self.physics_hz
+            ));
+        }
+        if let Some(h) = self.mapping.distance_map_half_size_m {
+            positive("mapping.distance_map_half_size_m", h)?;
+        }
+        positive(
+            "mapping.forgetting.time_constant_s",
+            self.mapping.forgetting.time_constant_s,
+        )?;
+        positive(
+            "mapping.forgetting.half_size_m",
+            self.mapping.forgetting.half_size_m,
+        )?;
+        let a = &self.autonomy;
+        positive("autonomy.horizon_m", a.horizon_m)?;
+        positive("autonomy.step_m", a.step_m)?;
+        positive("autonomy.offset_step_m", a.offset_step_m)?;
+        positive("autonomy.transition_m", a.transition_m)?;
+        non_negative("autonomy.max_offset_m", a.max_offset_m)?;
+        non_negative("autonomy.planner_safety_m", a.planner_safety_m as f64)?;
+        non_negative("autonomy.avoider_safety_m", a.avoider_safety_m as f64)?;
+        if let PoseSourceConfig::NoisyTruth(n) = &self.pose_source {
+            positive("pose_source.rate_hz", n.rate_hz)?;
+            positive("pose_source.drift_time_constant_s", n.drift_time_constant_s)?;
+            for (field, v) in [
+                ("pose_source.drift_sigma_m", n.drift_sigma_m),
+                ("pose_source.drift_sigma_rad", n.drift_sigma_rad),
+                ("pose_source.white_sigma_m", n.white_sigma_m),
+                ("pose_source.white_sigma_rad", n.white_sigma_rad),
+            ] {
+                non_negative(field, v)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The circle model this configuration gives `vehicle`.
+    pub fn collision_model(&self, vehicle: &aircraft::Vehicle) -> Result<CollisionModel, Error> {
+        let heights = &vehicle.spec.heights_of_interest_m;
+        Ok(match &self.collision_model {
+            CollisionModelConfig::Vehicle => vehicle.fit()?.model,
+            CollisionModelConfig::Fit { options } => vehicle.fit_with(heights, options)?.model,
+            CollisionModelConfig::Circles { circles } => {
+                CollisionModel::new(circles.clone(), heights.clone()).map_err(|e| {
+                    Error::Config {
+                        origin: "collision_model.circles".into(),
+                        message: e.to_string(),
+                    }
+                })?
+            }
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_configuration_survives_toml_both_ways() {
+        let mut c = RunConfig {
+            schedule: Schedule::Sequential,
+            pose_source: PoseSourceConfig::NoisyTruth(NoisyTruthConfig {
+                drift_sigma_m: 0.2,
+                white_sigma_rad: 0.01,
+                ..Default::default()
+            }),
+            collision_model: CollisionModelConfig::Circles {
+                circles: vec![Circle {
+                    x_m: 1.0,
+                    y_m: -0.5,
+                    radius_m: 1.2,
+                    level: 0,
+                }],
+            },
+            ..RunConfig::default()
+        };
+        c.mapping.forgetting.enabled = false;
+        c.autonomy.planner_safety_m = 0.8;
+        let text = c.to_toml();
+        assert_eq!(RunConfig::from_toml(&text, "t").unwrap(), c, "{text}");
+        let fit = RunConfig {
+            collision_model: CollisionModelConfig::Fit {
+                options: aircraft::FitOptions {
+                    max_circles: Some(12),
+                    ..Default::default()
+                },
+            },
+            ..RunConfig::default()
+        };
+        assert_eq!(RunConfig::from_toml(&fit.to_toml(), "t").unwrap(), fit);
+    }
+
+    #[test]
+    fn a_partial_file_keeps_the_defaults_and_bad_values_name_their_field() {
+        let c = RunConfig::from_toml("[autonomy]\nplanner_safety_m = 0.9\n", "f.toml").unwrap();
+        assert_eq!(c.autonomy.planner_safety_m, 0.9);
+        assert_eq!(c.autonomy.horizon_m, AutonomyConfig::default().horizon_m);
+        assert_eq!(c.physics_hz, 100.0);
+        for (text, field) in [
+            ("scan_hz = 0.0\n", "scan_hz"),
+            ("scan_hz = 200.0\n", "scan_hz"),
+            (
+                "[mapping.forgetting]\ntime_constant_s = -1.0\n",
+                "mapping.forgetting.time_constant_s",
+            ),
+            (
+                "[pose_source]\nkind = \"noisy_truth\"\nwhite_sigma_m = nan\n",
+                "pose_source.white_sigma_m",
+            ),
+            ("[autonomy]\nstep_m = 0.0\n", "autonomy.step_m"),
+        ] {
+            let e = RunConfig::from_toml(text, "f.toml")
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with("f.toml") && e.contains(field), "{text}: {e}");
+        }
+        let e = RunConfig::from_toml("[pose_source]\nkind = \"gps\"\n", "f.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("f.toml:2:") && e.contains("gps"), "{e}");
+    }
+}

@@ -1,0 +1,55 @@
+//! The `sim` library's errors: typed, each naming the file, field or option at fault.
+
+use std::path::PathBuf;
+
+/// What can go wrong in the simulator's library.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A scenario or run configuration file is wrong (file, line, column, field).
+    #[error(transparent)]
+    Scenario(#[from] crate::scenario::ScenarioError),
+    /// A value of the run configuration is wrong.
+    #[error("{origin}: {message}")]
+    Config {
+        /// The file or field it came from.
+        origin: String,
+        /// What is wrong, naming the field.
+        message: String,
+    },
+    /// The mapper refused something (a bad scan, a bad block file, a bad model).
+    #[error(transparent)]
+    Map(#[from] mapper::MapError),
+    /// A vehicle description could not be read or fitted.
+    #[error(transparent)]
+    Vehicle(#[from] aircraft::Error),
+    /// A file could not be read or written.
+    #[error("{what}: {}: {source}", path.display())]
+    Io {
+        /// What was being done.
+        what: &'static str,
+        /// The file or directory.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A file the simulator wrote earlier is not what it should be (a map manifest, a PLY).
+    #[error("{}: {message}", path.display())]
+    BadFile {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong and what to do.
+        message: String,
+    },
+    /// A bad argument or option (the message names it).
+    #[error("{0}")]
+    Invalid(String),
+    /// The replay (Rerun) failed.
+    #[error("replay: {0}")]
+    Replay(String),
+    /// JSON could not be written.
+    #[error("JSON: {0}")]
+    Json(#[from] serde_json::Error),
+}
+
+/// The library's result.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

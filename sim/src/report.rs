@@ -1,0 +1,74 @@
+//! A run's report: the judge's verdicts, the configuration it ran with, why it ended, and where
+//! the wall time went.
+
+use serde::Serialize;
+
+use crate::config::RunConfig;
+use crate::judge::{EndReason, ObstacleReport, Stop};
+use crate::world::Contact;
+
+/// What a run did.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunReport {
+    /// Scenario name.
+    pub scenario: String,
+    /// Seed used.
+    pub seed: u64,
+    /// True when every expectation held and every lap was completed.
+    pub expectations_met: bool,
+    /// Why the run ended: `completed`, `timed_out` or `interrupted`.
+    pub end: EndReason,
+    /// Laps asked for.
+    pub laps: u32,
+    /// Laps completed.
+    pub laps_completed: u32,
+    /// Lap times, seconds.
+    pub lap_times_s: Vec<f64>,
+    /// Ground-truth contacts.
+    pub contacts: Vec<Contact>,
+    /// Per run-time obstacle.
+    pub obstacles: Vec<ObstacleReport>,
+    /// Stops.
+    pub stops: Vec<Stop>,
+    /// Smallest ground-truth clearance per level to any object, metres.
+    pub min_clearance_m: Vec<f64>,
+    /// The scenario's danger distance, metres (`None`: not stated): a pass closer than this to
+    /// its obstacle, at any level, does not meet its expectation.
+    pub danger_distance_m: Option<f64>,
+    /// Simulated time, seconds.
+    pub sim_time_s: f64,
+    /// Wall time, seconds.
+    pub wall_time_s: f64,
+    /// Simulated seconds per wall second.
+    pub real_time_factor: f64,
+    /// Where the wall time went, seconds: LiDAR, mapping, distance maps, planning, physics.
+    pub time_split_s: TimeSplit,
+    /// The configuration the run ran with.
+    pub config: RunConfig,
+}
+
+/// Wall time per stage, seconds.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct TimeSplit {
+    /// Ray casting.
+    pub lidar: f64,
+    /// Scan insertion.
+    pub mapping: f64,
+    /// Distance maps.
+    pub distance_maps: f64,
+    /// Planner and avoider.
+    pub planning: f64,
+    /// Motion, ground truth, obstacles.
+    pub physics: f64,
+}
+
+/// Progress of a run, for a progress bar.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Simulated time, seconds.
+    pub sim_time_s: f64,
+    /// Laps completed.
+    pub laps_completed: u32,
+    /// Fraction of the whole run done, 0..1.
+    pub fraction: f64,
+}
