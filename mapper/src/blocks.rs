@@ -21,8 +21,11 @@
 //!
 //! A file is written to a temporary file in the same directory and renamed over the target, so
 //! a reader never sees half a block. Reading checks the size, magic, version, that the header
-//! matches the map being loaded into, and the checksum; any mismatch is an error naming the file
-//! and the field.
+//! matches the map being loaded into, the checksum, and that every value is one the map can hold
+//! (a valid checksum only says the bytes are the ones written): a log-odds is NaN (unknown) or
+//! within the map's clamp `+-l_max` (so never infinite); a remission sum and sum of squares are
+//! finite, the sum of squares is not negative, and a cell without samples has zero sums. Any
+//! mismatch is an error naming the file and the field (with the level and cell of a bad value).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -53,6 +56,8 @@ pub struct BlockSpec {
     pub resolution_m: f64,
     /// Levels of the map.
     pub levels: Levels,
+    /// The map's log-odds clamp (`OccupancyParams::l_max`): every known cell is within +-this.
+    pub l_max: f32,
 }
 
 impl BlockSpec {
@@ -228,11 +233,73 @@ pub fn decode_block(spec: &BlockSpec, bytes: &[u8], path: &Path) -> Result<Block
             count: u32::from_le_bytes([b[8], b[9], b[10], b[11]]),
         })
         .collect();
-    Ok(Block {
+    let block = Block {
         index,
         levels,
         remission,
-    })
+    };
+    match bad_value(spec, &block) {
+        Some(why) => Err(bad(why)),
+        None => Ok(block),
+    }
+}
+
+/// The first value of a block no map of `spec` can hold, described with its field, level and
+/// cell; `None` when every value is possible.
+///
+/// A log-odds is NaN (unknown, by design) or within `+-spec.l_max`: insertion clamps every update
+/// to it, free-space walks stop at `-l_max`, forgetting moves a cell toward its prior, and only
+/// live cells are saved, so an infinite or larger value was never written by a map. A remission
+/// cell is a sum and a sum of squares of finite intensities and their count
+/// ([`RemissionCell::add`]): the sums are finite, the sum of squares is not negative, and both
+/// are zero when the count is (a count cannot be negative: it is a `u32`). The sum itself may be
+/// negative: scans require finite intensities only, 0..1 is a convention.
+fn bad_value(spec: &BlockSpec, block: &Block) -> Option<String> {
+    let side = spec.side;
+    let at = |i: usize| format!("cell {i} (row {}, column {})", i / side, i % side);
+    for (k, level) in block.levels.iter().enumerate() {
+        // NaN fails the comparison but is legitimate; test the fast common case first.
+        let bad = level
+            .iter()
+            .position(|v| !(v.abs() <= spec.l_max || v.is_nan()));
+        if let Some(i) = bad {
+            let v = level[i];
+            let what = if v.is_infinite() {
+                "infinite"
+            } else {
+                "beyond the map's log-odds clamp"
+            };
+            return Some(format!(
+                "field `log_odds` of level {k}, {}: {v} is {what} (a cell is NaN = unknown or \
+                 within +-{} = occupancy.l_max): no map with this clamp writes it",
+                at(i),
+                spec.l_max
+            ));
+        }
+    }
+    for (i, r) in block.remission.iter().enumerate() {
+        let why = if !r.sum.is_finite() {
+            format!("field `remission.sum`, {}: {} is not finite", at(i), r.sum)
+        } else if !r.sum_sq.is_finite() || r.sum_sq < 0.0 {
+            format!(
+                "field `remission.sum_sq`, {}: {} is not a sum of squares (finite, >= 0)",
+                at(i),
+                r.sum_sq
+            )
+        } else if r.count == 0 && (r.sum != 0.0 || r.sum_sq != 0.0) {
+            format!(
+                "field `remission.count`, {}: 0 samples but sum {} and sum of squares {} \
+                 (a cell without samples has zero sums)",
+                at(i),
+                r.sum,
+                r.sum_sq
+            )
+        } else {
+            continue;
+        };
+        return Some(why);
+    }
+    None
 }
 
 /// Writes `bytes` to `path` atomically: a temporary file in the same directory, synced, then renamed.

@@ -407,6 +407,7 @@ impl MultiHeightMap {
             side: config.block_cells,
             resolution_m: config.resolution_m,
             levels: levels.clone(),
+            l_max: config.occupancy.l_max,
         };
         let prior_store = prior_dir
             .map(|d| BlockStore::open(d, spec.clone()))

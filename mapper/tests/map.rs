@@ -437,6 +437,91 @@ fn bad_block_files_are_errors_that_name_the_file() {
     assert!(err.contains("heights[1]"), "{err}");
 }
 
+/// A block whose checksum is valid but which holds a value no map writes (an infinite log-odds,
+/// one beyond the clamp, a non-finite remission sum...) is refused, naming the file, the field,
+/// the level and the cell; NaN log-odds (unknown) and values at the clamp still load.
+#[test]
+fn block_with_valid_checksum_and_non_finite_value_is_rejected() {
+    let dir = tempfile::tempdir().unwrap();
+    let levels = Levels::cumulative(vec![0.0, 0.7]).unwrap();
+    let mut map = map_with(levels.clone());
+    insert(&mut map, &scene(vec![Solid::post(4.0, 4.0, 0.3, 1.0)]), 1);
+    let spec = map.block_spec().clone();
+    let store = mapper::BlockStore::open(dir.path(), spec.clone()).unwrap();
+    map.save_live(&store).unwrap();
+    let index = mapper::BlockIndex { x: 0, y: 0 };
+    let path = store.path(index);
+    let good = std::fs::read(&path).unwrap();
+    let cells = spec.side * spec.side;
+    let header = 48 + 8 * levels.count();
+    // A cell with remission samples (a ground return), so a zeroed count contradicts its sums.
+    let original = map
+        .live_blocks()
+        .into_iter()
+        .find(|b| b.index == index)
+        .unwrap();
+    let cell = original
+        .remission
+        .iter()
+        .position(|r| r.count > 0 && r.sum != 0.0)
+        .unwrap();
+    let (row, column) = (cell / spec.side, cell % spec.side);
+    let log_odds_at = |k: usize| header + 4 * (k * cells + cell);
+    let remission_at = header + 4 * cells * levels.count() + 12 * cell;
+    // Writes `value` at byte `offset` with a recomputed (valid) checksum and loads the block.
+    let load = |offset: usize, value: [u8; 4]| {
+        let mut bytes = good.clone();
+        bytes[offset..offset + 4].copy_from_slice(&value);
+        let n = bytes.len();
+        let crc = crc32fast::hash(&bytes[..n - 4]);
+        bytes[n - 4..].copy_from_slice(&crc.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        store.load(index).map(|_| ()).map_err(|e| e.to_string())
+    };
+    let names = |e: &str, field: &str| {
+        e.contains(&path.display().to_string())
+            && e.contains(field)
+            && e.contains(&format!("cell {cell} (row {row}, column {column})"))
+    };
+    let e = load(log_odds_at(1), f32::INFINITY.to_le_bytes()).unwrap_err();
+    assert!(
+        names(&e, "`log_odds` of level 1") && e.contains("inf is infinite"),
+        "{e}"
+    );
+    let e = load(log_odds_at(0), f32::NEG_INFINITY.to_le_bytes()).unwrap_err();
+    assert!(names(&e, "`log_odds` of level 0"), "{e}");
+    let e = load(log_odds_at(0), 40.0f32.to_le_bytes()).unwrap_err();
+    assert!(
+        names(&e, "`log_odds` of level 0") && e.contains("clamp") && e.contains("37"),
+        "{e}"
+    );
+    let e = load(remission_at, f32::NAN.to_le_bytes()).unwrap_err();
+    assert!(names(&e, "`remission.sum`"), "{e}");
+    let e = load(remission_at + 4, (-1.0f32).to_le_bytes()).unwrap_err();
+    assert!(names(&e, "`remission.sum_sq`"), "{e}");
+    let e = load(remission_at + 8, 0u32.to_le_bytes()).unwrap_err();
+    assert!(
+        names(&e, "`remission.count`") && e.contains("0 samples"),
+        "{e}"
+    );
+    // The map refuses to open over such a prior, naming the file too.
+    load(log_odds_at(1), f32::INFINITY.to_le_bytes()).unwrap_err();
+    let err = MultiHeightMap::with_stores(
+        MapConfig::default(),
+        levels.clone(),
+        Point2::origin(),
+        Some(dir.path()),
+        None,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(names(&err, "`log_odds` of level 1"), "{err}");
+    // What a map can write still loads: unknown (NaN, any payload) and the clamp itself.
+    load(log_odds_at(1), f32::NAN.to_le_bytes()).unwrap();
+    load(log_odds_at(1), (-37.0f32).to_le_bytes()).unwrap();
+    load(log_odds_at(0), 37.0f32.to_le_bytes()).unwrap();
+}
+
 #[test]
 fn distance_maps_around_the_vehicle_equal_the_full_window_inside_their_reach() {
     let scene = scene(vec![
