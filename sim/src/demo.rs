@@ -59,7 +59,16 @@ pub fn run(
         path: options.out.clone(),
         source,
     })?;
+    // The map's live store: blocks a previous run left there would be loaded as this run's
+    // live map, so the same inputs would not give the same map. Start from an empty one.
     let blocks_dir = options.out.join("blocks");
+    if blocks_dir.exists() {
+        std::fs::remove_dir_all(&blocks_dir).map_err(|source| crate::Error::Io {
+            what: "clearing the demo's old map blocks",
+            path: blocks_dir.clone(),
+            source,
+        })?;
+    }
     let scene = workloads::parking_lot_scene();
     let car = workloads::fake_wing_car();
     let levels = Levels::cumulative(car.level_heights_m().to_vec())?;

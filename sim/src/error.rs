@@ -32,6 +32,9 @@ pub enum Error {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// A map directory's manifest exists but cannot be used.
+    #[error(transparent)]
+    Manifest(#[from] crate::mapping::ManifestError),
     /// A file the simulator wrote earlier is not what it should be (a map manifest, a PLY).
     #[error("{}: {message}", path.display())]
     BadFile {

@@ -60,17 +60,81 @@ pub fn fingerprint(scenario: &Scenario, config: &RunConfig) -> Result<String> {
     Ok(format!("{:08x}", h.finalize()))
 }
 
-/// The manifest of the map in `dir`, if it exists and matches `scenario` and `config`.
+/// A map's `manifest.json` exists but cannot be used: rebuilding over it would hide the cause.
+#[derive(Debug, thiserror::Error)]
+pub enum ManifestError {
+    /// The file exists but cannot be read (permissions, not UTF-8, a directory...).
+    #[error("{}: cannot read the map manifest: {error}; {remedy}", path.display())]
+    Read {
+        /// The manifest file.
+        path: PathBuf,
+        /// The underlying error.
+        error: std::io::Error,
+        /// What to do about it.
+        remedy: String,
+    },
+    /// The file is not a manifest (garbage, truncated, another format).
+    #[error("{}:{line}:{column}: not a map manifest: {message}; {remedy}", path.display())]
+    Parse {
+        /// The manifest file.
+        path: PathBuf,
+        /// 1-based line of the mistake (serde_json's).
+        line: usize,
+        /// 1-based column of the mistake (serde_json's).
+        column: usize,
+        /// What serde_json says is wrong.
+        message: String,
+        /// What to do about it.
+        remedy: String,
+    },
+}
+
+/// The manifest of the map in `dir`, if it exists and matches `scenario` and `config`: `None`
+/// when it is missing or stale (build the map), a [`ManifestError`] when it exists but is
+/// unreadable.
 pub fn fresh_manifest(
     scenario: &Scenario,
     config: &RunConfig,
     dir: &Path,
 ) -> Result<Option<MapManifest>> {
-    let Ok(text) = std::fs::read_to_string(dir.join("manifest.json")) else {
-        return Ok(None);
+    let path = dir.join("manifest.json");
+    let remedy = || {
+        format!(
+            "delete it, or rebuild the map with `taxi-sim map {} --out {}`",
+            scenario.path.display(),
+            dir.display()
+        )
     };
-    let Ok(manifest) = serde_json::from_str::<MapManifest>(&text) else {
-        return Ok(None);
+    let text = match std::fs::read_to_string(&path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(error) => {
+            let remedy = remedy();
+            return Err(ManifestError::Read {
+                path,
+                error,
+                remedy,
+            }
+            .into());
+        }
+    };
+    let manifest = match serde_json::from_str::<MapManifest>(&text) {
+        Ok(manifest) => manifest,
+        Err(e) => {
+            let (line, column) = (e.line(), e.column());
+            let full = e.to_string();
+            let at = format!(" at line {line} column {column}");
+            let message = full.strip_suffix(&at).unwrap_or(&full).to_string();
+            let remedy = remedy();
+            return Err(ManifestError::Parse {
+                path,
+                line,
+                column,
+                message,
+                remedy,
+            }
+            .into());
+        }
     };
     Ok((manifest.fingerprint == fingerprint(scenario, config)?).then_some(manifest))
 }

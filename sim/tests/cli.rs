@@ -105,33 +105,23 @@ fn the_printed_default_configuration_reads_back_and_mistakes_are_located() {
 
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("run.toml");
-    std::fs::write(
-        &file,
-        "scan_hz = 10.0\n\n[autonomy]\nhorizon_m = 30.0\nhorizn = 3\n",
-    )
-    .unwrap();
-    let (code, _, stderr) = taxi_sim(&[
-        "run",
-        "../scenarios/straight_cone_under_wing.toml",
-        "--config",
-        file.to_str().unwrap(),
-    ]);
+    let run_with = |text: &str| {
+        std::fs::write(&file, text).unwrap();
+        taxi_sim(&[
+            "run",
+            "../scenarios/straight_cone_under_wing.toml",
+            "--config",
+            file.to_str().unwrap(),
+        ])
+    };
+    let (code, _, stderr) =
+        run_with("scan_hz = 10.0\n\n[autonomy]\nhorizon_m = 30.0\nhorizn = 3\n");
     assert_eq!(code, 2, "{stderr}");
     assert!(
         stderr.contains("run.toml:5:") && stderr.contains("horizn"),
         "{stderr}"
     );
-    std::fs::write(
-        &file,
-        "[pose_source]\nkind = \"noisy_truth\"\nrate_hz = -5.0\n",
-    )
-    .unwrap();
-    let (code, _, stderr) = taxi_sim(&[
-        "run",
-        "../scenarios/straight_cone_under_wing.toml",
-        "--config",
-        file.to_str().unwrap(),
-    ]);
+    let (code, _, stderr) = run_with("[pose_source]\nkind = \"noisy_truth\"\nrate_hz = -5.0\n");
     assert_eq!(code, 2, "{stderr}");
     assert!(
         stderr.contains("run.toml") && stderr.contains("pose_source.rate_hz = -5"),

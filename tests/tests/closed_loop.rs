@@ -99,6 +99,11 @@ fn the_car_deviates_around_a_cone_in_its_path_with_sequential_sensing() {
     });
     assert!(r.expectations_met, "{r:#?}");
     assert!(outcomes(&r).iter().all(|(_, o)| o == "deviated"), "{r:#?}");
+    // The report records the configuration it ran with, and it reads back as one.
+    let json = serde_json::to_value(&r).unwrap();
+    let config: RunConfig = serde_json::from_value(json["config"].clone()).unwrap();
+    assert_eq!(config.schedule, Schedule::Sequential);
+    assert_eq!(config, r.config);
 }
 
 #[test]
@@ -174,6 +179,24 @@ fn without_forgetting_the_jet_waits_for_the_crossing_cars_hidden_trail() {
     assert_eq!(r.end, EndReason::TimedOut);
 }
 
+/// Debris 0.15 m tall appears on the far side of the loop at 20 s: the car must see it at
+/// wheel level and not touch it on either lap. It ran over it on both laps (4 wheel contacts)
+/// while no test ran this shipped scenario.
+#[test]
+fn the_car_never_touches_the_debris_that_appears_on_its_loop() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = run_scenario("closed_loop_pose_file", dir.path());
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
+    assert_eq!(r.laps_completed, 2);
+    let debris = r
+        .obstacles
+        .iter()
+        .find(|o| o.id == "debris_far_side")
+        .unwrap();
+    assert_eq!(debris.passes.len(), 2, "{debris:?}");
+    assert!(r.expectations_met, "{r:#?}");
+}
+
 #[test]
 fn a_run_is_identical_for_the_same_seed() {
     let dir = tempfile::tempdir().unwrap();
@@ -191,4 +214,32 @@ fn a_run_is_identical_for_the_same_seed() {
         v
     };
     assert_eq!(strip(&a), strip(&b));
+}
+
+/// Every scenario shipped in `scenarios/` is run in closed loop by a test of this crate (this
+/// file or `experiments.rs`, found by its name in quotes), so a new scenario that nobody runs
+/// fails here (one that failed its expectations once shipped untested).
+#[test]
+fn every_shipped_scenario_is_run_by_a_test() {
+    let here = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let sources: String = ["tests/closed_loop.rs", "tests/experiments.rs"]
+        .iter()
+        .map(|f| std::fs::read_to_string(here.join(f)).unwrap())
+        .collect();
+    let mut shipped = Vec::new();
+    for entry in std::fs::read_dir(here.join("../scenarios")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            shipped.push(path.file_stem().unwrap().to_string_lossy().into_owned());
+        }
+    }
+    assert!(shipped.len() >= 8, "{shipped:?}");
+    let untested: Vec<_> = shipped
+        .iter()
+        .filter(|name| !sources.contains(&format!("scenario(\"{name}\"")))
+        .collect();
+    assert!(
+        untested.is_empty(),
+        "shipped but run by no test: {untested:?}"
+    );
 }

@@ -1,4 +1,5 @@
-//! The mapping demo end to end: levels separate cones from containers, files read back, runs repeat.
+//! The mapping demo end to end: levels separate cones from containers, files read back, runs
+//! repeat (into fresh folders and into the same one).
 
 use mapper::export::{Trinary, read_npy, read_ros_map};
 use mapper::synthetic::Solid;
@@ -131,4 +132,54 @@ fn a_run_is_a_function_of_its_seed() {
         ra.iter().zip(&rc).any(|(x, y)| x.to_bits() != y.to_bits()),
         "another seed draws other noise"
     );
+}
+
+/// Every file of a demo's output folder (the blocks included), by path relative to it, with its bytes.
+fn folder_bytes(dir: &std::path::Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut pending = vec![dir.to_path_buf()];
+    while let Some(d) = pending.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                pending.push(path);
+            } else {
+                let bytes = std::fs::read(&path).unwrap();
+                out.push((path.strip_prefix(dir).unwrap().to_path_buf(), bytes));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn demo_run_twice_into_the_same_folder_gives_the_same_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let options = DemoOptions {
+        out: dir.path().to_path_buf(),
+        scans: 6,
+        seed: 3,
+        range_noise_m: 0.02,
+    };
+    let first = run(&options, &mut |_, _| {}).unwrap();
+    let first_files = folder_bytes(dir.path());
+    assert!(
+        first_files
+            .iter()
+            .any(|(p, _)| p.starts_with("blocks") && p.extension().is_some_and(|e| e == "tsmb")),
+        "the demo writes blocks: {:?}",
+        first_files.iter().map(|(p, _)| p).collect::<Vec<_>>()
+    );
+    let second = run(&options, &mut |_, _| {}).unwrap();
+    let second_files = folder_bytes(dir.path());
+    assert_eq!(first.levels, second.levels, "occupied cells per level");
+    assert_eq!(first.blocks, second.blocks, "blocks written");
+    let names = |files: &[(std::path::PathBuf, Vec<u8>)]| {
+        files.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>()
+    };
+    assert_eq!(names(&first_files), names(&second_files), "same files");
+    for ((path, a), (_, b)) in first_files.iter().zip(&second_files) {
+        assert!(a == b, "{} differs between the two runs", path.display());
+    }
 }
