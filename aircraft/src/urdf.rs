@@ -72,15 +72,71 @@ fn isometry(pose: &urdf_rs::Pose) -> Isometry3<f64> {
 
 /// Places every collision primitive of a parsed robot in the frame of its root link.
 pub fn parts_from_robot(robot: &urdf_rs::Robot, file: &str) -> Result<Vec<Part>> {
-    let tree_err = |link: &str, message: String| Error::Tree {
+    let (children, parent_of) = joint_tree(robot, file)?;
+    let root = root_link(robot, file, &parent_of)?;
+    let vehicle_from_link = vehicle_from_links(robot, &children, root);
+    let mut parts = Vec::new();
+    for (i, link) in robot.links.iter().enumerate() {
+        let Some(vehicle_from_link) = vehicle_from_link[i] else {
+            return Err(tree_err(
+                file,
+                &link.name,
+                "is not reachable from the root link (the joints form a cycle)".into(),
+            ));
+        };
+        for (k, collision) in link.collision.iter().enumerate() {
+            let name = &link.name;
+            check_finite(
+                file,
+                name,
+                format!("collision {k} origin xyz"),
+                &collision.origin.xyz.0,
+            )?;
+            check_finite(
+                file,
+                name,
+                format!("collision {k} origin rpy"),
+                &collision.origin.rpy.0,
+            )?;
+            let shape = collision_shape(file, name, k, &collision.geometry)?;
+            parts.push(Part {
+                link: name.clone(),
+                collision_index: k,
+                shape,
+                vehicle_from_part: vehicle_from_link * isometry(&collision.origin),
+            });
+        }
+    }
+    if parts.is_empty() {
+        return Err(Error::NoCollisionGeometry {
+            file: file.to_string(),
+        });
+    }
+    Ok(parts)
+}
+
+/// A [`Error::Tree`]: `link` of `file` is wrongly placed in the link tree.
+fn tree_err(file: &str, link: &str, message: String) -> Error {
+    Error::Tree {
         file: file.to_string(),
         link: link.to_string(),
         message,
-    };
+    }
+}
+
+/// The links' tree as the joints make it, indexed like `robot.links`: `children[parent]` lists
+/// `(joint, child)` in joint order, `parent_of[child]` is the joint above the link. Refuses a link
+/// defined twice, a joint naming an unknown link, a link with two parent joints and a joint
+/// origin that is not finite (in that order, joint by joint).
+#[allow(clippy::type_complexity)]
+fn joint_tree(
+    robot: &urdf_rs::Robot,
+    file: &str,
+) -> Result<(Vec<Vec<(usize, usize)>>, Vec<Option<usize>>)> {
     let mut index: BTreeMap<&str, usize> = BTreeMap::new();
     for (i, link) in robot.links.iter().enumerate() {
         if index.insert(link.name.as_str(), i).is_some() {
-            return Err(tree_err(&link.name, "defined twice".into()));
+            return Err(tree_err(file, &link.name, "defined twice".into()));
         }
     }
     // children[parent] = (joint, child); parent_of[child] = joint.
@@ -99,6 +155,7 @@ pub fn parts_from_robot(robot: &urdf_rs::Robot, file: &str) -> Result<Vec<Part>>
         let child = find(&joint.child.link, "child")?;
         if let Some(other) = parent_of[child] {
             return Err(tree_err(
+                file,
                 &joint.child.link,
                 format!(
                     "is the child of two joints (`{}` and `{}`)",
@@ -121,28 +178,42 @@ pub fn parts_from_robot(robot: &urdf_rs::Robot, file: &str) -> Result<Vec<Part>>
         parent_of[child] = Some(j);
         children[parent].push((j, child));
     }
+    Ok((children, parent_of))
+}
+
+/// The one link without a parent joint; none (a cycle) or several (a forest) is an error.
+fn root_link(robot: &urdf_rs::Robot, file: &str, parent_of: &[Option<usize>]) -> Result<usize> {
     let roots: Vec<usize> = (0..robot.links.len())
         .filter(|&i| parent_of[i].is_none())
         .collect();
-    let root = match roots.as_slice() {
-        [root] => *root,
+    match roots.as_slice() {
+        [root] => Ok(*root),
         [] => {
             let name = robot.links.first().map_or("", |l| l.name.as_str());
-            return Err(tree_err(
+            Err(tree_err(
+                file,
                 name,
                 "no root link: the joints form a cycle".into(),
-            ));
+            ))
         }
-        [first, second, ..] => {
-            return Err(tree_err(
-                &robot.links[*second].name,
-                format!(
-                    "is not connected to the root link `{}` (a description has one tree)",
-                    robot.links[*first].name
-                ),
-            ));
-        }
-    };
+        [first, second, ..] => Err(tree_err(
+            file,
+            &robot.links[*second].name,
+            format!(
+                "is not connected to the root link `{}` (a description has one tree)",
+                robot.links[*first].name
+            ),
+        )),
+    }
+}
+
+/// Each link's pose in the vehicle (root link) frame, composing the joint origins breadth first
+/// from `root`; `None` for a link the root does not reach.
+fn vehicle_from_links(
+    robot: &urdf_rs::Robot,
+    children: &[Vec<(usize, usize)>],
+    root: usize,
+) -> Vec<Option<Isometry3<f64>>> {
     let mut vehicle_from_link: Vec<Option<Isometry3<f64>>> = vec![None; robot.links.len()];
     vehicle_from_link[root] = Some(Isometry3::identity());
     let mut queue = VecDeque::from([root]);
@@ -158,103 +229,58 @@ pub fn parts_from_robot(robot: &urdf_rs::Robot, file: &str) -> Result<Vec<Part>>
             }
         }
     }
-    let mut parts = Vec::new();
-    for (i, link) in robot.links.iter().enumerate() {
-        let Some(vehicle_from_link) = vehicle_from_link[i] else {
-            return Err(tree_err(
-                &link.name,
-                "is not reachable from the root link (the joints form a cycle)".into(),
-            ));
-        };
-        for (k, collision) in link.collision.iter().enumerate() {
-            let name = &link.name;
-            check_finite(
+    vehicle_from_link
+}
+
+/// The shape of collision `k` of link `name`, its dimensions checked positive (box sizes are
+/// full extents, cylinder and capsule lengths full lengths); a mesh is refused.
+fn collision_shape(
+    file: &str,
+    name: &str,
+    k: usize,
+    geometry: &urdf_rs::Geometry,
+) -> Result<Shape> {
+    Ok(match geometry {
+        urdf_rs::Geometry::Box { size } => {
+            let mut half = Vector3::zeros();
+            for (axis, (v, label)) in size.0.iter().zip(["x", "y", "z"]).enumerate() {
+                half[axis] = 0.5
+                    * check_positive(file, name, format!("collision {k} box size {label}"), *v)?;
+            }
+            Shape::Box {
+                half_extents_m: half,
+            }
+        }
+        urdf_rs::Geometry::Cylinder { radius, length } => Shape::Cylinder {
+            radius_m: check_positive(
                 file,
                 name,
-                format!("collision {k} origin xyz"),
-                &collision.origin.xyz.0,
-            )?;
-            check_finite(
-                file,
-                name,
-                format!("collision {k} origin rpy"),
-                &collision.origin.rpy.0,
-            )?;
-            let shape = match &collision.geometry {
-                urdf_rs::Geometry::Box { size } => {
-                    let mut half = Vector3::zeros();
-                    for (axis, (v, label)) in size.0.iter().zip(["x", "y", "z"]).enumerate() {
-                        half[axis] = 0.5
-                            * check_positive(
-                                file,
-                                name,
-                                format!("collision {k} box size {label}"),
-                                *v,
-                            )?;
-                    }
-                    Shape::Box {
-                        half_extents_m: half,
-                    }
-                }
-                urdf_rs::Geometry::Cylinder { radius, length } => Shape::Cylinder {
-                    radius_m: check_positive(
-                        file,
-                        name,
-                        format!("collision {k} cylinder radius"),
-                        *radius,
-                    )?,
-                    half_length_m: 0.5
-                        * check_positive(
-                            file,
-                            name,
-                            format!("collision {k} cylinder length"),
-                            *length,
-                        )?,
-                },
-                urdf_rs::Geometry::Capsule { radius, length } => Shape::Capsule {
-                    radius_m: check_positive(
-                        file,
-                        name,
-                        format!("collision {k} capsule radius"),
-                        *radius,
-                    )?,
-                    half_length_m: 0.5
-                        * check_positive(
-                            file,
-                            name,
-                            format!("collision {k} capsule length"),
-                            *length,
-                        )?,
-                },
-                urdf_rs::Geometry::Sphere { radius } => Shape::Sphere {
-                    radius_m: check_positive(
-                        file,
-                        name,
-                        format!("collision {k} sphere radius"),
-                        *radius,
-                    )?,
-                },
-                urdf_rs::Geometry::Mesh { filename, .. } => {
-                    return Err(Error::UnsupportedGeometry {
-                        file: file.to_string(),
-                        link: name.clone(),
-                        index: k,
-                        geometry: format!("mesh (`{filename}`)"),
-                    });
-                }
-            };
-            parts.push(Part {
-                link: name.clone(),
-                collision_index: k,
-                shape,
-                vehicle_from_part: vehicle_from_link * isometry(&collision.origin),
+                format!("collision {k} cylinder radius"),
+                *radius,
+            )?,
+            half_length_m: 0.5
+                * check_positive(
+                    file,
+                    name,
+                    format!("collision {k} cylinder length"),
+                    *length,
+                )?,
+        },
+        urdf_rs::Geometry::Capsule { radius, length } => Shape::Capsule {
+            radius_m: check_positive(file, name, format!("collision {k} capsule radius"), *radius)?,
+            half_length_m: 0.5
+                * check_positive(file, name, format!("collision {k} capsule length"), *length)?,
+        },
+        urdf_rs::Geometry::Sphere { radius } => Shape::Sphere {
+            radius_m: check_positive(file, name, format!("collision {k} sphere radius"), *radius)?,
+        },
+        urdf_rs::Geometry::Mesh { filename, .. } => {
+            return Err(Error::UnsupportedGeometry {
+                file: file.to_string(),
+                link: name.to_string(),
+                index: k,
+                geometry: format!("mesh (`{filename}`)"),
             });
         }
-    }
-    if parts.is_empty() {
-        return Err(Error::NoCollisionGeometry {
-            file: file.to_string(),
-        });
-    }
-    Ok(parts)
+    })
 }

@@ -183,6 +183,48 @@ struct Candidate<'a> {
     sin_el_max: f32,
 }
 
+/// The candidates of every column in one flat list, each column's in the candidates' order:
+/// column c's are `flat[start[c]..start[c + 1]]`.
+struct Buckets {
+    start: Vec<u32>,
+    flat: Vec<u32>,
+}
+
+impl Buckets {
+    /// Buckets `candidates` (indices into it) by the columns each may be seen from (`None`:
+    /// all `columns`): counted, then filled in the candidates' order.
+    fn new<T>(candidates: &[(T, Option<std::ops::Range<i64>>)], columns: usize) -> Self {
+        let mut start = vec![0u32; columns + 1];
+        let each_column = |ks: &Option<std::ops::Range<i64>>, f: &mut dyn FnMut(usize)| match ks {
+            None => (0..columns).for_each(&mut *f),
+            Some(ks) => ks
+                .clone()
+                .for_each(|k| f(k.rem_euclid(columns as i64) as usize)),
+        };
+        for (_, ks) in candidates {
+            each_column(ks, &mut |c| start[c + 1] += 1);
+        }
+        for c in 0..columns {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut flat = vec![0u32; start[columns] as usize];
+        for (index, (_, ks)) in candidates.iter().enumerate() {
+            each_column(ks, &mut |c| {
+                flat[fill[c] as usize] = index as u32;
+                fill[c] += 1;
+            });
+        }
+        Buckets { start, flat }
+    }
+
+    /// Column `c`'s candidates, nearest first when the candidates are.
+    #[inline]
+    fn column(&self, c: usize) -> &[u32] {
+        &self.flat[self.start[c] as usize..self.start[c + 1] as usize]
+    }
+}
+
 impl Lidar {
     /// A sensor mounted at `vehicle_from_sensor`.
     pub fn new(config: LidarConfig, vehicle_from_sensor: Isometry3<f64>) -> Result<Self, String> {
@@ -244,6 +286,26 @@ impl Lidar {
 
     /// One revolution with the fast path. `scan_index` and `seed` seed the noise.
     pub fn scan(&self, world: &World, sweep: &SweepPoses, scan_index: u64, seed: u64) -> LidarScan {
+        let mut candidates = self.candidates(world, sweep);
+        // Nearest first (a stable sort: equals keep the colliders' order), so that every bucket,
+        // filled in this order, is sorted without sorting 2187 buckets a revolution.
+        candidates.sort_by(|a, b| a.0.d_min.total_cmp(&b.0.d_min));
+        let buckets = Buckets::new(&candidates, self.config.columns);
+        let candidates: Vec<Candidate> = candidates.into_iter().map(|(c, _)| c).collect();
+        let scene = world.scene();
+        let ground = (scene.min_m, scene.max_m);
+        self.assemble(world, sweep, scan_index, seed, |c, origin, dirs, out| {
+            self.cast_column(&candidates, buckets.column(c), ground, origin, dirs, out);
+        })
+    }
+
+    /// Every object collider as the fast path sees it from the sweep's first column origin,
+    /// with the columns it may be seen from (`None`: all of them), in the colliders' order.
+    fn candidates<'w>(
+        &self,
+        world: &'w World,
+        sweep: &SweepPoses,
+    ) -> Vec<(Candidate<'w>, Option<std::ops::Range<i64>>)> {
         let (_, first) = self.column_poses(sweep, 0);
         let origin = first.translation.vector;
         // How far column origins stray from the first one over the sweep: a culling margin.
@@ -252,7 +314,6 @@ impl Lidar {
         } else {
             0.0
         };
-        let columns = self.config.columns;
         // Each candidate with the columns it may be seen from (`None`: all of them).
         let mut candidates: Vec<(Candidate, Option<std::ops::Range<i64>>)> = Vec::new();
         for (owner, collider) in world.object_colliders() {
@@ -297,122 +358,124 @@ impl Lidar {
                 candidates.push((candidate, None));
                 continue;
             }
-            let corners = [(lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y)];
-            let mid_az = (0.5 * (lo.y + hi.y) - oy).atan2(0.5 * (lo.x + hi.x) - ox);
-            let (mut a_lo, mut a_hi) = (0.0f32, 0.0f32);
-            for (x, y) in corners {
-                let a = (y - oy).atan2(x - ox) - mid_az;
-                let a = (a + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU)
-                    - std::f32::consts::PI;
-                a_lo = a_lo.min(a);
-                a_hi = a_hi.max(a);
-            }
-            let margin = (pad / d_min.max(0.1)).min(std::f32::consts::PI)
-                + 2.0 * std::f32::consts::TAU / columns as f32;
-            let (a_lo, a_hi) = (mid_az + a_lo - margin, mid_az + a_hi + margin);
-            // The sensor's column azimuths are measured in its own frame: rotate the window.
-            let yaw0 = sweep.start.rotation.angle() as f32 + sensor_yaw(&self.vehicle_from_sensor);
-            let per = columns as f32 / std::f32::consts::TAU;
-            let (c_lo, c_hi) = (
-                ((a_lo - yaw0) * per).floor() as i64,
-                ((a_hi - yaw0) * per).ceil() as i64,
-            );
-            let span = (c_hi - c_lo + 1).min(columns as i64);
-            let yaw_pad = if self.config.motion_during_sweep {
-                (crate::motion::wrap_angle(
-                    sweep.end.rotation.angle() - sweep.start.rotation.angle(),
-                )
-                .abs() as f32
-                    * per)
-                    .ceil() as i64
-                    + 1
-            } else {
-                0
-            };
-            let ks = (c_lo - yaw_pad)..(c_lo + span + yaw_pad).min(c_lo - yaw_pad + columns as i64);
+            let ks = self.column_window(sweep, ([lo.x, lo.y], [hi.x, hi.y]), (ox, oy), d_min, pad);
             candidates.push((candidate, Some(ks)));
         }
-        // Nearest first (a stable sort: equals keep the colliders' order), so that every bucket,
-        // filled in this order, is sorted without sorting 2187 buckets a revolution.
-        candidates.sort_by(|a, b| a.0.d_min.total_cmp(&b.0.d_min));
-        // The buckets in one flat list (column c's are `flat[start[c]..start[c + 1]]`): counted,
-        // then filled in the candidates' order.
-        let mut start = vec![0u32; columns + 1];
-        let each_column = |ks: &Option<std::ops::Range<i64>>, f: &mut dyn FnMut(usize)| match ks {
-            None => (0..columns).for_each(&mut *f),
-            Some(ks) => ks
-                .clone()
-                .for_each(|k| f(k.rem_euclid(columns as i64) as usize)),
+        candidates
+    }
+
+    /// The columns (a range of indices to take modulo the column count) from which a box with
+    /// horizontal footprint `lo`..`hi`, `d_min` > 0 metres from the origin `(ox, oy)`, may be
+    /// seen: its azimuth window widened by `pad` (the origins' stray) and two columns, rotated
+    /// into the sensor's frame at the sweep's start and widened by the sweep's turn.
+    fn column_window(
+        &self,
+        sweep: &SweepPoses,
+        (lo, hi): ([f32; 2], [f32; 2]),
+        (ox, oy): (f32, f32),
+        d_min: f32,
+        pad: f32,
+    ) -> std::ops::Range<i64> {
+        let columns = self.config.columns;
+        let corners = [
+            (lo[0], lo[1]),
+            (hi[0], lo[1]),
+            (lo[0], hi[1]),
+            (hi[0], hi[1]),
+        ];
+        let mid_az = (0.5 * (lo[1] + hi[1]) - oy).atan2(0.5 * (lo[0] + hi[0]) - ox);
+        let (mut a_lo, mut a_hi) = (0.0f32, 0.0f32);
+        for (x, y) in corners {
+            let a = (y - oy).atan2(x - ox) - mid_az;
+            let a =
+                (a + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI;
+            a_lo = a_lo.min(a);
+            a_hi = a_hi.max(a);
+        }
+        let margin = (pad / d_min.max(0.1)).min(std::f32::consts::PI)
+            + 2.0 * std::f32::consts::TAU / columns as f32;
+        let (a_lo, a_hi) = (mid_az + a_lo - margin, mid_az + a_hi + margin);
+        // The sensor's column azimuths are measured in its own frame: rotate the window.
+        let yaw0 = sweep.start.rotation.angle() as f32 + sensor_yaw(&self.vehicle_from_sensor);
+        let per = columns as f32 / std::f32::consts::TAU;
+        let (c_lo, c_hi) = (
+            ((a_lo - yaw0) * per).floor() as i64,
+            ((a_hi - yaw0) * per).ceil() as i64,
+        );
+        let span = (c_hi - c_lo + 1).min(columns as i64);
+        let yaw_pad = if self.config.motion_during_sweep {
+            (crate::motion::wrap_angle(sweep.end.rotation.angle() - sweep.start.rotation.angle())
+                .abs() as f32
+                * per)
+                .ceil() as i64
+                + 1
+        } else {
+            0
         };
-        for (_, ks) in &candidates {
-            each_column(ks, &mut |c| start[c + 1] += 1);
-        }
-        for c in 0..columns {
-            start[c + 1] += start[c];
-        }
-        let mut fill = start.clone();
-        let mut flat = vec![0u32; start[columns] as usize];
-        for (index, (_, ks)) in candidates.iter().enumerate() {
-            each_column(ks, &mut |c| {
-                flat[fill[c] as usize] = index as u32;
-                fill[c] += 1;
-            });
-        }
-        let bucket = |c: usize| &flat[start[c] as usize..start[c + 1] as usize];
-        let candidates: Vec<Candidate> = candidates.into_iter().map(|(c, _)| c).collect();
-        let scene = world.scene();
-        let ground = (scene.min_m, scene.max_m);
-        self.assemble(world, sweep, scan_index, seed, |c, origin, dirs, out| {
-            let o = Vector::new(origin.x as f32, origin.y as f32, origin.z as f32);
-            for (b, d) in dirs.iter().enumerate() {
-                let dir = Vector::new(d[0], d[1], d[2]);
-                let mut best: Option<(f32, Owner)> = None;
-                let mut t_best = self.config.range_m as f32;
-                if let Some((t, owner)) = out[b] {
-                    (t_best, best) = (t, Some((t, owner))); // the vehicle itself, from the table
-                }
-                if dir.z < 0.0 {
-                    let t = -o.z / dir.z;
-                    let (x, y) = ((o.x + t * dir.x) as f64, (o.y + t * dir.y) as f64);
-                    if t <= t_best
-                        && x >= ground.0[0]
-                        && x <= ground.1[0]
-                        && y >= ground.0[1]
-                        && y <= ground.1[1]
-                    {
-                        t_best = t;
-                        best = Some((t, Owner::Ground));
-                    }
-                }
-                let horizontal = (dir.x * dir.x + dir.y * dir.y).sqrt();
-                let ray = Ray::new(o, dir);
-                for &i in bucket(c) {
-                    let cand = &candidates[i as usize];
-                    if t_best * horizontal < cand.d_min {
-                        break; // sorted by distance: nothing farther can be nearer than the hit
-                    }
-                    if dir.z < cand.sin_el_min || dir.z > cand.sin_el_max {
-                        continue;
-                    }
-                    let hit = match &cand.analytic {
-                        Some(v) => v.cast(&ray, t_best),
-                        None => cand.collider.shape().cast_ray(
-                            cand.collider.position(),
-                            &ray,
-                            t_best,
-                            true,
-                        ),
-                    };
-                    if let Some(t) = hit
-                        && t < t_best
-                    {
-                        t_best = t;
-                        best = Some((t, cand.owner));
-                    }
-                }
-                out[b] = best;
+        (c_lo - yaw_pad)..(c_lo + span + yaw_pad).min(c_lo - yaw_pad + columns as i64)
+    }
+
+    /// Casts one column's rays (`dirs`, from `origin`) against the ground plane within `ground`
+    /// (its corners) and the column's `bucket` of `candidates` (nearest first), keeping each
+    /// ray's nearest hit in `out` (prefilled with the vehicle's self-hits).
+    #[inline]
+    fn cast_column(
+        &self,
+        candidates: &[Candidate],
+        bucket: &[u32],
+        ground: ([f64; 2], [f64; 2]),
+        origin: Point3<f64>,
+        dirs: &[[f32; 3]],
+        out: &mut [Option<(f32, Owner)>],
+    ) {
+        let o = Vector::new(origin.x as f32, origin.y as f32, origin.z as f32);
+        for (b, d) in dirs.iter().enumerate() {
+            let dir = Vector::new(d[0], d[1], d[2]);
+            let mut best: Option<(f32, Owner)> = None;
+            let mut t_best = self.config.range_m as f32;
+            if let Some((t, owner)) = out[b] {
+                (t_best, best) = (t, Some((t, owner))); // the vehicle itself, from the table
             }
-        })
+            if dir.z < 0.0 {
+                let t = -o.z / dir.z;
+                let (x, y) = ((o.x + t * dir.x) as f64, (o.y + t * dir.y) as f64);
+                if t <= t_best
+                    && x >= ground.0[0]
+                    && x <= ground.1[0]
+                    && y >= ground.0[1]
+                    && y <= ground.1[1]
+                {
+                    t_best = t;
+                    best = Some((t, Owner::Ground));
+                }
+            }
+            let horizontal = (dir.x * dir.x + dir.y * dir.y).sqrt();
+            let ray = Ray::new(o, dir);
+            for &i in bucket {
+                let cand = &candidates[i as usize];
+                if t_best * horizontal < cand.d_min {
+                    break; // sorted by distance: nothing farther can be nearer than the hit
+                }
+                if dir.z < cand.sin_el_min || dir.z > cand.sin_el_max {
+                    continue;
+                }
+                let hit = match &cand.analytic {
+                    Some(v) => v.cast(&ray, t_best),
+                    None => {
+                        cand.collider
+                            .shape()
+                            .cast_ray(cand.collider.position(), &ray, t_best, true)
+                    }
+                };
+                if let Some(t) = hit
+                    && t < t_best
+                {
+                    t_best = t;
+                    best = Some((t, cand.owner));
+                }
+            }
+            out[b] = best;
+        }
     }
 
     /// One revolution casting every ray with Rapier's generic query (the BVH over every

@@ -416,6 +416,74 @@ fn log_part(rec: &RecordingStream, path: &str, part: &aircraft::Part, color: Rgb
     Ok(())
 }
 
+/// The ground slab and the painted patches (grey by remission).
+fn log_ground(rec: &RecordingStream, scene: &crate::scene::Scene) -> Result<()> {
+    let (min, max) = (scene.min_m, scene.max_m);
+    rec.log_static(
+        "world/ground",
+        &rerun::Boxes3D::from_centers_and_half_sizes(
+            [[
+                (0.5 * (min[0] + max[0])) as f32,
+                (0.5 * (min[1] + max[1])) as f32,
+                -0.03,
+            ]],
+            [[
+                (0.5 * (max[0] - min[0])) as f32,
+                (0.5 * (max[1] - min[1])) as f32,
+                0.02,
+            ]],
+        )
+        .with_fill_mode(FillMode::Solid)
+        .with_colors([Rgba32::from_rgb(70, 72, 78)]),
+    )?;
+    if !scene.patches.is_empty() {
+        let grey = |r: f32| {
+            let v = (90.0 + 160.0 * r.clamp(0.0, 1.0)) as u8;
+            Rgba32::from_rgb(v, v, v)
+        };
+        rec.log_static(
+            "world/patches",
+            &rerun::Boxes3D::from_centers_and_half_sizes(
+                scene
+                    .patches
+                    .iter()
+                    .map(|p| [p.x_m as f32, p.y_m as f32, -0.005]),
+                scene
+                    .patches
+                    .iter()
+                    .map(|p| [0.5 * p.length_m as f32, 0.5 * p.width_m as f32, 0.004]),
+            )
+            .with_quaternions(scene.patches.iter().map(|p| yaw_quat(p.yaw_rad)))
+            .with_fill_mode(FillMode::Solid)
+            .with_colors(scene.patches.iter().map(|p| grey(p.remission))),
+        )?;
+    }
+    Ok(())
+}
+
+/// The route as a line strip just above the ground, closed back to its first point when the
+/// route is closed.
+fn log_route(rec: &RecordingStream, scenario: &crate::scenario::Scenario) -> Result<()> {
+    let mut route: Vec<[f32; 3]> = scenario
+        .route
+        .waypoints_m
+        .iter()
+        .map(|p| [p.x as f32, p.y as f32, 0.02])
+        .collect();
+    if scenario.route.closed
+        && let Some(first) = route.first().copied()
+    {
+        route.push(first);
+    }
+    rec.log_static(
+        "world/route",
+        &rerun::LineStrips3D::new([route])
+            .with_radii([0.08])
+            .with_colors([Rgba32::from_rgb(250, 250, 250)]),
+    )?;
+    Ok(())
+}
+
 /// A circle of the plane z = `z` as a closed line strip.
 fn circle_strip(x: f64, y: f64, r: f64, z: f64) -> Vec<[f32; 3]> {
     const SIDES: usize = 32;
@@ -694,50 +762,14 @@ impl Replay {
         Ok(())
     }
 
+    /// Logs what stays the same all run (static): the axes' convention, the ground and its
+    /// patches, the static objects, the route, the vehicle, the LiDAR's classes and the names
+    /// and colours of the time series, in that order.
     fn log_static_world(&mut self, run: &RunStart<'_>) -> Result<()> {
         let rec = &self.rec;
         rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
         let scene = run.scene;
-        let (min, max) = (scene.min_m, scene.max_m);
-        rec.log_static(
-            "world/ground",
-            &rerun::Boxes3D::from_centers_and_half_sizes(
-                [[
-                    (0.5 * (min[0] + max[0])) as f32,
-                    (0.5 * (min[1] + max[1])) as f32,
-                    -0.03,
-                ]],
-                [[
-                    (0.5 * (max[0] - min[0])) as f32,
-                    (0.5 * (max[1] - min[1])) as f32,
-                    0.02,
-                ]],
-            )
-            .with_fill_mode(FillMode::Solid)
-            .with_colors([Rgba32::from_rgb(70, 72, 78)]),
-        )?;
-        if !scene.patches.is_empty() {
-            let grey = |r: f32| {
-                let v = (90.0 + 160.0 * r.clamp(0.0, 1.0)) as u8;
-                Rgba32::from_rgb(v, v, v)
-            };
-            rec.log_static(
-                "world/patches",
-                &rerun::Boxes3D::from_centers_and_half_sizes(
-                    scene
-                        .patches
-                        .iter()
-                        .map(|p| [p.x_m as f32, p.y_m as f32, -0.005]),
-                    scene
-                        .patches
-                        .iter()
-                        .map(|p| [0.5 * p.length_m as f32, 0.5 * p.width_m as f32, 0.004]),
-                )
-                .with_quaternions(scene.patches.iter().map(|p| yaw_quat(p.yaw_rad)))
-                .with_fill_mode(FillMode::Solid)
-                .with_colors(scene.patches.iter().map(|p| grey(p.remission))),
-            )?;
-        }
+        log_ground(rec, scene)?;
         for solid in &scene.solids[..run.first_obstacle] {
             log_solid(
                 rec,
@@ -747,25 +779,16 @@ impl Replay {
                 true,
             )?;
         }
-        let mut route: Vec<[f32; 3]> = run
-            .scenario
-            .route
-            .waypoints_m
-            .iter()
-            .map(|p| [p.x as f32, p.y as f32, 0.02])
-            .collect();
-        if run.scenario.route.closed
-            && let Some(first) = route.first().copied()
-        {
-            route.push(first);
-        }
-        rec.log_static(
-            "world/route",
-            &rerun::LineStrips3D::new([route])
-                .with_radii([0.08])
-                .with_colors([Rgba32::from_rgb(250, 250, 250)]),
-        )?;
-        // The vehicle: its parts, coloured by level, and its circles at each level's height.
+        log_route(rec, run.scenario)?;
+        self.log_vehicle(run)?;
+        self.log_lidar_classes()?;
+        self.log_series_names()?;
+        Ok(())
+    }
+
+    /// The vehicle: its parts, coloured by level, and its circles at each level's height.
+    fn log_vehicle(&self, run: &RunStart<'_>) -> Result<()> {
+        let rec = &self.rec;
         let vehicle = &run.scenario.vehicle.vehicle;
         for (i, part) in vehicle.parts.iter().enumerate() {
             let level = run.part_levels.get(i).copied().unwrap_or(0);
@@ -795,7 +818,12 @@ impl Replay {
                     .with_colors([level_color(k)]),
             )?;
         }
-        // The LiDAR's classes.
+        Ok(())
+    }
+
+    /// The LiDAR's classes (ground, vehicle, unmapped, above every level, one per level) as the
+    /// annotation context of `world/lidar`.
+    fn log_lidar_classes(&self) -> Result<()> {
         let mut classes: Vec<(u16, String, Rgba32)> = vec![
             (
                 CLASS_GROUND,
@@ -825,7 +853,7 @@ impl Replay {
                 level_color(k),
             ));
         }
-        rec.log_static(
+        self.rec.log_static(
             "world/lidar",
             &rerun::AnnotationContext::new(
                 classes
@@ -833,7 +861,12 @@ impl Replay {
                     .map(|(id, label, color)| (*id, label.as_str(), *color)),
             ),
         )?;
-        // Names and colours of the time series.
+        Ok(())
+    }
+
+    /// Names and colours of the time series.
+    fn log_series_names(&self) -> Result<()> {
+        let rec = &self.rec;
         for (k, _) in self.level_heights_m.iter().enumerate() {
             rec.log_static(
                 format!("plots/clearance_m/level_{k}"),

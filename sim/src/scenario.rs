@@ -823,33 +823,84 @@ impl Resolver<'_> {
         let world = self.world(&spec.world)?;
         let route = self.route(&spec.route, &world)?;
         let vehicle = self.vehicle(&spec.vehicle, &route, &world)?;
-
         // Every id, with who uses it (as error messages name it).
         let mut ids: HashMap<String, String> = HashMap::new();
-        let mut claim = |id: &str,
-                         span: Range<usize>,
-                         field: &str,
-                         owner: String,
-                         made: &str|
-         -> Result<(), ScenarioError> {
-            if id.is_empty() {
-                return Err(self.err(span, field, "an id must not be empty"));
-            }
-            if let Some(first) = ids.insert(id.to_string(), owner) {
-                return Err(self.err(
-                    span,
-                    field,
-                    format!("{made}duplicate id `{id}` (already used by {first})"),
-                ));
-            }
-            Ok(())
-        };
+        let mut objects = self.objects(&spec.objects, &world, &vehicle, &mut ids)?;
+        self.rows(&spec.rows, &world, &route, &vehicle, &mut ids, &mut objects)?;
+        let patches = self.patches(&spec.patches, &world, &mut ids)?;
+        let obstacles = self.obstacles(&spec.obstacles, &world, &vehicle, &mut ids)?;
+        Ok(Scenario {
+            path: path.to_path_buf(),
+            name: spec.name,
+            description: spec.description,
+            seed: spec.seed,
+            laps: spec.laps.0,
+            world,
+            vehicle,
+            route,
+            objects,
+            patches,
+            obstacles,
+            danger_distance_m: spec.expectations.danger_distance_m.map(|d| d.0),
+        })
+    }
 
-        let mut objects = Vec::with_capacity(spec.objects.len());
-        for (i, o) in spec.objects.iter().enumerate() {
+    /// Claims `id` in `ids` for `owner` (as error messages name it): an empty id or one
+    /// already claimed is refused at `span` under `field`, the message starting with `made`.
+    fn claim(
+        &self,
+        ids: &mut HashMap<String, String>,
+        id: &str,
+        span: Range<usize>,
+        field: &str,
+        owner: String,
+        made: &str,
+    ) -> Result<(), ScenarioError> {
+        if id.is_empty() {
+            return Err(self.err(span, field, "an id must not be empty"));
+        }
+        if let Some(first) = ids.insert(id.to_string(), owner) {
+            return Err(self.err(
+                span,
+                field,
+                format!("{made}duplicate id `{id}` (already used by {first})"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Claims the id of table `field` (`objects[3]`), named `<field>.id` as field and owner.
+    fn claim_id(
+        &self,
+        ids: &mut HashMap<String, String>,
+        id: &Spanned<String>,
+        field: &str,
+    ) -> Result<(), ScenarioError> {
+        let field = format!("{field}.id");
+        self.claim(
+            ids,
+            id.get_ref(),
+            id.span(),
+            &field,
+            format!("`{field}`"),
+            "",
+        )
+    }
+
+    /// The `[[objects]]` as solids, in file order: ids claimed, shapes checked, each inside the
+    /// world and clear of the vehicle at its start.
+    fn objects(
+        &self,
+        specs: &[Spanned<ObjectSpec>],
+        world: &World,
+        vehicle: &ScenarioVehicle,
+        ids: &mut HashMap<String, String>,
+    ) -> Result<Vec<Solid>, ScenarioError> {
+        let mut objects = Vec::with_capacity(specs.len());
+        for (i, o) in specs.iter().enumerate() {
             let field = format!("objects[{i}]");
             let o_ref = o.get_ref();
-            claim_id(&mut claim, &o_ref.id, &field)?;
+            self.claim_id(ids, &o_ref.id, &field)?;
             let shape = self.shape(
                 &field,
                 o.span(),
@@ -871,16 +922,30 @@ impl Resolver<'_> {
                     .map_or_else(|| default_remission(o_ref.kind), |r| r.0),
                 runtime: false,
             };
-            self.inside_world(&world, &field, o_ref.id.span(), solid.x_m, solid.y_m)?;
-            self.no_start_overlap(&vehicle, &solid, &field, o_ref.id.span())?;
+            self.inside_world(world, &field, o_ref.id.span(), solid.x_m, solid.y_m)?;
+            self.no_start_overlap(vehicle, &solid, &field, o_ref.id.span())?;
             objects.push(solid);
         }
+        Ok(objects)
+    }
 
-        for (i, r) in spec.rows.iter().enumerate() {
+    /// Appends the objects of each `[[rows]]`, in file order, to `objects`: the row's id and
+    /// each object's id claimed, each object inside the world and clear of the vehicle at its
+    /// start.
+    fn rows(
+        &self,
+        specs: &[Spanned<RowSpec>],
+        world: &World,
+        route: &Route,
+        vehicle: &ScenarioVehicle,
+        ids: &mut HashMap<String, String>,
+        objects: &mut Vec<Solid>,
+    ) -> Result<(), ScenarioError> {
+        for (i, r) in specs.iter().enumerate() {
             let field = format!("rows[{i}]");
             let id = &r.get_ref().id;
-            claim_id(&mut claim, id, &field)?;
-            for (n, made) in self.row(r, &field, &route)?.into_iter().enumerate() {
+            self.claim_id(ids, id, &field)?;
+            for (n, made) in self.row(r, &field, route)?.into_iter().enumerate() {
                 let solid = made.solid;
                 let what = format!(
                     "object {} (arc length {:.2} m, offset {} m)",
@@ -888,7 +953,8 @@ impl Resolver<'_> {
                     made.s_m,
                     made.offset_m
                 );
-                claim(
+                self.claim(
+                    ids,
                     &solid.id,
                     id.span(),
                     &format!("{field}.id"),
@@ -913,17 +979,26 @@ impl Resolver<'_> {
                         ),
                     ));
                 }
-                self.no_start_overlap(&vehicle, &solid, &field, id.span())?;
+                self.no_start_overlap(vehicle, &solid, &field, id.span())?;
                 objects.push(solid);
             }
         }
+        Ok(())
+    }
 
-        let mut patches = Vec::with_capacity(spec.patches.len());
-        for (i, p) in spec.patches.iter().enumerate() {
+    /// The `[[patches]]`, in file order: ids claimed, each inside the world.
+    fn patches(
+        &self,
+        specs: &[Spanned<PatchSpec>],
+        world: &World,
+        ids: &mut HashMap<String, String>,
+    ) -> Result<Vec<Patch>, ScenarioError> {
+        let mut patches = Vec::with_capacity(specs.len());
+        for (i, p) in specs.iter().enumerate() {
             let field = format!("patches[{i}]");
             let p = p.get_ref();
-            claim_id(&mut claim, &p.id, &field)?;
-            self.inside_world(&world, &field, p.id.span(), p.x_m.0, p.y_m.0)?;
+            self.claim_id(ids, &p.id, &field)?;
+            self.inside_world(world, &field, p.id.span(), p.x_m.0, p.y_m.0)?;
             patches.push(Patch {
                 id: p.id.get_ref().clone(),
                 x_m: p.x_m.0,
@@ -934,15 +1009,26 @@ impl Resolver<'_> {
                 remission: p.remission.map_or(0.8, |r| r.0),
             });
         }
+        Ok(patches)
+    }
 
-        let mut obstacles = Vec::with_capacity(spec.obstacles.len());
-        for (i, o) in spec.obstacles.iter().enumerate() {
+    /// The `[[obstacles]]`, in file order: ids claimed, each (and its path) inside the world,
+    /// and one present at the start clear of the vehicle there.
+    fn obstacles(
+        &self,
+        specs: &[Spanned<ObstacleSpec>],
+        world: &World,
+        vehicle: &ScenarioVehicle,
+        ids: &mut HashMap<String, String>,
+    ) -> Result<Vec<Obstacle>, ScenarioError> {
+        let mut obstacles = Vec::with_capacity(specs.len());
+        for (i, o) in specs.iter().enumerate() {
             let field = format!("obstacles[{i}]");
-            claim_id(&mut claim, &o.get_ref().id, &field)?;
+            self.claim_id(ids, &o.get_ref().id, &field)?;
             let obstacle = self.obstacle(o, &field)?;
             let id_span = o.get_ref().id.span();
             self.inside_world(
-                &world,
+                world,
                 &field,
                 id_span.clone(),
                 obstacle.solid.x_m,
@@ -950,29 +1036,15 @@ impl Resolver<'_> {
             )?;
             if let (Some(m), Some(path)) = (&obstacle.motion, &o.get_ref().path_m) {
                 for p in &m.path_m {
-                    self.inside_world(&world, &format!("{field}.path_m"), path.span(), p.x, p.y)?;
+                    self.inside_world(world, &format!("{field}.path_m"), path.span(), p.x, p.y)?;
                 }
             }
             if obstacle.appears_s <= 0.0 {
-                self.no_start_overlap(&vehicle, &obstacle.solid, &field, id_span)?;
+                self.no_start_overlap(vehicle, &obstacle.solid, &field, id_span)?;
             }
             obstacles.push(obstacle);
         }
-
-        Ok(Scenario {
-            path: path.to_path_buf(),
-            name: spec.name,
-            description: spec.description,
-            seed: spec.seed,
-            laps: spec.laps.0,
-            world,
-            vehicle,
-            route,
-            objects,
-            patches,
-            obstacles,
-            danger_distance_m: spec.expectations.danger_distance_m.map(|d| d.0),
-        })
+        Ok(obstacles)
     }
 
     fn world(&self, w: &WorldSpec) -> Result<World, ScenarioError> {
@@ -1333,7 +1405,23 @@ impl Resolver<'_> {
             &spec.radius_m,
             &spec.height_m,
         )?;
-        let line = match (&spec.along_m, &spec.along) {
+        let line = self.row_line(r, field, route)?;
+        let length = line.length_m();
+        let offsets = self.row_offsets(spec, field)?;
+        let stations = self.row_stations(spec, field, &line, length, offsets.len())?;
+        self.place_row(r, field, shape, &line, &offsets, &stations)
+    }
+
+    /// A row's line: its own `along_m` (checked as a polyline) or the route (`along = "route"`),
+    /// exactly one of them.
+    fn row_line(
+        &self,
+        r: &Spanned<RowSpec>,
+        field: &str,
+        route: &Route,
+    ) -> Result<Polyline, ScenarioError> {
+        let spec = r.get_ref();
+        Ok(match (&spec.along_m, &spec.along) {
             (Some(_), Some(a)) => {
                 return Err(self.err(
                     a.span(),
@@ -1367,10 +1455,12 @@ impl Resolver<'_> {
             (None, Some(a)) => match a.get_ref() {
                 RowLine::Route => Polyline::new(&route.waypoints_m, route.closed),
             },
-        };
-        let length = line.length_m();
+        })
+    }
 
-        let offsets: Vec<f64> = match &spec.offsets_m {
+    /// A row's lateral offsets, metres (default: on the line): at least one, none twice.
+    fn row_offsets(&self, spec: &RowSpec, field: &str) -> Result<Vec<f64>, ScenarioError> {
+        Ok(match &spec.offsets_m {
             None => vec![0.0],
             Some(o) => {
                 let v: Vec<f64> = o.get_ref().iter().map(|x| x.0).collect();
@@ -1392,8 +1482,20 @@ impl Resolver<'_> {
                 }
                 v
             }
-        };
+        })
+    }
 
+    /// Where along its line (`length` metres long) a row's stations run, checking `end_m`
+    /// against `start_m` and the line, `start_m` against the line, and the number of objects
+    /// (`offset_count` a station) against [`MAX_ROW_OBJECTS`].
+    fn row_stations(
+        &self,
+        spec: &RowSpec,
+        field: &str,
+        line: &Polyline,
+        length: f64,
+        offset_count: usize,
+    ) -> Result<RowStations, ScenarioError> {
         let start = spec.start_m.as_ref().map_or(0.0, |s| s.get_ref().0);
         // On a closed line without end_m, the station at the full length would repeat s = 0.
         let (end, open_end) = match &spec.end_m {
@@ -1432,7 +1534,7 @@ impl Resolver<'_> {
         };
         let spacing = spec.spacing_m.get_ref().0;
         let stations = ((end - start) / spacing + 1e-9).floor() + 1.0;
-        let count = stations * offsets.len() as f64;
+        let count = stations * offset_count as f64;
         if count > MAX_ROW_OBJECTS as f64 {
             return Err(self.err(
                 spec.spacing_m.span(),
@@ -1440,11 +1542,42 @@ impl Resolver<'_> {
                 format!(
                     "{spacing} m over {:.1} m with {} offset(s) makes {count:.0} objects, more than {MAX_ROW_OBJECTS}",
                     end - start,
-                    offsets.len()
+                    offset_count
                 ),
             ));
         }
+        Ok(RowStations {
+            start,
+            end,
+            open_end,
+            length,
+            spacing,
+            stations,
+            count,
+        })
+    }
 
+    /// Places a row's objects, station by station and, at each, offset by offset (ids
+    /// `<row id>_<n>` from 1), refusing an offset object a sharp turn puts near the line.
+    fn place_row(
+        &self,
+        r: &Spanned<RowSpec>,
+        field: &str,
+        shape: SolidShape,
+        line: &Polyline,
+        offsets: &[f64],
+        stations: &RowStations,
+    ) -> Result<Vec<RowObject>, ScenarioError> {
+        let spec = r.get_ref();
+        let RowStations {
+            start,
+            end,
+            open_end,
+            length,
+            spacing,
+            stations,
+            count,
+        } = *stations;
         let remission = spec
             .remission
             .map_or_else(|| default_remission(spec.kind), |r| r.0);
@@ -1457,7 +1590,7 @@ impl Resolver<'_> {
             }
             let (p, heading) = line.at(s_m);
             let normal = Vector2::new(-heading.sin(), heading.cos());
-            for &offset_m in &offsets {
+            for &offset_m in offsets {
                 let q = p + normal * offset_m;
                 // A sharp turn of the line puts an offset object of one segment over another:
                 // refuse it rather than place an object where the line runs.
@@ -1619,16 +1752,6 @@ impl Resolver<'_> {
     }
 }
 
-/// Claims the id of table `field` (`objects[3]`) through `claim` (id, span, field, owner, prefix).
-fn claim_id(
-    claim: &mut impl FnMut(&str, Range<usize>, &str, String, &str) -> Result<(), ScenarioError>,
-    id: &Spanned<String>,
-    field: &str,
-) -> Result<(), ScenarioError> {
-    let field = format!("{field}.id");
-    claim(id.get_ref(), id.span(), &field, format!("`{field}`"), "")
-}
-
 /// An object a row made, with where along its line it stands.
 struct RowObject {
     solid: Solid,
@@ -1636,6 +1759,25 @@ struct RowObject {
     s_m: f64,
     /// Lateral offset from the line, metres, left positive.
     offset_m: f64,
+}
+
+/// Where along its line a row's stations run (see [`Resolver::row_stations`]).
+#[derive(Clone, Copy)]
+struct RowStations {
+    /// Arc length of the first station, metres.
+    start: f64,
+    /// Arc length no station goes beyond, metres.
+    end: f64,
+    /// A closed line without `end_m`: no station at the full length (it would repeat s = 0).
+    open_end: bool,
+    /// Length of the line, metres.
+    length: f64,
+    /// Distance between stations, metres.
+    spacing: f64,
+    /// Number of stations (a whole number).
+    stations: f64,
+    /// Number of objects: stations times offsets.
+    count: f64,
 }
 
 /// A row's line: a polyline with arc lengths (closed: back to its first point).
