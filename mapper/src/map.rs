@@ -37,7 +37,7 @@ use crate::collision::CollisionModel;
 use crate::edt::EdtScratch;
 use crate::error::{MapError, Result, positive};
 use crate::grid::{Grid, GridGeometry};
-use crate::levels::{HeightClass, Levels};
+use crate::levels::{HeightClass, LevelMode, Levels};
 use crate::occupancy::{ObstacleTest, ObstacleTestParams, OccupancyParams, probability};
 use crate::odm::{DistanceMap, DistanceMaps};
 use crate::remission::RemissionCell;
@@ -204,6 +204,8 @@ pub struct InsertStats {
     pub self_hits: usize,
     /// Dropped beyond the maximum range or outside the window.
     pub out_of_range: usize,
+    /// Dropped at or above the levels' ceiling (in no level, no evidence to the obstacle test).
+    pub above_ceiling: usize,
     /// Obstacle hits per level.
     pub hits: Vec<usize>,
     /// Cells updated as free per level.
@@ -258,8 +260,25 @@ fn height_class(height_m: f32, lo: f32, hi: f32) -> HeightClass {
 }
 
 /// With [`FreeSpaceStop::ScanHits`], a beam clears an older occupied cell only when it crosses
-/// it lower than this above the level's height, metres.
+/// it lower than this above the level's height (cumulative levels: above the ground, the height
+/// of level 0, for every level; see [`clear_below_m`]), metres.
 const CLEAR_MARGIN_M: f64 = 0.2;
+
+/// Below this height a beam crossing an older occupied cell of level `k` is evidence the cell is
+/// free ([`FreeSpaceStop::ScanHits`]).
+///
+/// Cumulative levels: `h_0 + CLEAR_MARGIN_M` for every level. Level k holds a subset of level 0
+/// (what reaches h_k or higher), so what clears a cell of level k must clear it in level 0 too;
+/// with `h_k + margin` a beam passing under a deck between `h_0 + margin` and `h_k + margin` (the
+/// jet's 1.55 m sensor sends nearly every beam under a bridge below its `h_1 + margin` = 1.3 m)
+/// lowered the deck's cells in level 1 and left them in level 0, so level 1 lost what the
+/// cumulative rule says it holds. Banded levels are independent bands: `h_k + margin`.
+fn clear_below_m(levels: &Levels, k: usize) -> f64 {
+    match levels.mode() {
+        LevelMode::Cumulative => levels.heights_m()[0] + CLEAR_MARGIN_M,
+        LevelMode::Banded => levels.heights_m()[k] + CLEAR_MARGIN_M,
+    }
+}
 
 /// The local window of a quantized multi-height occupancy grid map.
 #[derive(Debug)]
@@ -770,13 +789,17 @@ impl MultiHeightMap {
         Ok(stats)
     }
 
-    /// Step 1 of the insertion: drop and classify every return once.
+    /// Step 1 of the insertion: drop and classify every return once (self-hits, returns out of
+    /// range or at or above the ceiling are dropped).
     fn classify(&mut self, scan: &Scan, vehicle: Option<&CollisionModel>, stats: &mut InsertStats) {
         let beams = scan.beams();
         let params = self.config.obstacle_test;
         let test = ObstacleTest::new(params);
         let margin = self.config.self_hit_margin_m;
         let geometry = self.geometry;
+        // Returns at or above the ceiling belong to no level (CARMEN drops points above the
+        // vehicle plus a margin): dropped here, before the obstacle test pairs them.
+        let ceiling = self.levels.ceiling_m().unwrap_or(f64::INFINITY);
         // Every entry is written below: resizing (not clearing) spares a serial pass over them.
         self.classified
             .resize(scan.returns().len(), Classified::default());
@@ -791,7 +814,7 @@ impl MultiHeightMap {
         let n_levels = bands.len().max(1);
         self.column_levels
             .resize(scan.columns().len() * n_levels, ColumnLevel::default());
-        let counts: (usize, usize, usize) = self
+        let counts: (usize, usize, usize, usize) = self
             .classified
             .par_chunks_mut(beams)
             .zip(self.column_levels.par_chunks_mut(n_levels))
@@ -801,7 +824,7 @@ impl MultiHeightMap {
                 let sensor = Point2::from(column.world_from_sensor.translation.vector.xy());
                 let sensor3 = nalgebra::Point3::from(column.world_from_sensor.translation.vector);
                 let vehicle_from_world = column.world_from_vehicle.inverse();
-                let (mut n, mut self_hits, mut far) = (0, 0, 0);
+                let (mut n, mut self_hits, mut far, mut above) = (0, 0, 0, 0);
                 summary.fill(ColumnLevel::default());
                 // The return of the beam below (dropped or not) and its horizontal range.
                 let mut below: Option<(Point3<f64>, f64)> = None;
@@ -819,8 +842,14 @@ impl MultiHeightMap {
                     let xy = Point2::new(p.x, p.y);
                     let (dx, dy) = (p.x - sensor.x, p.y - sensor.y);
                     let range_xy = (dx * dx + dy * dy).sqrt();
-                    let lower = below.replace((p, range_xy));
                     let height = p.z - params.ground_height_m;
+                    if height >= ceiling {
+                        // In no level, and no evidence for the beam above: as if it had no echo.
+                        below = None;
+                        above += 1;
+                        continue;
+                    }
+                    let lower = below.replace((p, range_xy));
                     let Some(cell) = geometry
                         .index_of(&xy)
                         .filter(|_| range_xy <= params.max_range_m)
@@ -864,12 +893,16 @@ impl MultiHeightMap {
                         }
                     }
                 }
-                (n, self_hits, far)
+                (n, self_hits, far, above)
             })
-            .reduce(|| (0, 0, 0), |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2));
+            .reduce(
+                || (0, 0, 0, 0),
+                |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2, a.3 + b.3),
+            );
         stats.returns = counts.0;
         stats.self_hits = counts.1;
         stats.out_of_range = counts.2;
+        stats.above_ceiling = counts.3;
     }
 
     /// Recomputes the distance maps of the levels that changed since the last call, over the
@@ -1271,7 +1304,7 @@ fn insert_level(
     }
     let watch = no_obstacle_at_or_below(config);
     // Below this height a beam crossing an older occupied cell is evidence the cell is free.
-    let clear_below = levels.heights_m()[k] + CLEAR_MARGIN_M;
+    let clear_below = clear_below_m(levels, k);
     let stops_walk = |i: usize, ray_z: &mut dyn FnMut() -> f64| match config.free_space_stop {
         FreeSpaceStop::AnyOccupied => true,
         FreeSpaceStop::ScanHits => {
