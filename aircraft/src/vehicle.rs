@@ -105,10 +105,7 @@ impl Vehicle {
     /// The vehicle's top: the highest point of its collision parts above the ground, metres
     /// (0 for a vehicle without parts).
     pub fn top_m(&self) -> f64 {
-        self.parts
-            .iter()
-            .map(|p| p.top_m())
-            .fold(0.0, f64::max)
+        self.parts.iter().map(|p| p.top_m()).fold(0.0, f64::max)
     }
 
     /// The map's ceiling for this vehicle: its top plus the sidecar's `overhead_clearance_m`,

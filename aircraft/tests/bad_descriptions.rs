@@ -199,7 +199,10 @@ fn sidecar_parses_and_errors_carry_line_and_column() {
     let spec = VehicleSpec::from_str(SPEC, "t.toml").expect("parses");
     assert_eq!(spec.lidar.rpy_rad, [0.0; 3]);
     assert_eq!(spec.fit, aircraft::FitOptions::default());
-    assert_eq!(spec.overhead_clearance_m, aircraft::DEFAULT_OVERHEAD_CLEARANCE_M);
+    assert_eq!(
+        spec.overhead_clearance_m,
+        aircraft::DEFAULT_OVERHEAD_CLEARANCE_M
+    );
     // An unknown field on line 9.
     let text = SPEC.replace("max_speed_m_s = 8.33", "max_speed_kmh = 30.0");
     match VehicleSpec::from_str(&text, "t.toml") {

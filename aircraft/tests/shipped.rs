@@ -274,7 +274,10 @@ fn every_shipped_vehicle_has_its_top_and_a_ceiling_0_4_m_above_it() {
     ] {
         let v = Vehicle::shipped(name).unwrap();
         assert!((v.top_m() - top).abs() < 1e-4, "{name}: top {}", v.top_m());
-        assert_eq!(v.spec.overhead_clearance_m, aircraft::DEFAULT_OVERHEAD_CLEARANCE_M);
+        assert_eq!(
+            v.spec.overhead_clearance_m,
+            aircraft::DEFAULT_OVERHEAD_CLEARANCE_M
+        );
         assert!(
             (v.ceiling_m() - (top + 0.4)).abs() < 1e-4,
             "{name}: ceiling {}",

@@ -138,14 +138,20 @@ fn a_deck_over_the_route_is_in_level_1_wherever_it_is_in_level_0() {
     for i in 0..140 {
         let x = -40.0 + i as f64 * 0.5;
         let scan = Lidar::hdl32e()
-            .scan(&deck, &Isometry2::new(Vector2::new(x, 0.0), 0.0), &mount, |_, _| 0.0)
+            .scan(
+                &deck,
+                &Isometry2::new(Vector2::new(x, 0.0), 0.0),
+                &mount,
+                |_, _| 0.0,
+            )
             .unwrap();
         let returns = scan
             .returns()
             .chunks(scan.beams())
             .enumerate()
             .flat_map(|(c, column)| {
-                let ahead = (c as f64 / scan.column_count() as f64 * std::f64::consts::TAU).cos() > 0.0;
+                let ahead =
+                    (c as f64 / scan.column_count() as f64 * std::f64::consts::TAU).cos() > 0.0;
                 column.iter().map(move |r| r.filter(|_| ahead))
             })
             .collect();
