@@ -108,7 +108,8 @@ pub enum FreeSpaceWalks {
 #[serde(rename_all = "snake_case")]
 pub enum FreeSpaceStop {
     /// Cells hit by the scan being inserted, and older occupied cells the beam passes above
-    /// the level's height plus 0.2 m (a beam over a cone is no evidence the cone left). An older
+    /// 0.2 m over the ground (cumulative levels; banded: over the level's height) (a beam over a
+    /// cone is no evidence the cone left). An older
     /// occupied cell the beam passes lower through is lowered by `l_free`, so an obstacle that
     /// moved away (a crossing vehicle) is cleared. The default.
     #[default]

@@ -102,8 +102,8 @@ fn the_car_stops_short_of_a_bar_whose_underside_is_1_9_m_up() {
 }
 
 /// The boarding bridge 6 m up is a static object (infrastructure: in the offline map). Under
-/// its ceiling (7.00 m) it is an obstacle in both levels and the jet stops short of it and waits
-/// - here with forgetting off. With the default forgetting (live occupancy no longer seen fades
+/// its ceiling (7.00 m) it is an obstacle in both levels and the jet stops short of it and waits,
+/// here with forgetting off. With the default forgetting (live occupancy no longer seen fades
 /// to the prior in 10 s) the deck fades before the tail gets there: the nose sensor (1.55 m)
 /// stops seeing a 6 m deck from 23.6 m, and the tail is 20 m behind it; see the ignored test
 /// below and issue 19 part 1 (forgetting on evidence).
