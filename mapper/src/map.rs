@@ -37,7 +37,7 @@ use crate::collision::CollisionModel;
 use crate::edt::EdtScratch;
 use crate::error::{MapError, Result, positive};
 use crate::grid::{Grid, GridGeometry};
-use crate::levels::{HeightClass, LevelMode, Levels};
+use crate::levels::{HeightClass, Levels};
 use crate::occupancy::{ObstacleTest, ObstacleTestParams, OccupancyParams, probability};
 use crate::odm::{DistanceMap, DistanceMaps};
 use crate::remission::RemissionCell;
@@ -108,8 +108,7 @@ pub enum FreeSpaceWalks {
 #[serde(rename_all = "snake_case")]
 pub enum FreeSpaceStop {
     /// Cells hit by the scan being inserted, and older occupied cells the beam passes above
-    /// 0.2 m over the ground (cumulative levels; banded: over the level's height) (a beam over a
-    /// cone is no evidence the cone left). An older
+    /// the level's height plus 0.2 m (a beam over a cone is no evidence the cone left). An older
     /// occupied cell the beam passes lower through is lowered by `l_free`, so an obstacle that
     /// moved away (a crossing vehicle) is cleared. The default.
     #[default]
@@ -261,25 +260,17 @@ fn height_class(height_m: f32, lo: f32, hi: f32) -> HeightClass {
 }
 
 /// With [`FreeSpaceStop::ScanHits`], a beam clears an older occupied cell only when it crosses
-/// it lower than this above the level's height (cumulative levels: above the ground, the height
-/// of level 0, for every level; see [`clear_below_m`]), metres.
-const CLEAR_MARGIN_M: f64 = 0.2;
-
-/// Below this height a beam crossing an older occupied cell of level `k` is evidence the cell is
-/// free ([`FreeSpaceStop::ScanHits`]).
+/// it lower than this above the level's height, metres.
 ///
-/// Cumulative levels: `h_0 + CLEAR_MARGIN_M` for every level. Level k holds a subset of level 0
-/// (what reaches h_k or higher), so what clears a cell of level k must clear it in level 0 too;
-/// with `h_k + margin` a beam passing under a deck between `h_0 + margin` and `h_k + margin` (the
-/// jet's 1.55 m sensor sends nearly every beam under a bridge below its `h_1 + margin` = 1.3 m)
-/// lowered the deck's cells in level 1 and left them in level 0, so level 1 lost what the
-/// cumulative rule says it holds. Banded levels are independent bands: `h_k + margin`.
-fn clear_below_m(levels: &Levels, k: usize) -> f64 {
-    match levels.mode() {
-        LevelMode::Cumulative => levels.heights_m()[0] + CLEAR_MARGIN_M,
-        LevelMode::Banded => levels.heights_m()[k] + CLEAR_MARGIN_M,
-    }
-}
+/// Known to break the cumulative rule for overhangs (issue 19): with the level's own height, a
+/// beam passing under a deck between 0.2 m and h_k + 0.2 m lowers the deck's cells in level k
+/// and not in level 0 (the jet's 1.55 m sensor sends nearly every beam under a bridge below its
+/// h_1 + 0.2 = 1.3 m: a mapping drive under a 6 m deck leaves 2693 deck cells in level 0 and 63
+/// in level 1). The fix, `h_0 + 0.2` for every cumulative level (level k is a subset of level
+/// 0, so what clears it there must clear it in level 0), is on branch
+/// `overhead-cumulative-clear`: it changes the parking-lot golden and gives the crossing-vehicle
+/// jet a second 0.6 s stop, so it waits for a decision.
+const CLEAR_MARGIN_M: f64 = 0.2;
 
 /// The local window of a quantized multi-height occupancy grid map.
 #[derive(Debug)]
@@ -1305,7 +1296,7 @@ fn insert_level(
     }
     let watch = no_obstacle_at_or_below(config);
     // Below this height a beam crossing an older occupied cell is evidence the cell is free.
-    let clear_below = clear_below_m(levels, k);
+    let clear_below = levels.heights_m()[k] + CLEAR_MARGIN_M;
     let stops_walk = |i: usize, ray_z: &mut dyn FnMut() -> f64| match config.free_space_stop {
         FreeSpaceStop::AnyOccupied => true,
         FreeSpaceStop::ScanHits => {

@@ -19,8 +19,7 @@ use crate::lidar::{Lidar, SweepPoses};
 use crate::scenario::Scenario;
 use crate::world::World;
 
-/// Bumped when the mapping drive changes what it builds (2: the vehicle's ceiling, and cumulative
-/// levels cleared by the ground level's rule).
+/// Bumped when the mapping drive changes what it builds (2: the vehicle's ceiling).
 const MAP_FORMAT: u32 = 2;
 
 /// What a mapping drive did.
