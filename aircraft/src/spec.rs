@@ -1,10 +1,12 @@
 //! The sidecar TOML beside each URDF: what URDF does not say about a vehicle (motion limits,
-//! LiDAR mount, heights of interest, fit options). Unknown fields are errors.
+//! LiDAR mount, heights of interest, overhead clearance, fit options). Unknown fields are errors.
 //!
 //! ```toml
 //! name = "iara_car"                 # vehicle name
 //! urdf = "iara_car.urdf"            # URDF path, relative to this file
 //! heights_of_interest_m = [0.0]     # h_0 = 0 < h_1 < ..., metres above the ground
+//! overhead_clearance_m = 0.4        # optional, >= 0, default 0.4: the map's ceiling is the
+//!                                   # vehicle's top (highest collision part) plus this, m
 //!
 //! [motion]
 //! steering = "front_wheels"         # "front_wheels" or "nose_wheel"
@@ -91,6 +93,21 @@ impl LidarMount {
     }
 }
 
+/// The default overhead clearance, metres: 0.4 m.
+///
+/// What it must cover is the error in the height of a return near the top of the vehicle,
+/// when a structure ahead must be judged: the map takes the vehicle as level on flat ground, so
+/// a pitch of 1 degree (braking, a ramp, a bump; unmodelled) moves a point 10 m ahead by
+/// 0.17 m; the suspension's or gear struts' travel over a bump, about 0.1 m; the LiDAR's range
+/// error, 0.02 m; and roof-top items the URDF leaves out (antennas, beacons). That sums to about
+/// 0.3 m; 0.4 m leaves a margin over it. Larger gives away headroom that is really there: the
+/// car (top 2.22 m) would no longer pass under a 2.8 m canopy with 0.6 m.
+pub const DEFAULT_OVERHEAD_CLEARANCE_M: f64 = 0.4;
+
+fn default_overhead_clearance_m() -> f64 {
+    DEFAULT_OVERHEAD_CLEARANCE_M
+}
+
 /// A vehicle's sidecar file.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -101,6 +118,13 @@ pub struct VehicleSpec {
     pub urdf: PathBuf,
     /// Heights of interest h_0 = 0 < h_1 < ..., metres above the ground: one level each.
     pub heights_of_interest_m: Vec<f64>,
+    /// How far above the vehicle's top (the highest point of its collision parts) the map's
+    /// ceiling is, metres (>= 0; default [`DEFAULT_OVERHEAD_CLEARANCE_M`]): returns at or above
+    /// the ceiling belong to no level, so the vehicle drives under what is higher (CARMEN drops
+    /// points above its highest sensor plus `safe_range_above_sensors` the same way), while
+    /// anything whose underside is lower is an obstacle.
+    #[serde(default = "default_overhead_clearance_m")]
+    pub overhead_clearance_m: f64,
     /// Motion limits.
     pub motion: MotionLimits,
     /// LiDAR mount pose.
@@ -121,6 +145,12 @@ impl VehicleSpec {
         };
         check_heights(&spec.heights_of_interest_m)
             .map_err(|m| field("heights_of_interest_m", m))?;
+        if !(spec.overhead_clearance_m.is_finite() && spec.overhead_clearance_m >= 0.0) {
+            return Err(field(
+                "overhead_clearance_m",
+                format!("{} must be finite and >= 0", spec.overhead_clearance_m),
+            ));
+        }
         let m = &spec.motion;
         for (name, v) in [
             ("motion.wheelbase_m", m.wheelbase_m),

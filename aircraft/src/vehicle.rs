@@ -102,6 +102,18 @@ impl Vehicle {
         self.spec.lidar.vehicle_from_lidar()
     }
 
+    /// The vehicle's top: the highest point of its collision parts above the ground, metres
+    /// (0 for a vehicle without parts).
+    pub fn top_m(&self) -> f64 {
+        self.parts.iter().map(|p| p.top_m()).fold(0.0, f64::max)
+    }
+
+    /// The map's ceiling for this vehicle: its top plus the sidecar's `overhead_clearance_m`,
+    /// metres above the ground. Returns at or above it belong to no level.
+    pub fn ceiling_m(&self) -> f64 {
+        self.top_m() + self.spec.overhead_clearance_m
+    }
+
     /// Fits the circle model with the spec's heights of interest and fit options.
     pub fn fit(&self) -> Result<FittedModel> {
         fit_parts(

@@ -199,6 +199,10 @@ fn sidecar_parses_and_errors_carry_line_and_column() {
     let spec = VehicleSpec::from_str(SPEC, "t.toml").expect("parses");
     assert_eq!(spec.lidar.rpy_rad, [0.0; 3]);
     assert_eq!(spec.fit, aircraft::FitOptions::default());
+    assert_eq!(
+        spec.overhead_clearance_m,
+        aircraft::DEFAULT_OVERHEAD_CLEARANCE_M
+    );
     // An unknown field on line 9.
     let text = SPEC.replace("max_speed_m_s = 8.33", "max_speed_kmh = 30.0");
     match VehicleSpec::from_str(&text, "t.toml") {
@@ -238,6 +242,16 @@ fn sidecar_parses_and_errors_carry_line_and_column() {
             "motion.max_steering_angle_rad",
         ),
         ("[0.5, 0.0, 2.15]", "[0.5, nan, 2.15]", "lidar"),
+        (
+            "heights_of_interest_m = [0.0, 0.7]",
+            "heights_of_interest_m = [0.0, 0.7]\noverhead_clearance_m = -0.1",
+            "overhead_clearance_m",
+        ),
+        (
+            "heights_of_interest_m = [0.0, 0.7]",
+            "heights_of_interest_m = [0.0, 0.7]\noverhead_clearance_m = inf",
+            "overhead_clearance_m",
+        ),
     ] {
         let e = VehicleSpec::from_str(&SPEC.replace(from, to), "t.toml").expect_err(field);
         assert!(matches!(e, Error::Field { .. }), "{e}");

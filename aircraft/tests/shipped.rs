@@ -261,3 +261,27 @@ fn svg_has_one_group_per_level_and_every_circle() {
         fit.model.circles().len()
     );
 }
+
+#[test]
+fn every_shipped_vehicle_has_its_top_and_a_ceiling_0_4_m_above_it() {
+    // (name, top: the highest point of a collision part, m)
+    for (name, top) in [
+        // The Velodyne on the roof board: 1.72 + 0.43 + 0.144 / 2.
+        ("iara_car", 2.222),
+        ("iara_car_fake_wing", 2.222),
+        // The T-tail's stabiliser on top of the fin.
+        ("praetor600", 6.6043),
+    ] {
+        let v = Vehicle::shipped(name).unwrap();
+        assert!((v.top_m() - top).abs() < 1e-4, "{name}: top {}", v.top_m());
+        assert_eq!(
+            v.spec.overhead_clearance_m,
+            aircraft::DEFAULT_OVERHEAD_CLEARANCE_M
+        );
+        assert!(
+            (v.ceiling_m() - (top + 0.4)).abs() < 1e-4,
+            "{name}: ceiling {}",
+            v.ceiling_m()
+        );
+    }
+}

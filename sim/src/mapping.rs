@@ -19,8 +19,8 @@ use crate::lidar::{Lidar, SweepPoses};
 use crate::scenario::Scenario;
 use crate::world::World;
 
-/// Bumped when the mapping drive changes what it builds.
-const MAP_FORMAT: u32 = 1;
+/// Bumped when the mapping drive changes what it builds (2: the vehicle's ceiling).
+const MAP_FORMAT: u32 = 2;
 
 /// What a mapping drive did.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
@@ -46,8 +46,8 @@ pub fn map_config(config: &RunConfig) -> MapConfig {
     config.mapping.map
 }
 
-/// Fingerprint of a scenario's offline map inputs: the scenario and vehicle files, the map and
-/// LiDAR settings of `config`, the format.
+/// Fingerprint of a scenario's offline map inputs: the scenario and vehicle files, the levels
+/// (heights and ceiling), the map and LiDAR settings of `config`, the format.
 pub fn fingerprint(scenario: &Scenario, config: &RunConfig) -> Result<String> {
     let mut h = crc32fast::Hasher::new();
     h.update(&std::fs::read(&scenario.path).map_err(|source| Error::Io {
@@ -56,6 +56,7 @@ pub fn fingerprint(scenario: &Scenario, config: &RunConfig) -> Result<String> {
         source,
     })?);
     h.update(format!("{:?}", scenario.vehicle.vehicle).as_bytes());
+    h.update(format!("{:?}", levels_of(scenario)?).as_bytes());
     h.update(format!("{:?}{:?}{MAP_FORMAT}", map_config(config), config.lidar).as_bytes());
     Ok(format!("{:08x}", h.finalize()))
 }
@@ -153,10 +154,14 @@ pub fn self_filter_model(vehicle: &aircraft::Vehicle) -> Result<mapper::Collisio
         .model)
 }
 
-/// The levels a scenario's vehicle asks for (its heights of interest, cumulative).
+/// The levels a scenario's vehicle asks for: its heights of interest, cumulative, under its
+/// ceiling (`aircraft::Vehicle::ceiling_m`: its top plus its overhead clearance).
 pub fn levels_of(scenario: &Scenario) -> Result<Levels> {
-    Ok(Levels::cumulative(
-        scenario.vehicle.vehicle.spec.heights_of_interest_m.clone(),
+    let vehicle = &scenario.vehicle.vehicle;
+    Ok(Levels::new(
+        vehicle.spec.heights_of_interest_m.clone(),
+        mapper::LevelMode::Cumulative,
+        Some(vehicle.ceiling_m()),
     )?)
 }
 

@@ -98,3 +98,23 @@ fn garbage_manifest_is_an_error_not_a_missing_map() {
             .is_some()
     );
 }
+
+#[test]
+fn the_fingerprint_changes_with_the_vehicles_ceiling() {
+    let mut scenario = scenario();
+    let config = RunConfig::default();
+    let before = fingerprint(&scenario, &config).unwrap();
+    let levels = sim::mapping::levels_of(&scenario).unwrap();
+    assert!(
+        (levels.ceiling_m().unwrap() - 2.622).abs() < 1e-3,
+        "{levels:?}"
+    );
+    scenario.vehicle.vehicle.spec.overhead_clearance_m = 0.3;
+    let after = fingerprint(&scenario, &config).unwrap();
+    assert_ne!(before, after);
+    let levels = sim::mapping::levels_of(&scenario).unwrap();
+    assert!(
+        (levels.ceiling_m().unwrap() - 2.522).abs() < 1e-3,
+        "{levels:?}"
+    );
+}

@@ -222,10 +222,14 @@ fn a_run_is_identical_for_the_same_seed() {
 #[test]
 fn every_shipped_scenario_is_run_by_a_test() {
     let here = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let sources: String = ["tests/closed_loop.rs", "tests/experiments.rs"]
-        .iter()
-        .map(|f| std::fs::read_to_string(here.join(f)).unwrap())
-        .collect();
+    let sources: String = [
+        "tests/closed_loop.rs",
+        "tests/experiments.rs",
+        "tests/overhead.rs",
+    ]
+    .iter()
+    .map(|f| std::fs::read_to_string(here.join(f)).unwrap())
+    .collect();
     let mut shipped = Vec::new();
     for entry in std::fs::read_dir(here.join("../scenarios")).unwrap() {
         let path = entry.unwrap().path();

@@ -43,9 +43,11 @@ fn summary(s: &Scenario) -> Result<String, std::fmt::Error> {
     };
     writeln!(
         t,
-        "vehicle    {}{from}, levels at {} m, {} collision parts",
+        "vehicle    {}{from}, levels at {} m, ceiling {:.2} m (top {:.2} m), {} collision parts",
         v.vehicle.spec.name,
         levels.join(", "),
+        v.vehicle.ceiling_m(),
+        v.vehicle.top_m(),
         v.vehicle.parts.len()
     )?;
     writeln!(

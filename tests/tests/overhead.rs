@@ -1,0 +1,146 @@
+//! Overhead structures in the closed loop: every vehicle's map has a ceiling (its top plus its
+//! sidecar's `overhead_clearance_m`); what is above it is no obstacle, what reaches below it is.
+//! Each scenario of `scenarios/` about it, run after its mapping drive.
+
+use std::path::{Path, PathBuf};
+
+use sim::config::RunConfig;
+use sim::judge::EndReason;
+use sim::report::RunReport;
+use sim::run::{RunSetup, run};
+use sim::scenario::Scenario;
+
+fn scenario(name: &str) -> Scenario {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenarios")
+        .join(format!("{name}.toml"));
+    Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Builds the offline map (mapping drive) in `map_dir` with `config`, then runs the closed loop.
+fn run_with(s: &Scenario, map_dir: &Path, config: RunConfig) -> RunReport {
+    sim::mapping::map_drive(s, &config, map_dir, &mut |_, _| {})
+        .unwrap_or_else(|e| panic!("{}: mapping drive: {e:#}", s.name));
+    let setup = RunSetup {
+        config,
+        ..RunSetup::new(map_dir.to_path_buf())
+    };
+    run(s, &setup).unwrap_or_else(|e| panic!("{}: {e:#}", s.name))
+}
+
+/// A run-time structure the vehicle must drive under: passed, no stop anywhere, no contact.
+fn assert_passes_under(s: Scenario, id: &str) -> RunReport {
+    let name = s.name.clone();
+    let dir = tempfile::tempdir().unwrap();
+    let r = run_with(&s, dir.path(), RunConfig::default());
+    assert!(r.expectations_met, "{name}: {r:#?}");
+    assert_eq!(r.obstacles.len(), 1);
+    let o = &r.obstacles[0];
+    assert_eq!(o.id, id);
+    assert_eq!(o.passes.len(), 1, "{name}: {o:#?}");
+    assert_eq!(o.passes[0].outcome.as_str(), "passed", "{name}: {o:#?}");
+    assert!(o.passes[0].max_offset_m < 0.5, "{name}: {o:#?}");
+    assert!(r.stops.is_empty(), "{name}: no stop-and-go: {:?}", r.stops);
+    assert!(r.contacts.is_empty(), "{name}: {:?}", r.contacts);
+    r
+}
+
+#[test]
+fn the_car_passes_under_a_canopy_2_8_m_up_without_stopping() {
+    let r = assert_passes_under(scenario("canopy_car"), "canopy");
+    // The canopy's underside is 0.58 m above the Velodyne's top (2.22 m).
+    let d = r.obstacles[0].passes[0].min_clearance_m[0];
+    assert!((d - 0.58).abs() < 0.02, "{d}");
+}
+
+#[test]
+fn the_car_passes_under_a_bridge_4_5_m_up_without_stop_and_go() {
+    assert_passes_under(scenario("bridge_car"), "deck");
+}
+
+#[test]
+fn the_jet_passes_under_a_footbridge_9_m_up() {
+    assert_passes_under(scenario("footbridge_jet"), "footbridge");
+    // The jet passed under it before the ceiling too, only because its nose sensor stops seeing
+    // the deck 40 m out. Now the deck is in no level: as a static object, the offline map holds
+    // exactly what it holds without it.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(&scenario("footbridge_jet").path).unwrap();
+    let (before, deck) = text.split_once("[[obstacles]]").unwrap();
+    let deck = deck.replace("expect = \"pass_under\"\n", "");
+    let occupied = |text: &str, name: &str| {
+        let path = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let s = Scenario::from_file(&path).unwrap();
+        sim::mapping::map_drive(
+            &s,
+            &RunConfig::default(),
+            &dir.path().join(name),
+            &mut |_, _| {},
+        )
+        .unwrap()
+        .occupied_cells
+    };
+    let with_deck = occupied(&format!("{before}[[objects]]{deck}"), "with");
+    let without = occupied(before, "without");
+    assert_eq!(with_deck, without);
+}
+
+#[test]
+fn the_car_stops_short_of_a_bar_whose_underside_is_1_9_m_up() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario("low_bar_car");
+    let r = run_with(&s, dir.path(), RunConfig::default());
+    assert!(r.expectations_met, "{r:#?}");
+    let pass = &r.obstacles[0].passes[0];
+    assert_eq!(pass.outcome.as_str(), "stopped", "{r:#?}");
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
+    // It stopped before the bar was swung away (40 s), short of it (route x = 60 m), with room.
+    let stop = &r.stops[0];
+    assert!(stop.start_s < 40.0, "{stop:?}");
+    assert!(stop.route_s_m < 60.0, "{stop:?}");
+    assert!(pass.min_clearance_m[0] > 0.5, "{pass:?}");
+}
+
+/// The bridge 6 m up (a run-time obstacle that never goes away: the judge cannot close its
+/// `stop` pass, so this test asserts the stop itself). Under its ceiling (7.00 m) it is an obstacle in both levels and the jet stops short of it and waits,
+/// here with forgetting off. With the default forgetting (live occupancy no longer seen fades
+/// to the prior in 10 s) the deck fades before the tail gets there: the nose sensor (1.55 m)
+/// stops seeing a 6 m deck from 23.6 m, and the tail is 20 m behind it; see the ignored test
+/// below and issue 19 part 1 (forgetting on evidence).
+#[test]
+#[ignore = "needs the cumulative clearing rule of branch overhead-cumulative-clear: without it level 1 loses the deck and the tail strikes it at 31 s"]
+fn the_jet_stops_short_of_a_bridge_6_m_up_and_waits() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = scenario("low_bridge_jet");
+    let mut config = RunConfig::default();
+    config.mapping.forgetting.enabled = false;
+    let r = run_with(&s, dir.path(), config);
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
+    assert_eq!(r.end, EndReason::TimedOut, "it waits for ever: {r:#?}");
+    assert_eq!(r.stops.len(), 1, "{:?}", r.stops);
+    // Stopped with its main gear (the route's reference point) about under the bridge (x 118 ..
+    // 122 m): the wings (1.2 .. 2.1 m up) pass under it, the T-tail (from 5.6 m up, 8 to 11 m
+    // behind the main gear) stays short of it.
+    assert!(r.stops[0].route_s_m < 122.0, "{:?}", r.stops);
+    assert!(
+        r.min_clearance_m.iter().all(|d| *d > 0.3),
+        "{:?}",
+        r.min_clearance_m
+    );
+}
+
+/// The same with the default configuration: fails today (the tail strikes the deck at about
+/// 31 s), see the test above.
+#[test]
+#[ignore = "the default forgetting fades the unseen deck before the tail reaches it (issue 19 part 1)"]
+fn the_jet_stops_short_of_a_bridge_6_m_up_with_the_default_forgetting() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = run_with(
+        &scenario("low_bridge_jet"),
+        dir.path(),
+        RunConfig::default(),
+    );
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
+    assert_eq!(r.stops.len(), 1, "{:?}", r.stops);
+}
