@@ -102,45 +102,28 @@ fn the_car_stops_short_of_a_bar_whose_underside_is_1_9_m_up() {
     assert!(pass.min_clearance_m[0] > 0.5, "{pass:?}");
 }
 
-/// The bridge 6 m up (a run-time obstacle that never goes away: the judge cannot close its
-/// `stop` pass, so this test asserts the stop itself). Under its ceiling (7.00 m) it is an obstacle in both levels and the jet stops short of it and waits,
-/// here with forgetting off. With the default forgetting (live occupancy no longer seen fades
-/// to the prior in 10 s) the deck fades before the tail gets there: the nose sensor (1.55 m)
-/// stops seeing a 6 m deck from 23.6 m, and the tail is 20 m behind it; see the ignored test
-/// below and issue 19 part 1 (forgetting on evidence).
+/// FIXME(issue 19): the jet under a bridge 6 m up - below its ceiling (7.00 m), so an obstacle
+/// in both levels - should stop short of it and wait; today its T-tail strikes the deck. Two
+/// causes, both issue 19 part 1 and the cumulative rule: beams passing under the deck clear it
+/// from level 1 but not level 0 (see `mapper/tests/overhead.rs`), and forgetting fades the
+/// unseen deck (the nose sensor, 1.55 m up, stops seeing it 23.6 m out; the tail is 20 m
+/// behind). The scenario lives in `tests/fixme/`, not `scenarios/`, until it passes; this
+/// test asserts what happens today, so a fix shows here.
 #[test]
-#[ignore = "needs the cumulative clearing rule of branch overhead-cumulative-clear: without it level 1 loses the deck and the tail strikes it at 31 s"]
-fn the_jet_stops_short_of_a_bridge_6_m_up_and_waits() {
+fn fixme_the_jet_strikes_a_bridge_6_m_up_with_its_tail() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixme/low_bridge_jet.toml");
+    let s = Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"));
     let dir = tempfile::tempdir().unwrap();
-    let s = scenario("low_bridge_jet");
-    let mut config = RunConfig::default();
-    config.mapping.forgetting.enabled = false;
-    let r = run_with(&s, dir.path(), config);
-    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
-    assert_eq!(r.end, EndReason::TimedOut, "it waits for ever: {r:#?}");
-    assert_eq!(r.stops.len(), 1, "{:?}", r.stops);
-    // Stopped with its main gear (the route's reference point) about under the bridge (x 118 ..
-    // 122 m): the wings (1.2 .. 2.1 m up) pass under it, the T-tail (from 5.6 m up, 8 to 11 m
-    // behind the main gear) stays short of it.
-    assert!(r.stops[0].route_s_m < 122.0, "{:?}", r.stops);
+    let r = run_with(&s, dir.path(), RunConfig::default());
     assert!(
-        r.min_clearance_m.iter().all(|d| *d > 0.3),
+        !r.contacts.is_empty(),
+        "fixed? then move the scenario to scenarios/: {r:#?}"
+    );
+    assert!(
+        r.contacts
+            .iter()
+            .all(|c| c.part.contains("tail") || c.part.contains("stabil")),
         "{:?}",
-        r.min_clearance_m
+        r.contacts
     );
-}
-
-/// The same with the default configuration: fails today (the tail strikes the deck at about
-/// 31 s), see the test above.
-#[test]
-#[ignore = "the default forgetting fades the unseen deck before the tail reaches it (issue 19 part 1)"]
-fn the_jet_stops_short_of_a_bridge_6_m_up_with_the_default_forgetting() {
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_with(
-        &scenario("low_bridge_jet"),
-        dir.path(),
-        RunConfig::default(),
-    );
-    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
-    assert_eq!(r.stops.len(), 1, "{:?}", r.stops);
 }
