@@ -5,7 +5,6 @@
 use std::path::{Path, PathBuf};
 
 use sim::config::RunConfig;
-use sim::judge::EndReason;
 use sim::report::RunReport;
 use sim::run::{RunSetup, run};
 use sim::scenario::Scenario;
