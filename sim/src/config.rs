@@ -70,7 +70,8 @@ pub enum Schedule {
 #[serde(deny_unknown_fields, default)]
 pub struct MappingConfig {
     /// The map (cells, blocks, log-odds, obstacle test, self-hit margin). Default: the mapper's
-    /// defaults with a 1.5 m self-hit margin. The offline map is built with the same settings;
+    /// defaults with a 1.5 m self-hit margin and returns [`OBSTACLE_HEIGHT_M`] (0.1 m) above the
+    /// flat ground obstacles whatever the consecutive-beam test says. The offline map is built with the same settings;
     /// its fingerprint holds them. `max_distance_m` is set by the run from the vehicle and planner
     /// (`run::distance_cap_m`).
     pub map: MapConfig,
@@ -81,12 +82,31 @@ pub struct MappingConfig {
     pub forgetting: ForgettingConfig,
 }
 
+/// Height above the ground from which a return is an obstacle whatever the consecutive-beam
+/// test says, metres (the mapper's `unsafe_height_above_ground_m`, 1.0 m by default).
+///
+/// That test sees an object only where it rises more than about half a beam spacing (0.49 x
+/// range x 1.33 deg for the HDL-32E): 0.11 m at 10 m, 0.23 m at 20 m, 0.45 m at 40 m. A 0.15 m
+/// piece of debris is ground to it beyond about 14 m, and the car's own cabin hides the ground
+/// closer than about 10 m straight ahead, so the car of `closed_loop_pose_file` first had the
+/// debris in its map 12.7 m ahead: too late to go round it (it stopped against it, forgot it and
+/// drove over it). The simulator's ground is flat (z = 0) and a ground return's height is off by
+/// under 0.011 m rms (2 cm of range noise at the steepest beam, 30.67 deg), so 0.1 m is far
+/// outside the noise and below anything the vehicles must not touch (the debris, 0.15 m; the
+/// car's body clears 0.2 m, its wheels nothing).
+pub const OBSTACLE_HEIGHT_M: f64 = 0.1;
+
 impl Default for MappingConfig {
     fn default() -> Self {
+        let map = MapConfig::default();
         MappingConfig {
             map: MapConfig {
                 self_hit_margin_m: 1.5,
-                ..MapConfig::default()
+                obstacle_test: mapper::ObstacleTestParams {
+                    unsafe_height_above_ground_m: Some(OBSTACLE_HEIGHT_M),
+                    ..map.obstacle_test
+                },
+                ..map
             },
             distance_map_half_size_m: None,
             forgetting: ForgettingConfig::default(),

@@ -181,20 +181,24 @@ fn without_forgetting_the_jet_waits_for_the_crossing_cars_hidden_trail() {
 
 /// Debris 0.15 m tall appears on the far side of the loop at 20 s: the car must see it at
 /// wheel level and not touch it on either lap. It ran over it on both laps (4 wheel contacts)
-/// while no test ran this shipped scenario.
+/// while no test ran this shipped scenario: the consecutive-beam test alone mapped it only
+/// 12.7 m ahead, too late to go round; the car stopped against it, forgot it once its cabin hid
+/// it and drove over it. Mapped from its height (`sim::config::OBSTACLE_HEIGHT_M`), it is gone
+/// round on both laps.
 #[test]
-fn the_car_never_touches_the_debris_that_appears_on_its_loop() {
+fn the_car_goes_round_short_debris_on_both_laps_of_the_pose_file_loop() {
     let dir = tempfile::tempdir().unwrap();
     let r = run_scenario("closed_loop_pose_file", dir.path());
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
-    assert_eq!(r.laps_completed, 2);
-    let debris = r
-        .obstacles
-        .iter()
-        .find(|o| o.id == "debris_far_side")
-        .unwrap();
-    assert_eq!(debris.passes.len(), 2, "{debris:?}");
     assert!(r.expectations_met, "{r:#?}");
+    assert_eq!(r.laps_completed, 2);
+    assert_eq!(
+        outcomes(&r),
+        vec![("debris_far_side".into(), "deviated".into()); 2]
+    );
+    for pass in &r.obstacles[0].passes {
+        assert!(pass.min_clearance_m[0] > 0.2, "{pass:?}");
+    }
 }
 
 #[test]
