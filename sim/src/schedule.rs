@@ -90,28 +90,37 @@ impl Scheduler {
                 Ok((lidar_s, Some(thought)))
             }
             Schedule::Overlapped => {
-                let slot = std::mem::replace(&mut self.slot, Slot::Moving);
-                let (fresh, planned) = rayon::join(capture, || -> Result<_> {
-                    match slot {
-                        Slot::Ready(map) => Ok((map, None)),
-                        Slot::InFlight(rx) => {
-                            let (mut map, captured, mapping_s) = wait_for(&rx)?;
-                            let times = driver.plan(&mut map)?;
-                            Ok((map, Some((captured, mapping_s, times))))
-                        }
-                        Slot::Moving => Err(Error::Invalid("the online map was lost".into())),
+                // The last revolution's mapping is awaited here, on the loop's thread, before
+                // the join - not inside it. A closure of a join can be stolen by a worker that
+                // is itself inside the mapping task, waiting in one of the mapping's own joins:
+                // that worker would then wait for the mapping below it on its own stack, for
+                // ever (it hung with 3 or more threads).
+                let (mut map, last) = match std::mem::replace(&mut self.slot, Slot::Moving) {
+                    Slot::Ready(map) => (map, None),
+                    Slot::InFlight(rx) => {
+                        let (map, captured, mapping_s) = wait_for(&rx)?;
+                        (map, Some((captured, mapping_s)))
                     }
+                    Slot::Moving => {
+                        return Err(Error::Invalid("the online map was lost".into()));
+                    }
+                };
+                // The next revolution is cast beside the plan from the last one.
+                let (fresh, planned) = rayon::join(capture, || {
+                    last.map(|(captured, mapping_s)| {
+                        driver.plan(&mut map).map(|times| Thought {
+                            captured,
+                            mapping_s,
+                            times,
+                        })
+                    })
+                    .transpose()
                 });
-                let (map, thought) = planned?;
                 self.slot = Slot::Ready(map);
+                let thought = planned?;
                 let fresh = fresh?;
                 let lidar_s = fresh.lidar_s;
                 self.taken = Some(fresh);
-                let thought = thought.map(|(captured, mapping_s, times)| Thought {
-                    captured,
-                    mapping_s,
-                    times,
-                });
                 Ok((lidar_s, thought))
             }
         }
@@ -153,7 +162,8 @@ fn map_one(map: &mut OnlineMap, captured: &Captured) -> Result<f64> {
 }
 
 /// Waits for a mapping task's answer, running other pending rayon work meanwhile (the task's
-/// own parallel pieces, typically) instead of blocking a worker.
+/// own parallel pieces, typically) instead of blocking a worker. Only the loop's own thread
+/// waits here, outside any job another worker could steal.
 fn wait_for(rx: &Receiver<Mapped>) -> Mapped {
     loop {
         match rx.try_recv() {
