@@ -9,7 +9,7 @@ use crate::shapes::Part;
 use crate::spec::VehicleSpec;
 
 /// Names of the vehicles shipped in `aircraft/vehicles/`.
-pub const SHIPPED_VEHICLES: [&str; 3] = ["praetor600", "iara_car", "iara_car_fake_wing"];
+pub const SHIPPED_VEHICLES: [&str; 4] = ["praetor600", "iara_car", "iara_car_fake_wing", "a320"];
 
 macro_rules! shipped {
     ($name:literal) => {
@@ -24,10 +24,11 @@ macro_rules! shipped {
 }
 
 /// (name, sidecar path, sidecar text, URDF path, URDF text) of each shipped vehicle.
-const SHIPPED: [(&str, &str, &str, &str, &str); 3] = [
+const SHIPPED: [(&str, &str, &str, &str, &str); 4] = [
     shipped!("praetor600"),
     shipped!("iara_car"),
     shipped!("iara_car_fake_wing"),
+    shipped!("a320"),
 ];
 
 /// A described vehicle.

@@ -271,6 +271,8 @@ fn every_shipped_vehicle_has_its_top_and_a_ceiling_0_4_m_above_it() {
         ("iara_car_fake_wing", 2.222),
         // The T-tail's stabiliser on top of the fin.
         ("praetor600", 6.6043),
+        // The fin's top.
+        ("a320", 11.8),
     ] {
         let v = Vehicle::shipped(name).unwrap();
         assert!((v.top_m() - top).abs() < 1e-4, "{name}: top {}", v.top_m());
@@ -283,5 +285,44 @@ fn every_shipped_vehicle_has_its_top_and_a_ceiling_0_4_m_above_it() {
             "{name}: ceiling {}",
             v.ceiling_m()
         );
+    }
+}
+
+/// The A320-like airliner's three levels hold what they are for: the gear at the ground level,
+/// the underwing nacelles (underside 0.6 m) and the fuselage at 0.55 m, the wings, pylons and
+/// tail at 2.1 m; its default fit covers every level.
+#[test]
+fn the_airliner_has_its_gear_nacelles_and_wings_on_three_levels() {
+    let v = Vehicle::shipped("a320").unwrap();
+    let heights = v.spec.heights_of_interest_m.clone();
+    assert_eq!(heights, vec![0.0, 0.55, 2.1]);
+    let level = |link: &str| -> Vec<usize> {
+        v.parts
+            .iter()
+            .filter(|p| p.link == link)
+            .map(|p| aircraft::fit::level_of(p.underside_m(), &heights))
+            .collect()
+    };
+    for (link, want) in [
+        ("nose_gear", 0),
+        ("main_gear_left", 0),
+        ("main_gear_right", 0),
+        ("nacelle_left", 1),
+        ("nacelle_right", 1),
+        ("fuselage", 1),
+        ("wing_left", 2),
+        ("wing_right", 2),
+        ("fin", 2),
+    ] {
+        let levels = level(link);
+        assert!(!levels.is_empty(), "{link}: no part");
+        assert!(
+            levels.iter().all(|&l| l == want),
+            "{link}: levels {levels:?}"
+        );
+    }
+    let fit = v.fit().unwrap();
+    for r in evaluate(&fit, aircraft::report::DEFAULT_SAMPLES_PER_AXIS) {
+        assert_eq!(r.coverage, 1.0, "{r:?}");
     }
 }

@@ -14,6 +14,7 @@
 //! - [`remission`]: per-cell intensity statistics.
 //! - [`export`]: ROS map_server PGM/YAML, PNG and NumPy `.npy` files.
 //! - [`synthetic`]: analytic scenes and a synthetic HDL-32E for tests and benchmarks.
+//! - [`tracking`]: moving objects, so what they leave can be cleared on evidence.
 //! - [`workloads`]: the inputs of the headline benchmarks.
 
 pub mod blocks;
@@ -29,6 +30,7 @@ pub mod odm;
 pub mod remission;
 pub mod scan;
 pub mod synthetic;
+pub mod tracking;
 pub mod workloads;
 
 pub use blocks::{Block, BlockIndex, BlockSpec, BlockStore, write_atomically};
@@ -38,8 +40,11 @@ pub use collision::{
 pub use error::{MapError, Result};
 pub use grid::{Cell, Grid, GridGeometry};
 pub use levels::{HeightClass, LevelMode, Levels};
-pub use map::{FreeSpaceStop, FreeSpaceWalks, InsertStats, MapConfig, MergeMode, MultiHeightMap};
+pub use map::{
+    FreeSpaceStop, FreeSpaceWalks, InsertStats, MapConfig, MergeMode, MultiHeightMap, WorldCell,
+};
 pub use occupancy::{ObstacleTestParams, OccupancyParams};
 pub use odm::{DistanceMap, DistanceMaps};
 pub use remission::RemissionCell;
 pub use scan::{Return, Scan, ScanColumn};
+pub use tracking::{MovingObject, Tracker, TrackerConfig};

@@ -28,6 +28,8 @@
 //!    ([`FreeSpaceWalks::CoarseToFine`]) only every 2^j-th column walks there, adding 2^j
 //!    `l_free`: the same map with fewer cell updates.
 
+use std::collections::HashMap;
+
 use nalgebra::{Point2, Point3};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -259,17 +261,16 @@ fn height_class(height_m: f32, lo: f32, hi: f32) -> HeightClass {
     }
 }
 
-/// With [`FreeSpaceStop::ScanHits`], a beam clears an older occupied cell only when it crosses
-/// it lower than this above the level's height, metres.
+/// With [`FreeSpaceStop::ScanHits`], a beam clears an older occupied cell when it crosses the
+/// cell's column within this of the heights its obstacle was hit at (the span recorded per live
+/// cell), metres: a beam through where the obstacle was is evidence it has gone; a beam over a
+/// cone or under a deck is none. A cell with no recorded span (a live block read back from
+/// disk) is cleared by a beam lower than this above the level's height.
 ///
-/// Known to break the cumulative rule for overhangs (issue 19): with the level's own height, a
-/// beam passing under a deck between 0.2 m and h_k + 0.2 m lowers the deck's cells in level k
-/// and not in level 0 (the jet's 1.55 m sensor sends nearly every beam under a bridge below its
-/// h_1 + 0.2 = 1.3 m: a mapping drive under a 6 m deck leaves 2693 deck cells in level 0 and 63
-/// in level 1). The fix, `h_0 + 0.2` for every cumulative level (level k is a subset of level
-/// 0, so what clears it there must clear it in level 0), is on branch
-/// `overhead-cumulative-clear`: it changes the parking-lot golden and gives the crossing-vehicle
-/// jet a second 0.6 s stop, so it waits for a decision.
+/// The older rule, this above the level's height for every cell, broke the cumulative rule for
+/// overhangs (issue 19): a beam passing under a deck between 0.2 m and h_k + 0.2 m lowered the
+/// deck's cells in level k and not in level 0 (a mapping drive under a 6 m deck left 2693 deck
+/// cells in level 0 and 63 in level 1), and a beam under a bar 1.9 m up cleared the bar.
 const CLEAR_MARGIN_M: f64 = 0.2;
 
 /// The local window of a quantized multi-height occupancy grid map.
@@ -303,8 +304,17 @@ pub struct MultiHeightMap {
     column_levels: Vec<ColumnLevel>,
     /// Per level, the live cells that may be occupied: what forgetting visits.
     occupied: Vec<OccupiedCells>,
+    /// Per level, the cells the last revolution hit as obstacles (window indices, sorted).
+    last_hits: Vec<Vec<u32>>,
+    /// Per level, the span of heights (lowest, highest above ground, metres) at which each live
+    /// cell was hit as an obstacle: what a later beam must cross to clear it.
+    hit_spans: Vec<HashMap<WorldCell, HitSpan>>,
     edt_scratch: EdtScratch,
 }
+
+/// A cell on the world lattice: cell (0, 0) has its lower-left corner at the world origin. The
+/// same cell whatever the window (window indices move when it re-centres).
+pub type WorldCell = (i64, i64);
 
 /// The live cells of one level whose log-odds may be positive (p > 0.5), so that forgetting
 /// visits them instead of sweeping its square: a superset, as a list and a flag per cell. A hit
@@ -459,6 +469,8 @@ impl MultiHeightMap {
             classified: Vec::new(),
             column_levels: Vec::new(),
             occupied: vec![OccupiedCells::default(); n],
+            last_hits: vec![Vec::new(); n],
+            hit_spans: vec![HashMap::new(); n],
             edt_scratch: EdtScratch::default(),
             levels,
         };
@@ -604,6 +616,12 @@ impl MultiHeightMap {
         // region they are asked for next.
         self.odm_obstacles.iter_mut().for_each(Vec::clear);
         self.touched.iter_mut().for_each(TouchedCells::clear);
+        self.last_hits.iter_mut().for_each(Vec::clear);
+        let (x0, y0) = self.window_cell0();
+        let (w, h) = (self.geometry.width() as i64, self.geometry.height() as i64);
+        for spans in &mut self.hit_spans {
+            spans.retain(|c, _| c.0 >= x0 && c.1 >= y0 && c.0 < x0 + w && c.1 < y0 + h);
+        }
         Ok(true)
     }
 
@@ -736,6 +754,7 @@ impl MultiHeightMap {
         self.classify(scan, vehicle, &mut stats);
 
         let config = self.config;
+        let cell0 = self.window_cell0();
         let levels = &self.levels;
         let classified = &self.classified;
         let column_levels = &self.column_levels;
@@ -748,16 +767,25 @@ impl MultiHeightMap {
                     .par_iter_mut()
                     .zip(self.occupied.par_iter_mut())
                     .zip(self.touched.par_iter_mut())
+                    .zip(self.last_hits.par_iter_mut())
+                    .zip(self.hit_spans.par_iter_mut())
                     .enumerate()
-                    .map(|(k, ((grid, occupied), touched))| {
+                    .map(|(k, ((((grid, occupied), touched), last_hits), spans))| {
                         let summary = ColumnsOfLevel {
                             all: column_levels,
                             levels: levels.count(),
                             k,
                         };
                         insert_level(
-                            k, grid, occupied, touched, levels, classified, summary, scan,
-                            &geometry, &config,
+                            k,
+                            grid,
+                            (occupied, touched, last_hits, (spans, cell0)),
+                            levels,
+                            classified,
+                            summary,
+                            scan,
+                            &geometry,
+                            &config,
                         )
                     })
                     .collect()
@@ -1029,6 +1057,131 @@ impl MultiHeightMap {
         changed.iter().sum()
     }
 
+    /// The world-lattice cell of the window's cell (0, 0).
+    fn window_cell0(&self) -> WorldCell {
+        let b = self.config.block_cells as i64;
+        (self.window_lo.x * b, self.window_lo.y * b)
+    }
+
+    /// The world-lattice cell holding `point`.
+    pub fn world_cell(&self, point: &Point2<f64>) -> WorldCell {
+        let (x, y) = self.geometry.cell_coords(point);
+        let (x0, y0) = self.window_cell0();
+        (x + x0, y + y0)
+    }
+
+    /// The centre of a world-lattice cell, metres.
+    pub fn world_cell_center(&self, cell: WorldCell) -> Point2<f64> {
+        let r = self.config.resolution_m;
+        Point2::new((cell.0 as f64 + 0.5) * r, (cell.1 as f64 + 0.5) * r)
+    }
+
+    /// The window index of a world-lattice cell, `None` outside the window.
+    fn window_index(&self, cell: WorldCell) -> Option<usize> {
+        let (x0, y0) = self.window_cell0();
+        let (x, y) = (cell.0 - x0, cell.1 - y0);
+        let (w, h) = (self.geometry.width() as i64, self.geometry.height() as i64);
+        (x >= 0 && y >= 0 && x < w && y < h).then(|| (y * w + x) as usize)
+    }
+
+    /// The cells the last revolution hit as obstacles, each with the levels it hit them in (bit
+    /// k: level k), in world-lattice order. Empty after a re-centre until the next insertion.
+    pub fn last_scan_hits(&self) -> Vec<(WorldCell, u32)> {
+        let width = self.geometry.width();
+        let (x0, y0) = self.window_cell0();
+        let mut all: Vec<(WorldCell, u32)> = self
+            .last_hits
+            .iter()
+            .enumerate()
+            .flat_map(|(k, cells)| {
+                cells.iter().map(move |&i| {
+                    let i = i as usize;
+                    (
+                        ((i % width) as i64 + x0, (i / width) as i64 + y0),
+                        1u32 << k.min(31),
+                    )
+                })
+            })
+            .collect();
+        all.sort_unstable();
+        all.dedup_by(|b, a| {
+            if a.0 == b.0 {
+                a.1 |= b.1;
+                true
+            } else {
+                false
+            }
+        });
+        all
+    }
+
+    /// Hands the live evidence of obstacle at `cells` (world lattice) back to the prior, in every
+    /// level: a live cell more occupied than free (log-odds > 0) becomes unknown, so the offline
+    /// map speaks for it again. What moved away is cleared this way (the tracker of moving
+    /// objects decides what); free live cells and cells outside the window are left alone.
+    /// Returns the level cells changed.
+    pub fn clear_live(&mut self, cells: &[WorldCell]) -> usize {
+        let mut changed = 0;
+        for &cell in cells {
+            let Some(i) = self.window_index(cell) else {
+                continue;
+            };
+            for k in 0..self.levels.count() {
+                self.hit_spans[k].remove(&cell);
+                let v = &mut self.live[k].data_mut()[i];
+                if *v > 0.0 {
+                    *v = f32::NAN;
+                    self.touched[k].note(i as u32);
+                    self.odm_dirty[k] = true;
+                    changed += 1;
+                }
+            }
+        }
+        changed
+    }
+
+    /// Whether a world-lattice cell is an obstacle of level `level` (live merged with prior above
+    /// the obstacle threshold); false outside the window.
+    pub fn is_obstacle(&self, level: usize, cell: WorldCell) -> bool {
+        let (Some(i), Some(live)) = (self.window_index(cell), self.live.get(level)) else {
+            return false;
+        };
+        let t = self.config.obstacle_threshold;
+        merge_log_odds(
+            live.data()[i],
+            self.prior[level].data()[i],
+            self.config.merge,
+        )
+        .is_some_and(|l| l > (t / (1.0 - t)).ln())
+    }
+
+    /// The obstacle cells of `level` whose centres lie within `radius_m` of `center`.
+    pub fn obstacles_within(
+        &self,
+        level: usize,
+        center: &Point2<f64>,
+        radius_m: f64,
+    ) -> Vec<WorldCell> {
+        let r = self.config.resolution_m;
+        if !(radius_m.is_finite() && radius_m >= 0.0) {
+            return Vec::new();
+        }
+        let (cx, cy) = self.world_cell(center);
+        let n = (radius_m / r).ceil() as i64 + 1;
+        let mut out = Vec::new();
+        for y in cy - n..=cy + n {
+            for x in cx - n..=cx + n {
+                let c = (x, y);
+                if (self.world_cell_center(c) - center).norm() <= radius_m
+                    && self.is_obstacle(level, c)
+                {
+                    out.push(c);
+                }
+            }
+        }
+        out
+    }
+
     /// Recomputes, over the region of `rw` x `rh` cells from (`x0`, `y0`), the distance map of
     /// each level that changed since its last computation and whose obstacle cells differ from
     /// those it was computed from. Returns how many levels were recomputed.
@@ -1238,13 +1391,78 @@ impl ColumnsOfLevel<'_> {
     }
 }
 
+/// What the insertion of one level updates beside its grid: its occupied and touched cells, the
+/// cells this scan hit, and the height spans of its hits (keyed by world cell, with the world
+/// cell of the window's cell 0).
+type LevelState<'a> = (
+    &'a mut OccupiedCells,
+    &'a mut TouchedCells,
+    &'a mut Vec<u32>,
+    (&'a mut HashMap<WorldCell, HitSpan>, WorldCell),
+);
+
+/// The lowest and highest heights above ground a cell was hit at as an obstacle, metres.
+type HitSpan = (f32, f32);
+
+/// Step 2 of the insertion for one level: its obstacle hits raise their cells (the column's
+/// nearest twice), are listed (this scan's hit cells, sorted) and their heights recorded.
+/// Returns the hits.
+fn insert_hits(
+    data: &mut [f32],
+    (occupied, touched, hit_cells, (spans, cell0)): LevelState<'_>,
+    classified: &[Classified],
+    summary: &ColumnsOfLevel,
+    (beams, width): (usize, usize),
+    (h_lo, h_hi): (f32, f32),
+    occ: OccupancyParams,
+) -> usize {
+    let add = |v: &mut f32, delta: f32| {
+        let cur = if v.is_nan() { 0.0 } else { *v };
+        *v = (cur + delta).clamp(-occ.l_max, occ.l_max);
+    };
+    let mut hits = 0;
+    hit_cells.clear();
+    for ci in 0..classified.len() / beams.max(1) {
+        let nearest = summary.get(ci).nearest_hit;
+        if nearest == NONE {
+            continue;
+        }
+        for (b, c) in classified[ci * beams..(ci + 1) * beams].iter().enumerate() {
+            if !(c.cell != DROPPED
+                && c.obstacle
+                && height_class(c.height_m, h_lo, h_hi) == HeightClass::Inside)
+            {
+                continue;
+            }
+            let v = &mut data[c.cell as usize];
+            let weight = if b == nearest as usize { 2.0 } else { 1.0 };
+            add(v, weight * occ.l_occ);
+            if *v > 0.0 {
+                occupied.note(c.cell);
+            }
+            hits += 1;
+            hit_cells.push(c.cell);
+            let i = c.cell as usize;
+            let at = ((i % width) as i64 + cell0.0, (i / width) as i64 + cell0.1);
+            let span = spans.entry(at).or_insert((c.height_m, c.height_m));
+            span.0 = span.0.min(c.height_m);
+            span.1 = span.1.max(c.height_m);
+        }
+    }
+    hit_cells.sort_unstable();
+    hit_cells.dedup();
+    for &i in hit_cells.iter() {
+        touched.note(i);
+    }
+    hits
+}
+
 /// Steps 2-4 of the insertion for one level. Returns (obstacle hits, free cells updated).
 #[allow(clippy::too_many_arguments)]
 fn insert_level(
     k: usize,
     grid: &mut Grid<f32>,
-    occupied: &mut OccupiedCells,
-    touched: &mut TouchedCells,
+    (occupied, touched, hit_cells, (spans, cell0)): LevelState<'_>,
     levels: &Levels,
     classified: &[Classified],
     summary: ColumnsOfLevel,
@@ -1255,54 +1473,44 @@ fn insert_level(
     let beams = scan.beams();
     let occ = config.occupancy;
     let (h_lo, h_hi) = (levels.heights_m()[k] as f32, levels.upper_m(k) as f32);
-    let class = |c: &Classified| height_class(c.height_m, h_lo, h_hi);
     let data = grid.data_mut();
-    let add = |v: &mut f32, delta: f32| {
-        let cur = if v.is_nan() { 0.0 } else { *v };
-        *v = (cur + delta).clamp(-occ.l_max, occ.l_max);
-    };
     let n = scan.columns().len();
+    let width = geometry.width();
     // Hits first, so this scan's obstacles already stop this scan's free-space walks.
-    let mut hits = 0;
-    let mut hit_cells: Vec<u32> = Vec::new();
-    for ci in 0..n {
-        let nearest = summary.get(ci).nearest_hit;
-        if nearest == NONE {
-            continue;
-        }
-        for (b, c) in classified[ci * beams..(ci + 1) * beams].iter().enumerate() {
-            if c.cell != DROPPED && c.obstacle && class(c) == HeightClass::Inside {
-                let v = &mut data[c.cell as usize];
-                add(
-                    v,
-                    if b == nearest as usize {
-                        2.0 * occ.l_occ
-                    } else {
-                        occ.l_occ
-                    },
-                );
-                if *v > 0.0 {
-                    occupied.note(c.cell);
-                }
-                hits += 1;
-                hit_cells.push(c.cell);
-            }
-        }
-    }
-    hit_cells.sort_unstable();
-    hit_cells.dedup();
-    for &i in &hit_cells {
-        touched.note(i);
-    }
+    let hits = insert_hits(
+        data,
+        (
+            &mut *occupied,
+            &mut *touched,
+            &mut *hit_cells,
+            (&mut *spans, cell0),
+        ),
+        classified,
+        &summary,
+        (beams, width),
+        (h_lo, h_hi),
+        occ,
+    );
     let watch = no_obstacle_at_or_below(config);
-    // Below this height a beam crossing an older occupied cell is evidence the cell is free.
+    // A beam crossing an older occupied cell where its obstacle was hit (or, with no span
+    // recorded, below this height) is evidence the cell is free.
     let clear_below = levels.heights_m()[k] + CLEAR_MARGIN_M;
-    let stops_walk = |i: usize, ray_z: &mut dyn FnMut() -> f64| match config.free_space_stop {
-        FreeSpaceStop::AnyOccupied => true,
-        FreeSpaceStop::ScanHits => {
-            ray_z() >= clear_below || hit_cells.binary_search(&(i as u32)).is_ok()
-        }
-    };
+    let margin = CLEAR_MARGIN_M as f32;
+    let stops_walk =
+        |i: usize, crosses: &mut dyn FnMut(f64, f64) -> bool| match config.free_space_stop {
+            FreeSpaceStop::AnyOccupied => true,
+            FreeSpaceStop::ScanHits => {
+                if hit_cells.binary_search(&(i as u32)).is_ok() {
+                    return true;
+                }
+                let at = ((i % width) as i64 + cell0.0, (i / width) as i64 + cell0.1);
+                let evidence = match spans.get(&at) {
+                    Some(&(lo, hi)) => crosses(f64::from(lo - margin), f64::from(hi + margin)),
+                    None => crosses(f64::NEG_INFINITY, clear_below),
+                };
+                !evidence
+            }
+        };
     // Free-space walks, to the farthest return this level considers in each column.
     let mut free = 0;
     let (w, h) = (geometry.width() as i64, geometry.height() as i64);
@@ -1337,26 +1545,28 @@ fn insert_level(
             Point2::new(end.point_in_world.x, end.point_in_world.y),
         );
         let total = (end_xy - sensor_xy).norm();
-        // The lowest beam of the column crossing each distance: the nearest return beyond it.
+        // Whether a beam of the column crosses distance r (returns beyond it) at a height in
+        // [lo, hi]: each beam's height at r on its straight line from the sensor.
         let ground = config.obstacle_test.ground_height_m;
         let sensor_z = sensor.z - ground;
-        // Gathered and sorted only if a walk meets an occupied cell (most never do).
+        // Gathered only if a walk meets an occupied cell (most never do).
         let mut ends_ready = false;
-        let mut ray_z = |r: f64| {
+        let mut crosses = |r: f64, lo: f64, hi: f64| {
             if !ends_ready {
                 ends.clear();
                 ends.extend(
                     classified[ci * beams..(ci + 1) * beams]
                         .iter()
-                        .filter(|c| c.cell != DROPPED && class(c) != HeightClass::Above)
+                        .filter(|c| c.cell != DROPPED)
                         .map(|c| (c.range_xy_m as f64, c.height_m as f64)),
                 );
-                ends.sort_by(|a, b| a.0.total_cmp(&b.0));
                 ends_ready = true;
             }
-            let i = ends.partition_point(|e| e.0 <= r);
-            ends.get(i).map_or(sensor_z, |&(range, z)| {
-                sensor_z + (z - sensor_z) * r / range.max(1e-6)
+            ends.iter().any(|&(range, z)| {
+                range > r && {
+                    let at = sensor_z + (z - sensor_z) * r / range.max(1e-6);
+                    at >= lo && at <= hi
+                }
             })
         };
         let walk = Walk {
@@ -1372,7 +1582,7 @@ fn insert_level(
             &walk,
             |r| hierarchy.weight(depth, r) * occ.l_free,
             occ.l_max,
-            |i, r| stops_walk(i, &mut || ray_z(r)),
+            |i, r| stops_walk(i, &mut |lo, hi| crosses(r, lo, hi)),
             (watch, &mut *touched),
         );
         free += updated;

@@ -246,6 +246,11 @@ impl RunConfig {
             "mapping.forgetting.half_size_m",
             self.mapping.forgetting.half_size_m,
         )?;
+        if let Some((field, v)) = self.mapping.forgetting.tracking.invalid_field() {
+            return Err(format!(
+                "mapping.forgetting.tracking.{field} = {v}: out of range (see `taxi-sim config`)"
+            ));
+        }
         let a = &self.autonomy;
         positive("autonomy.horizon_m", a.horizon_m)?;
         positive("autonomy.step_m", a.step_m)?;
@@ -254,6 +259,8 @@ impl RunConfig {
         non_negative("autonomy.max_offset_m", a.max_offset_m)?;
         non_negative("autonomy.planner_safety_m", a.planner_safety_m as f64)?;
         non_negative("autonomy.avoider_safety_m", a.avoider_safety_m as f64)?;
+        positive("autonomy.hidden_after_s", a.hidden_after_s)?;
+        positive("autonomy.pilot_call_after_s", a.pilot_call_after_s)?;
         if let PoseSourceConfig::NoisyTruth(n) = &self.pose_source {
             positive("pose_source.rate_hz", n.rate_hz)?;
             positive("pose_source.drift_time_constant_s", n.drift_time_constant_s)?;
@@ -310,7 +317,8 @@ mod tests {
             },
             ..RunConfig::default()
         };
-        c.mapping.forgetting.enabled = false;
+        c.mapping.forgetting.rule = autonomy::ForgettingRule::TimeDecay;
+        c.mapping.forgetting.tracking.enabled = false;
         c.autonomy.planner_safety_m = 0.8;
         let text = c.to_toml();
         assert_eq!(RunConfig::from_toml(&text, "t").unwrap(), c, "{text}");

@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use crate::motion::VehicleState;
 use crate::observer::Event;
-use crate::scenario::{Expectation, Scenario};
+use crate::scenario::{Expectation, ExpectedEnd, Scenario};
 use crate::world::{Contact, World};
 
 /// Half length of the stretch of route searched around the last progress, metres.
@@ -73,6 +73,9 @@ pub enum EndReason {
     TimedOut,
     /// Stopped from outside (Ctrl-C).
     Interrupted,
+    /// Stopped for an obstacle the sensor could no longer see, the vehicle waited
+    /// `pilot_call_after_s` and called for a pilot (the thesis' pilot intervention).
+    WaitingForHiddenObstacle,
 }
 
 /// One pass of the vehicle by an obstacle.
@@ -409,17 +412,44 @@ impl Judge {
         self.laps_completed() >= self.laps
     }
 
-    /// The verdicts: every lap driven, every obstacle passed as expected on every pass, no contact.
-    pub fn verdict(self, end: EndReason, contacts: &[Contact]) -> Verdict {
+    /// The run ended while the vehicle stood in front of obstacles (waiting for a hidden one):
+    /// the passes it was in the middle of close as they stand.
+    pub fn close_open_passes(&mut self, t_s: f64, world: &World) {
+        let lap = self.lap_times_s.len() as u32 + 1;
+        for (k, w) in self.windows.iter_mut().enumerate() {
+            if !(w.active && w.present) {
+                continue;
+            }
+            w.active = false;
+            let report = &mut self.obstacles[k];
+            let pass = close_pass(w, lap, &report.id, world, self.danger_distance_m);
+            self.events.push((
+                t_s,
+                Event::Pass {
+                    id: report.id.clone(),
+                    outcome: pass.outcome,
+                    met: pass.met,
+                },
+            ));
+            report.passes.push(pass);
+        }
+    }
+
+    /// The verdicts: the run ended as `expected` (every lap driven, or waiting for a hidden
+    /// obstacle), every obstacle passed as expected on every pass, no contact.
+    pub fn verdict(self, end: EndReason, expected: ExpectedEnd, contacts: &[Contact]) -> Verdict {
         let every_pass_met = self
             .obstacles
             .iter()
             .all(|r| !r.passes.is_empty() && r.passes.iter().all(|p| p.met));
+        let ended_as_expected = match expected {
+            ExpectedEnd::Completed => {
+                end == EndReason::Completed && self.laps_completed() == self.laps
+            }
+            ExpectedEnd::WaitingForHiddenObstacle => end == EndReason::WaitingForHiddenObstacle,
+        };
         Verdict {
-            expectations_met: end == EndReason::Completed
-                && self.laps_completed() == self.laps
-                && every_pass_met
-                && contacts.is_empty(),
+            expectations_met: ended_as_expected && every_pass_met && contacts.is_empty(),
             laps_completed: self.laps_completed(),
             lap_times_s: self.lap_times_s,
             obstacles: self.obstacles,

@@ -13,6 +13,7 @@
 //!   verdicts), [`observer`] (what watches a run), [`report`], and [`run`], the loop.
 //! - [`replay`]: the Rerun recording and live view of a run (the only module that knows Rerun).
 //! - [`bench`]: the headline performance figures, measured without criterion.
+//! - [`small_obstacles`]: the sweep that finds the smallest obstacle seen in time per speed.
 //! - [`demo`]: a mapping drive through a synthetic parking lot, exporting every level.
 //! - [`error`]: the library's typed errors.
 
@@ -33,6 +34,7 @@ pub mod run;
 pub mod scenario;
 pub mod scene;
 pub mod schedule;
+pub mod small_obstacles;
 pub mod world;
 
 pub use error::{Error, Result};

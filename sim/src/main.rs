@@ -69,6 +69,9 @@ enum Command {
     Model(ModelCommand),
     /// Print the default run configuration as TOML (a starting point for `run --config`).
     Config,
+    /// Sweep obstacle heights and speeds: the range each obstacle is first mapped at and whether
+    /// the vehicle keeps off it.
+    SmallObstacles(cli::small::SmallArgs),
 }
 
 #[derive(Subcommand)]
@@ -138,6 +141,7 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
             laps,
         } => bench(what, json, samples, &scenario, laps),
         Command::Model(ModelCommand::Fit(args)) => cli::model::run(&args),
+        Command::SmallObstacles(args) => cli::small::run(&args),
         Command::Check(args) => cli::check::run(&args),
         Command::Map(args) => cli::run::map(&args),
         Command::Run(_) => unreachable!("dispatched in run"),

@@ -1307,6 +1307,8 @@ impl Observer for Replay {
                     crate::judge::EndReason::Completed => "",
                     crate::judge::EndReason::TimedOut => " (timed out)",
                     crate::judge::EndReason::Interrupted => " (interrupted)",
+                    crate::judge::EndReason::WaitingForHiddenObstacle =>
+                        " (waiting for a hidden obstacle: pilot called)",
                 }
             ))
             .with_level(if report.expectations_met {

@@ -16,8 +16,11 @@ pub struct RunReport {
     pub seed: u64,
     /// True when every expectation held and every lap was completed.
     pub expectations_met: bool,
-    /// Why the run ended: `completed`, `timed_out` or `interrupted`.
+    /// Why the run ended: `completed`, `timed_out`, `interrupted` or
+    /// `waiting_for_hidden_obstacle`.
     pub end: EndReason,
+    /// When the run ended waiting for a hidden obstacle: which, and since when.
+    pub waiting_for: Option<HiddenObstacle>,
     /// Laps asked for.
     pub laps: u32,
     /// Laps completed.
@@ -45,6 +48,19 @@ pub struct RunReport {
     pub time_split_s: TimeSplit,
     /// The configuration the run ran with.
     pub config: RunConfig,
+}
+
+/// The obstacle a vehicle waits for without seeing it.
+#[derive(Clone, Debug, Serialize)]
+pub struct HiddenObstacle {
+    /// Its nearest cell to the vehicle's first colliding pose, metres (the estimate's frame).
+    pub x_m: f64,
+    /// See `x_m`.
+    pub y_m: f64,
+    /// When a revolution last hit it, seconds (`None`: not since the window held it).
+    pub last_seen_s: Option<f64>,
+    /// When the wait began, seconds.
+    pub since_s: f64,
 }
 
 /// Wall time per stage, seconds.

@@ -11,8 +11,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use autonomy::{
-    AutonomyConfig, Behaviour, Driver, LidarRevolution, Odometry, OnlineMap, RoutePath,
-    VehicleModel,
+    AutonomyConfig, Behaviour, Driver, DriverStatus, LidarRevolution, Odometry, OnlineMap,
+    RoutePath, VehicleModel,
 };
 use mapper::{CollisionModel, MultiHeightMap};
 use nalgebra::{Isometry2, Point2};
@@ -24,7 +24,7 @@ use crate::lidar::{Lidar, SweepPoses};
 use crate::motion::{Bicycle, VehicleState};
 use crate::observer::{NoObserver, Observer, RunStart, ScanFrame, StepFrame};
 use crate::pose_source::PoseSource;
-use crate::report::{Progress, RunReport, TimeSplit};
+use crate::report::{HiddenObstacle, Progress, RunReport, TimeSplit};
 use crate::scenario::Scenario;
 use crate::schedule::{Captured, Scheduler, Thought};
 use crate::world::World;
@@ -174,6 +174,9 @@ impl<'a> Rig<'a> {
             }
             if self.t_s > self.timeout_s {
                 return Ok(EndReason::TimedOut);
+            }
+            if self.driver.calls_for_pilot(self.t_s) {
+                return Ok(EndReason::WaitingForHiddenObstacle);
             }
             let physics = Instant::now();
             self.move_obstacles();
@@ -498,14 +501,36 @@ impl<'a> Rig<'a> {
     }
 
     /// The report, once the loop has ended for `end`.
-    fn report(self, end: EndReason, wall_time_s: f64) -> RunReport {
+    fn report(mut self, end: EndReason, wall_time_s: f64) -> RunReport {
         let contacts = self.world.contacts().to_vec();
-        let verdict = self.judge.verdict(end, &contacts);
+        let waiting_for = match (end, self.driver.status()) {
+            (
+                EndReason::WaitingForHiddenObstacle,
+                DriverStatus::WaitingForHiddenObstacle {
+                    obstacle,
+                    last_seen_s,
+                    since_s,
+                },
+            ) => {
+                self.judge.close_open_passes(self.t_s, &self.world);
+                Some(HiddenObstacle {
+                    x_m: obstacle.x,
+                    y_m: obstacle.y,
+                    last_seen_s,
+                    since_s,
+                })
+            }
+            _ => None,
+        };
+        let verdict = self
+            .judge
+            .verdict(end, self.scenario.expected_end, &contacts);
         RunReport {
             scenario: self.scenario.name.clone(),
             seed: self.seed,
             expectations_met: verdict.expectations_met,
             end,
+            waiting_for,
             laps: self.laps,
             laps_completed: verdict.laps_completed,
             lap_times_s: verdict.lap_times_s,

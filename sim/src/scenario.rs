@@ -375,6 +375,21 @@ pub struct ExpectationsSpec {
     /// obstacles were passed inside the safety distance but never closer than the danger
     /// distance). Default none: only a contact fails.
     pub danger_distance_m: Option<Positive>,
+    /// How the run must end: `completed` (every lap driven; the default) or
+    /// `waiting_for_hidden_obstacle` (stopped for an obstacle the sensor can no longer see, the
+    /// vehicle calls for a pilot rather than guess it has gone).
+    pub end: Option<ExpectedEnd>,
+}
+
+/// How a scenario's run must end (`[expectations] end`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ExpectedEnd {
+    /// Every lap driven.
+    #[default]
+    Completed,
+    /// Waiting for a hidden obstacle, calling for a pilot.
+    WaitingForHiddenObstacle,
 }
 
 /// `[world]`: the ground, a rectangle of the plane z = 0.
@@ -764,6 +779,8 @@ pub struct Scenario {
     /// ground-truth clearance between the vehicle and any run-time obstacle must stay at or
     /// above it. `None`: not checked (only a contact fails).
     pub danger_distance_m: Option<f64>,
+    /// How the run must end (`[expectations] end`).
+    pub expected_end: ExpectedEnd,
 }
 
 impl Scenario {
@@ -842,6 +859,7 @@ impl Resolver<'_> {
             patches,
             obstacles,
             danger_distance_m: spec.expectations.danger_distance_m.map(|d| d.0),
+            expected_end: spec.expectations.end.unwrap_or_default(),
         })
     }
 

@@ -170,13 +170,13 @@ fn shipped_scenarios_say_what_the_next_issues_need() {
         (ObjectKind::Vehicle, Expectation::Stop)
     );
     let motion = v.motion.as_ref().expect("moving");
-    assert_eq!(motion.speed_m_s, 2.0);
-    // Starts at the path's first point, heading along it; crosses y = 0 at t = 10 s.
+    assert_eq!(motion.speed_m_s, 1.5);
+    // Starts at the path's first point, heading along it; 30 m along it at t = 20 s.
     assert_eq!((v.solid.x_m, v.solid.y_m), (50.0, -20.0));
-    let (x, y, yaw) = v.pose_at(10.0).expect("present");
-    assert!((x - 50.0).abs() < 1e-12 && y.abs() < 1e-12);
+    let (x, y, yaw) = v.pose_at(20.0).expect("present");
+    assert!((x - 50.0).abs() < 1e-12 && (y - 10.0).abs() < 1e-9);
     assert!((yaw - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
-    assert_eq!(v.pose_at(25.0).map(|p| (p.0, p.1)), Some((50.0, 20.0)));
+    assert_eq!(v.pose_at(30.0).map(|p| (p.0, p.1)), Some((50.0, 20.0)));
     assert_eq!(v.pose_at(40.0), None);
 
     let s = shipped("closed_loop_pose_file.toml");

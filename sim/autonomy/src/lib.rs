@@ -20,10 +20,10 @@ pub mod route;
 pub mod stack;
 
 pub use messages::{Command, LidarRevolution, Odometry, PoseEstimate};
-pub use online_map::{ForgettingConfig, OnlineMap};
+pub use online_map::{ForgettingConfig, ForgettingRule, OnlineMap};
 pub use planner::{AutonomyConfig, Behaviour, Candidate, Plan, avoid, plan, pure_pursuit};
 pub use route::{RoutePath, wrap_angle};
-pub use stack::{Driver, PlanTimes, VehicleModel};
+pub use stack::{Driver, DriverStatus, PlanTimes, VehicleModel};
 
 impl Behaviour {
     /// The behaviour the thesis gives a vehicle by how it steers: a car (front wheels) deviates,

@@ -68,6 +68,12 @@ pub struct AutonomyConfig {
     pub lookahead_min_m: f64,
     /// See `lookahead_min_m`.
     pub lookahead_gain_s: f64,
+    /// A vehicle stopped for an obstacle no revolution has hit for this long waits for a
+    /// hidden obstacle, seconds. Default 2.
+    pub hidden_after_s: f64,
+    /// Waiting for a hidden obstacle this long, the vehicle calls for a pilot (the thesis'
+    /// pilot intervention): the run ends, seconds. Default 10.
+    pub pilot_call_after_s: f64,
 }
 
 impl Default for AutonomyConfig {
@@ -87,6 +93,8 @@ impl Default for AutonomyConfig {
             stop_buffer_m: 3.0,
             lookahead_min_m: 4.0,
             lookahead_gain_s: 1.2,
+            hidden_after_s: 2.0,
+            pilot_call_after_s: 10.0,
         }
     }
 }

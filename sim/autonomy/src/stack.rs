@@ -36,6 +36,32 @@ pub struct PlanTimes {
     pub planning_s: f64,
 }
 
+/// What the driver is doing about obstacles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DriverStatus {
+    /// Driving (perhaps slowing) with no obstacle stopping it.
+    Driving,
+    /// Stopped for an obstacle the sensor hit within `hidden_after_s`: it resumes when the
+    /// obstacle is seen gone.
+    StoppedFor {
+        /// The obstacle cell nearest the vehicle's first colliding pose, metres.
+        obstacle: Point2<f64>,
+        /// When a revolution last hit the obstacle, seconds.
+        last_seen_s: f64,
+    },
+    /// Stopped for an obstacle no revolution has hit for longer than `hidden_after_s` (hidden by
+    /// the airframe, or only in the offline map): the sensor cannot see it go, so it will wait
+    /// for ever; after `pilot_call_after_s` the run calls for a pilot.
+    WaitingForHiddenObstacle {
+        /// As in `StoppedFor`.
+        obstacle: Point2<f64>,
+        /// When a revolution last hit it (`None`: never since the window held it).
+        last_seen_s: Option<f64>,
+        /// When the wait began, seconds.
+        since_s: f64,
+    },
+}
+
 /// Planner, avoider, behaviour and follower over a route.
 pub struct Driver {
     route: RoutePath,
@@ -51,6 +77,7 @@ pub struct Driver {
     route_s_m: Option<f64>,
     plan: Option<Plan>,
     speed_command_m_s: f64,
+    status: DriverStatus,
 }
 
 impl Driver {
@@ -74,6 +101,7 @@ impl Driver {
             route_s_m: None,
             plan: None,
             speed_command_m_s: 0.0,
+            status: DriverStatus::Driving,
         }
     }
 
@@ -105,6 +133,7 @@ impl Driver {
     /// The vehicle was put back at the start of an open route (a new lap): progress and estimate
     /// start over.
     pub fn restart(&mut self) {
+        self.status = DriverStatus::Driving;
         self.route_s_m = None;
         self.estimate = None;
         self.last_odometry = None;
@@ -146,11 +175,75 @@ impl Driver {
             &self.config,
         );
         self.speed_command_m_s = v;
+        self.status = if v > 0.0 {
+            DriverStatus::Driving
+        } else {
+            self.stopped_status(&p, map, estimate.t_s)
+        };
         self.plan = Some(p);
         Ok(PlanTimes {
             distance_maps_s: (t1 - t0).as_secs_f64(),
             planning_s: t1.elapsed().as_secs_f64(),
         })
+    }
+
+    /// Why the vehicle is stopped by the chosen candidate's first colliding pose: the obstacle
+    /// cells within each circle's radius plus the avoider's margin there, and when a revolution
+    /// last hit any of them.
+    fn stopped_status(&self, p: &Plan, map: &OnlineMap, now_s: f64) -> DriverStatus {
+        let c = p.chosen();
+        let Some(at_m) = c.collision_at_m else {
+            return DriverStatus::Driving;
+        };
+        let k = ((at_m / self.config.step_m).round() as usize).min(c.poses.len().saturating_sub(1));
+        let Some(pose) = c.poses.get(k) else {
+            return DriverStatus::Driving;
+        };
+        let m = map.map();
+        let margin = f64::from(self.config.avoider_safety_m) + m.config().resolution_m;
+        let (mut nearest, mut last_seen): (Option<(f64, Point2<f64>)>, Option<f64>) = (None, None);
+        for circle in self.vehicle.collision.circles() {
+            let center = pose * Point2::new(circle.x_m, circle.y_m);
+            for cell in m.obstacles_within(circle.level, &center, circle.radius_m + margin) {
+                let at = m.world_cell_center(cell);
+                let d = (at - center).norm();
+                if nearest.is_none_or(|(best, _)| d < best) {
+                    nearest = Some((d, at));
+                }
+                if let Some(t) = map.last_hit_s(cell) {
+                    last_seen = Some(last_seen.map_or(t, |s: f64| s.max(t)));
+                }
+            }
+        }
+        let Some((_, obstacle)) = nearest else {
+            return DriverStatus::Driving;
+        };
+        match last_seen {
+            Some(t) if now_s - t <= self.config.hidden_after_s => DriverStatus::StoppedFor {
+                obstacle,
+                last_seen_s: t,
+            },
+            _ => DriverStatus::WaitingForHiddenObstacle {
+                obstacle,
+                last_seen_s: last_seen,
+                since_s: match self.status {
+                    DriverStatus::WaitingForHiddenObstacle { since_s, .. } => since_s,
+                    _ => now_s,
+                },
+            },
+        }
+    }
+
+    /// What the driver is doing about obstacles (as of the last plan).
+    pub fn status(&self) -> DriverStatus {
+        self.status
+    }
+
+    /// Whether the driver has waited for a hidden obstacle longer than `pilot_call_after_s` at
+    /// `now_s`: it calls for a pilot.
+    pub fn calls_for_pilot(&self, now_s: f64) -> bool {
+        matches!(self.status, DriverStatus::WaitingForHiddenObstacle { since_s, .. }
+            if now_s - since_s >= self.config.pilot_call_after_s)
     }
 
     /// The command now: the avoider's speed, and pure pursuit's steering onto the chosen path

@@ -5,3 +5,4 @@ pub mod check;
 pub mod model;
 pub mod run;
 pub mod scan;
+pub mod small;

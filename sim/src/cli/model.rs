@@ -8,7 +8,7 @@ use anyhow::Context as _;
 /// Arguments of `taxi-sim model fit`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct ModelFitArgs {
-    /// A shipped vehicle (praetor600, iara_car, iara_car_fake_wing) or a sidecar TOML path.
+    /// A shipped vehicle (praetor600, a320, iara_car, iara_car_fake_wing) or a sidecar TOML path.
     pub description: String,
     /// Heights of interest in metres, comma separated, starting at 0 (default: the sidecar's).
     #[arg(long, value_delimiter = ',', num_args = 1..)]

@@ -282,8 +282,23 @@ pub fn table(r: &RunReport) -> String {
             EndReason::Completed => "",
             EndReason::TimedOut => "  (timed out)",
             EndReason::Interrupted => "  (interrupted)",
+            EndReason::WaitingForHiddenObstacle =>
+                "  (waiting for a hidden obstacle: pilot called)",
         }
     );
+    if let Some(w) = &r.waiting_for {
+        let _ = writeln!(
+            t,
+            "waiting since {:.1} s for an obstacle at ({:.1}, {:.1}) m the sensor last hit {}",
+            w.since_s,
+            w.x_m,
+            w.y_m,
+            w.last_seen_s
+                .map_or("never (offline map)".to_string(), |s| format!(
+                    "at {s:.1} s"
+                ))
+        );
+    }
     let _ = writeln!(
         t,
         "{:<22} {:<10} {:<11} {:>4} {:<9} {:>10} {:>22}",
