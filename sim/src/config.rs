@@ -261,6 +261,9 @@ impl RunConfig {
         non_negative("autonomy.avoider_safety_m", a.avoider_safety_m as f64)?;
         positive("autonomy.hidden_after_s", a.hidden_after_s)?;
         positive("autonomy.pilot_call_after_s", a.pilot_call_after_s)?;
+        if let Some(r) = a.detection_range_m {
+            positive("autonomy.detection_range_m", r)?;
+        }
         if let PoseSourceConfig::NoisyTruth(n) = &self.pose_source {
             positive("pose_source.rate_hz", n.rate_hz)?;
             positive("pose_source.drift_time_constant_s", n.drift_time_constant_s)?;

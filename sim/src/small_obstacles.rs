@@ -1,5 +1,5 @@
 //! The small-obstacle sweep: a box of each height in the path of a vehicle's left wheels on a
-//! straight road, driven at at each speed in closed loop; for each pair, the range at which the
+//! straight road, driven at each speed in closed loop; for each pair, the range at which the
 //! stack first mapped it (level 0) and what the vehicle did. It finds the smallest object the
 //! obstacle test sees in time at each speed, for the README's table.
 
@@ -154,13 +154,18 @@ pub fn run_sweep(
 ) -> Result<Vec<SweepRow>> {
     let vehicle = aircraft::Vehicle::load(&spec.vehicle)
         .map_err(|e| Error::Invalid(format!("vehicle {}: {e}", spec.vehicle)))?;
-    let wheel_y_m = vehicle
-        .parts
-        .iter()
-        .filter(|p| p.link.contains("wheel") && p.link.contains("left"))
-        .map(|p| p.vehicle_from_part.translation.y)
-        .next()
-        .ok_or_else(|| Error::Invalid(format!("{}: no left wheel link", spec.vehicle)))?;
+    // The left wheels (a car's `wheel_*_left`, an aircraft's `main_gear_left`).
+    let left = |word: &str| {
+        vehicle
+            .parts
+            .iter()
+            .filter(|p| p.link.contains(word) && p.link.contains("left"))
+            .map(|p| p.vehicle_from_part.translation.y)
+            .next()
+    };
+    let wheel_y_m = left("wheel")
+        .or_else(|| left("gear"))
+        .ok_or_else(|| Error::Invalid(format!("{}: no left wheel or gear link", spec.vehicle)))?;
     let sensor_x_m = vehicle.vehicle_from_lidar().translation.x;
     // Each pair as a plain scenario file beside the results: any row can be run again alone.
     let files = out_dir.join("scenarios");

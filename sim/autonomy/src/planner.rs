@@ -74,6 +74,11 @@ pub struct AutonomyConfig {
     /// Waiting for a hidden obstacle this long, the vehicle calls for a pilot (the thesis'
     /// pilot intervention): the run ends, seconds. Default 10.
     pub pilot_call_after_s: f64,
+    /// The range at which the smallest obstacle the vehicle must avoid is surely mapped, metres
+    /// (`taxi-sim small-obstacles` measures it): the avoider never goes faster than it can
+    /// stop within it. Default none (no cap): for the IARA car, every obstacle of 0.12 m and up
+    /// is mapped 28.8 m ahead or more at up to 8 m/s, farther than it needs at its top speed.
+    pub detection_range_m: Option<f64>,
 }
 
 impl Default for AutonomyConfig {
@@ -95,6 +100,7 @@ impl Default for AutonomyConfig {
             lookahead_gain_s: 1.2,
             hidden_after_s: 2.0,
             pilot_call_after_s: 10.0,
+            detection_range_m: None,
         }
     }
 }
@@ -244,13 +250,27 @@ fn frenet_pose(
     Isometry2::new(q.coords, wrap_angle(heading + slope.atan()))
 }
 
-/// The avoider: the speed to command on the chosen candidate, and how many 0.95 scalings it took.
+/// The fastest speed from which the vehicle stops within `cfg.detection_range_m` (reaction
+/// time, braking at `deceleration_m_s2` and the stop buffer included); infinite without one.
+pub fn sight_speed_m_s(deceleration_m_s2: f64, cfg: &AutonomyConfig) -> f64 {
+    let Some(range) = cfg.detection_range_m else {
+        return f64::INFINITY;
+    };
+    // v t + v^2 / 2a + buffer = range, for v >= 0.
+    let (a, t) = (deceleration_m_s2, cfg.reaction_s);
+    let room = (range - cfg.stop_buffer_m).max(0.0);
+    a * (-t + (t * t + 2.0 * room / a).sqrt())
+}
+
+/// The avoider: the speed to command on the chosen candidate (never above what the detection
+/// range allows), and how many 0.95 scalings it took.
 pub fn avoid(
     candidate: &Candidate,
     wanted_m_s: f64,
     deceleration_m_s2: f64,
     cfg: &AutonomyConfig,
 ) -> (f64, u32) {
+    let wanted_m_s = wanted_m_s.min(sight_speed_m_s(deceleration_m_s2, cfg));
     let Some(at) = candidate.collision_at_m else {
         return (wanted_m_s, 0);
     };
@@ -325,5 +345,27 @@ mod tests {
             ..free
         };
         assert_eq!(avoid(&near, 5.0, 3.0, &cfg).0, 0.0);
+    }
+
+    /// With a detection range, the avoider goes no faster than it can stop within it - on a
+    /// free path too - and exactly that fast: 28.8 m at 3 m/s^2 with 0.5 s and a 3 m buffer.
+    #[test]
+    fn the_detection_range_caps_the_speed() {
+        let cfg = AutonomyConfig {
+            detection_range_m: Some(28.8),
+            ..AutonomyConfig::default()
+        };
+        let free = Candidate {
+            offset_m: 0.0,
+            poses: vec![],
+            collision_at_m: None,
+            cost: 0.0,
+        };
+        let (v, _) = avoid(&free, 20.0, 3.0, &cfg);
+        let stopping = v * 0.5 + v * v / 6.0 + 3.0;
+        assert!((stopping - 28.8).abs() < 1e-9, "{v} m/s stops in {stopping} m");
+        assert!((11.0..11.5).contains(&v), "{v}");
+        assert_eq!(avoid(&free, 5.0, 3.0, &cfg).0, 5.0, "slower than the cap: unchanged");
+        assert_eq!(avoid(&free, 20.0, 3.0, &AutonomyConfig::default()).0, 20.0);
     }
 }
