@@ -262,16 +262,31 @@ fn height_class(height_m: f32, lo: f32, hi: f32) -> HeightClass {
 }
 
 /// With [`FreeSpaceStop::ScanHits`], a beam clears an older occupied cell when it crosses the
-/// cell's column within this of the heights its obstacle was hit at (the span recorded per live
-/// cell), metres: a beam through where the obstacle was is evidence it has gone; a beam over a
-/// cone or under a deck is none. A cell with no recorded span (a live block read back from
-/// disk) is cleared by a beam lower than this above the level's height.
+/// cell's column within the span of heights its obstacle was hit at (recorded per live cell):
+/// a beam through where the obstacle was is evidence it has gone; a beam over a cone or under a
+/// deck is none. An obstacle standing on the ground (lowest hit under [`ON_GROUND_BELOW_M`]) is
+/// cleared by a beam lower than its highest hit or than this above the level's height, metres
+/// (so a stray hit just above the ground near the sensor, which no beam crosses lower down, is
+/// still cleared); an overhead one by a beam within [`OVERHEAD_SPAN_SLACK_M`] of its span; a
+/// cell with no recorded span (a live block read back from disk) by a beam
+/// lower than this above the level's height.
 ///
 /// The older rule, this above the level's height for every cell, broke the cumulative rule for
 /// overhangs (issue 19): a beam passing under a deck between 0.2 m and h_k + 0.2 m lowered the
 /// deck's cells in level k and not in level 0 (a mapping drive under a 6 m deck left 2693 deck
-/// cells in level 0 and 63 in level 1), and a beam under a bar 1.9 m up cleared the bar.
+/// cells in level 0 and 63 in level 1), and a beam under a bar 1.9 m up cleared the bar. A
+/// first span rule with 0.2 m of margin above the highest hit cleared a 0.3 m box in a jet's
+/// main-gear path with the beams just over it, and the gear struck it.
 const CLEAR_MARGIN_M: f64 = 0.2;
+
+/// An obstacle whose lowest hit is below this stands on the ground (hits under the obstacle
+/// height are ground to the test), metres: a beam through its column lower down clears it too.
+const ON_GROUND_BELOW_M: f32 = 0.3;
+
+/// How far beyond the span of its hits a beam may cross an overhead obstacle's column and still
+/// count as passing where it was, metres: a span is often a single hit, and a beam's height
+/// changes across a cell (0.2 m of a beam 27 degrees down: 0.1 m).
+const OVERHEAD_SPAN_SLACK_M: f64 = 0.1;
 
 /// The local window of a quantized multi-height occupancy grid map.
 #[derive(Debug)]
@@ -1495,7 +1510,6 @@ fn insert_level(
     // A beam crossing an older occupied cell where its obstacle was hit (or, with no span
     // recorded, below this height) is evidence the cell is free.
     let clear_below = levels.heights_m()[k] + CLEAR_MARGIN_M;
-    let margin = CLEAR_MARGIN_M as f32;
     let stops_walk =
         |i: usize, crosses: &mut dyn FnMut(f64, f64) -> bool| match config.free_space_stop {
             FreeSpaceStop::AnyOccupied => true,
@@ -1505,7 +1519,16 @@ fn insert_level(
                 }
                 let at = ((i % width) as i64 + cell0.0, (i / width) as i64 + cell0.1);
                 let evidence = match spans.get(&at) {
-                    Some(&(lo, hi)) => crosses(f64::from(lo - margin), f64::from(hi + margin)),
+                    // Down to the ground for what stands on it (its lowest hits are the
+                    // obstacle height up), never above its highest hit.
+                    Some(&(lo, hi)) if lo < ON_GROUND_BELOW_M => {
+                        crosses(f64::NEG_INFINITY, f64::from(hi).max(clear_below))
+                    }
+                    // Overhead: within the beam's rise across a cell of where it was hit.
+                    Some(&(lo, hi)) => crosses(
+                        f64::from(lo) - OVERHEAD_SPAN_SLACK_M,
+                        f64::from(hi) + OVERHEAD_SPAN_SLACK_M,
+                    ),
                     None => crosses(f64::NEG_INFINITY, clear_below),
                 };
                 !evidence
@@ -1546,7 +1569,8 @@ fn insert_level(
         );
         let total = (end_xy - sensor_xy).norm();
         // Whether a beam of the column crosses distance r (returns beyond it) at a height in
-        // [lo, hi]: each beam's height at r on its straight line from the sensor.
+        // [lo, hi]: each beam's height at r on its straight line from the sensor. Beams with no
+        // return (the sky) count for nothing: their elevation is not in the scan.
         let ground = config.obstacle_test.ground_height_m;
         let sensor_z = sensor.z - ground;
         // Gathered only if a walk meets an occupied cell (most never do).
@@ -1554,11 +1578,16 @@ fn insert_level(
         let mut crosses = |r: f64, lo: f64, hi: f64| {
             if !ends_ready {
                 ends.clear();
+                // Every return of the column, those the map drops included (beyond the obstacle
+                // test's range, above the ceiling): each beam crossed what lies before it.
                 ends.extend(
-                    classified[ci * beams..(ci + 1) * beams]
+                    scan.returns()[ci * beams..(ci + 1) * beams]
                         .iter()
-                        .filter(|c| c.cell != DROPPED)
-                        .map(|c| (c.range_xy_m as f64, c.height_m as f64)),
+                        .flatten()
+                        .map(|ret| {
+                            let p = ret.point_in_world;
+                            ((p.x - sensor.x).hypot(p.y - sensor.y), p.z - ground)
+                        }),
                 );
                 ends_ready = true;
             }

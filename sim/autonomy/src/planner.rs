@@ -363,9 +363,16 @@ mod tests {
         };
         let (v, _) = avoid(&free, 20.0, 3.0, &cfg);
         let stopping = v * 0.5 + v * v / 6.0 + 3.0;
-        assert!((stopping - 28.8).abs() < 1e-9, "{v} m/s stops in {stopping} m");
+        assert!(
+            (stopping - 28.8).abs() < 1e-9,
+            "{v} m/s stops in {stopping} m"
+        );
         assert!((11.0..11.5).contains(&v), "{v}");
-        assert_eq!(avoid(&free, 5.0, 3.0, &cfg).0, 5.0, "slower than the cap: unchanged");
+        assert_eq!(
+            avoid(&free, 5.0, 3.0, &cfg).0,
+            5.0,
+            "slower than the cap: unchanged"
+        );
         assert_eq!(avoid(&free, 20.0, 3.0, &AutonomyConfig::default()).0, 20.0);
     }
 }
