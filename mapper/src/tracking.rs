@@ -13,7 +13,10 @@
 //! (its path no longer than [`TrackerConfig::max_path_ratio`] times that travel, plus a metre),
 //! and only objects smaller than [`TrackerConfig::max_object_m`] may move (the visible stretch
 //! of a long wall slides along with the vehicle). A track lost from view clears nothing: what it
-//! painted keeps its state.
+//! painted keeps its state. A track clears only on a revolution that continued its motion (seen
+//! the revolution before, its step where its velocity said, within half its extent), and only
+//! cells it hit since its last jump: a step its motion does not explain may be another object's
+//! hits taken over, so what it painted before is no longer its to clear, nor what it took over.
 
 use std::collections::HashMap;
 
@@ -48,6 +51,13 @@ pub struct TrackerConfig {
     /// Tracks unseen this long are dropped (what they painted keeps its state), seconds.
     /// Default 2.
     pub lost_after_s: f64,
+    /// A track seen again after a longer gap neither clears nor paints on that revolution,
+    /// seconds. Default 0.25 (two revolutions at 10 Hz).
+    pub max_gap_s: f64,
+    /// ... nor one whose step misses where its velocity said by more than this plus half its
+    /// largest extent (what hiding or revealing part of it can shift its centre by), metres: a
+    /// track that jumped to another object's hits. Default 0.5.
+    pub max_step_error_m: f64,
 }
 
 impl Default for TrackerConfig {
@@ -62,6 +72,8 @@ impl Default for TrackerConfig {
             max_path_ratio: 1.5,
             clear_margin_m: 1.0,
             lost_after_s: 2.0,
+            max_gap_s: 0.25,
+            max_step_error_m: 0.5,
         }
     }
 }
@@ -76,6 +88,8 @@ impl TrackerConfig {
             ("extent_factor", self.extent_factor),
             ("max_path_ratio", self.max_path_ratio),
             ("lost_after_s", self.lost_after_s),
+            ("max_gap_s", self.max_gap_s),
+            ("max_step_error_m", self.max_step_error_m),
         ];
         let non_negative = [
             ("min_travel_m", self.min_travel_m),
@@ -105,7 +119,14 @@ struct Track {
     max_extent_m: f64,
     /// Its cells this revolution: bounding box (world cells), when seen.
     bbox: Option<(WorldCell, WorldCell)>,
+    /// Revolutions it was seen in since it was created or started over.
+    seen: u32,
+    /// Velocity of its centre, m/s (smoothed).
+    velocity: nalgebra::Vector2<f64>,
     moving: bool,
+    /// Whether this revolution's step continued its motion (seen the revolution before, where
+    /// its velocity said): only then may a moving track clear.
+    smooth: bool,
     /// Cells it painted (some may since belong to another track).
     painted: Vec<WorldCell>,
 }
@@ -193,7 +214,10 @@ impl Tracker {
                         path_m: 0.0,
                         max_extent_m: 0.0,
                         bbox: None,
+                        seen: 0,
+                        velocity: nalgebra::Vector2::zeros(),
                         moving: false,
+                        smooth: false,
                         painted: Vec::new(),
                     });
                     self.next_id = self.next_id.wrapping_add(1);
@@ -201,7 +225,24 @@ impl Tracker {
                 }
             };
             let track = &mut self.tracks[ti];
-            track.path_m += (cluster.center - track.last).norm();
+            let dt = t_s - track.last_t_s;
+            let step = cluster.center - track.last;
+            // A step its velocity does not explain (or after a gap) may be another object's hits
+            // taken over, or the same object seen anew.
+            track.smooth = dt > 0.0
+                && dt <= self.config.max_gap_s
+                && (step - track.velocity * dt).norm()
+                    <= self.config.max_step_error_m + 0.5 * track.max_extent_m;
+            if dt > 0.0 && !track.smooth && track.seen > 1 {
+                // Perhaps another object's hits now: what it painted so far is no longer its
+                // to clear (it keeps its state).
+                track.painted.clear();
+            }
+            if dt > 0.0 {
+                track.velocity = 0.5 * track.velocity + 0.5 * step / dt;
+                track.path_m += step.norm();
+            }
+            track.seen += 1;
             track.last = cluster.center;
             track.last_t_s = t_s;
             track.bbox = Some(cluster.bbox);
@@ -209,9 +250,12 @@ impl Tracker {
             let extent = self.resolution_m
                 * (((hi.0 - lo.0 + 1).pow(2) + (hi.1 - lo.1 + 1).pow(2)) as f64).sqrt();
             track.max_extent_m = track.max_extent_m.max(extent);
+            // What it hits on a step its motion does not explain (it took over another
+            // object's hits) it owns, so no other track clears it, but never clears itself.
+            let paints = track.smooth || track.seen <= 1;
             for &c in &cluster.cells {
                 if let Some(r) = self.cells.get_mut(&c) {
-                    if r.owner != track.id {
+                    if r.owner != track.id && paints {
                         track.painted.push(c);
                     }
                     r.owner = track.id;
@@ -229,7 +273,7 @@ impl Tracker {
         }
         let r = self.resolution_m;
         for track in &mut self.tracks {
-            if !(track.moving && track.bbox.is_some()) {
+            if !(track.moving && track.smooth && track.bbox.is_some()) {
                 continue;
             }
             // Every cell of the object lies within its extent of any point of it, the centre of
@@ -469,6 +513,34 @@ mod tests {
         for k in 0..100 {
             let wall = block(k * 2, 0, 100, 2); // 20 m of wall, sliding with the vehicle
             assert!(t.update(k as f64 * 0.1, &wall).is_empty());
+        }
+    }
+
+    /// A moving track (stray hits sliding along ahead of a vehicle) that loses its cluster and
+    /// picks up a static box nearby, then jumps back to its stray hits once the box is hidden,
+    /// clears nothing of the box: what it took over in a jump is never its to clear.
+    #[test]
+    fn a_moving_track_that_jumps_to_a_static_object_never_clears_it() {
+        let mut t = Tracker::new(TrackerConfig::default(), 0.2);
+        // 1.6 m to the side of the stray hits' line, where they are at the 40th revolution.
+        let boxed = block(200, 8, 2, 2);
+        let mut k = 0;
+        // Stray hits sliding at 5 m/s along y = 0 (2 x 2 cells); the box seen all along.
+        while k < 40 {
+            let mut hits = block(k * 5, 0, 2, 2);
+            hits.extend(&boxed);
+            t.update(k as f64 * 0.1, &hits);
+            k += 1;
+        }
+        assert_eq!(t.moving_objects().len(), 1);
+        // The stray hits vanish for a revolution; only the box is seen.
+        t.update(k as f64 * 0.1, &boxed);
+        k += 1;
+        // The box is hidden; the stray hits come back further on.
+        for _ in 0..30 {
+            let cleared = t.update(k as f64 * 0.1, &block(k * 5, 0, 2, 2));
+            assert!(cleared.iter().all(|c| !boxed.contains(c)), "{cleared:?}");
+            k += 1;
         }
     }
 
