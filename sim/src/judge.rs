@@ -447,6 +447,12 @@ impl Judge {
                 end == EndReason::Completed && self.laps_completed() == self.laps
             }
             ExpectedEnd::WaitingForHiddenObstacle => end == EndReason::WaitingForHiddenObstacle,
+            ExpectedEnd::StoppedForGood => {
+                matches!(
+                    end,
+                    EndReason::TimedOut | EndReason::WaitingForHiddenObstacle
+                ) && self.stops.last().is_some_and(|s| s.end_s.is_none())
+            }
         };
         Verdict {
             expectations_met: ended_as_expected && every_pass_met && contacts.is_empty(),

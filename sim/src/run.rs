@@ -503,6 +503,13 @@ impl<'a> Rig<'a> {
     /// The report, once the loop has ended for `end`.
     fn report(mut self, end: EndReason, wall_time_s: f64) -> RunReport {
         let contacts = self.world.contacts().to_vec();
+        if matches!(
+            end,
+            EndReason::TimedOut | EndReason::WaitingForHiddenObstacle
+        ) {
+            // The vehicle may stand before an obstacle: its pass closes as it stands.
+            self.judge.close_open_passes(self.t_s, &self.world);
+        }
         let waiting_for = match (end, self.driver.status()) {
             (
                 EndReason::WaitingForHiddenObstacle,
@@ -511,15 +518,12 @@ impl<'a> Rig<'a> {
                     last_seen_s,
                     since_s,
                 },
-            ) => {
-                self.judge.close_open_passes(self.t_s, &self.world);
-                Some(HiddenObstacle {
-                    x_m: obstacle.x,
-                    y_m: obstacle.y,
-                    last_seen_s,
-                    since_s,
-                })
-            }
+            ) => Some(HiddenObstacle {
+                x_m: obstacle.x,
+                y_m: obstacle.y,
+                last_seen_s,
+                since_s,
+            }),
             _ => None,
         };
         let verdict = self

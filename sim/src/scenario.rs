@@ -375,9 +375,10 @@ pub struct ExpectationsSpec {
     /// obstacles were passed inside the safety distance but never closer than the danger
     /// distance). Default none: only a contact fails.
     pub danger_distance_m: Option<Positive>,
-    /// How the run must end: `completed` (every lap driven; the default) or
+    /// How the run must end: `completed` (every lap driven; the default),
     /// `waiting_for_hidden_obstacle` (stopped for an obstacle the sensor can no longer see, the
-    /// vehicle calls for a pilot rather than guess it has gone).
+    /// vehicle calls for a pilot rather than guess it has gone) or `stopped_for_good` (stopped
+    /// before an obstacle that never goes, timed out or calling for a pilot).
     pub end: Option<ExpectedEnd>,
 }
 
@@ -390,6 +391,9 @@ pub enum ExpectedEnd {
     Completed,
     /// Waiting for a hidden obstacle, calling for a pilot.
     WaitingForHiddenObstacle,
+    /// Stopped for good before an obstacle that never goes: the run ends timed out or calling
+    /// for a pilot, the vehicle still standing.
+    StoppedForGood,
 }
 
 /// `[world]`: the ground, a rectangle of the plane z = 0.
