@@ -374,15 +374,7 @@ impl Judge {
             }
             let report = &mut self.obstacles[k];
             let pass = close_pass(w, lap, &report.id, world, self.danger_distance_m);
-            self.events.push((
-                t_s,
-                Event::Pass {
-                    id: report.id.clone(),
-                    outcome: pass.outcome,
-                    met: pass.met,
-                },
-            ));
-            report.passes.push(pass);
+            record_pass(report, &mut self.events, t_s, pass);
         }
     }
 
@@ -412,8 +404,8 @@ impl Judge {
         self.laps_completed() >= self.laps
     }
 
-    /// The run ended while the vehicle stood in front of obstacles (waiting for a hidden one):
-    /// the passes it was in the middle of close as they stand.
+    /// The run ended while the vehicle stood in front of obstacles (timed out, or waiting for a
+    /// hidden one): the passes it was in the middle of close as they stand.
     pub fn close_open_passes(&mut self, t_s: f64, world: &World) {
         let lap = self.lap_times_s.len() as u32 + 1;
         for (k, w) in self.windows.iter_mut().enumerate() {
@@ -423,15 +415,7 @@ impl Judge {
             w.active = false;
             let report = &mut self.obstacles[k];
             let pass = close_pass(w, lap, &report.id, world, self.danger_distance_m);
-            self.events.push((
-                t_s,
-                Event::Pass {
-                    id: report.id.clone(),
-                    outcome: pass.outcome,
-                    met: pass.met,
-                },
-            ));
-            report.passes.push(pass);
+            record_pass(report, &mut self.events, t_s, pass);
         }
     }
 
@@ -479,6 +463,19 @@ pub struct Verdict {
     pub stops: Vec<Stop>,
     /// Smallest ground-truth clearance per level to any object, metres.
     pub min_clearance_m: Vec<f64>,
+}
+
+/// Adds a closed pass to its obstacle's report, and its event.
+fn record_pass(report: &mut ObstacleReport, events: &mut Vec<(f64, Event)>, t_s: f64, pass: Pass) {
+    events.push((
+        t_s,
+        Event::Pass {
+            id: report.id.clone(),
+            outcome: pass.outcome,
+            met: pass.met,
+        },
+    ));
+    report.passes.push(pass);
 }
 
 /// The pass a window closes with: its outcome and whether it met the expectation.

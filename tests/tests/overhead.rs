@@ -2,30 +2,12 @@
 //! sidecar's `overhead_clearance_m`); what is above it is no obstacle, what reaches below it is.
 //! Each scenario of `scenarios/` about it, run after its mapping drive.
 
-use std::path::{Path, PathBuf};
-
 use sim::config::RunConfig;
 use sim::report::RunReport;
-use sim::run::{RunSetup, run};
 use sim::scenario::Scenario;
 
-fn scenario(name: &str) -> Scenario {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scenarios")
-        .join(format!("{name}.toml"));
-    Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Builds the offline map (mapping drive) in `map_dir` with `config`, then runs the closed loop.
-fn run_with(s: &Scenario, map_dir: &Path, config: RunConfig) -> RunReport {
-    sim::mapping::map_drive(s, &config, map_dir, &mut |_, _| {})
-        .unwrap_or_else(|e| panic!("{}: mapping drive: {e:#}", s.name));
-    let setup = RunSetup {
-        config,
-        ..RunSetup::new(map_dir.to_path_buf())
-    };
-    run(s, &setup).unwrap_or_else(|e| panic!("{}: {e:#}", s.name))
-}
+mod common;
+use common::{run_with, scenario};
 
 /// A run-time structure the vehicle must drive under: passed, no stop anywhere, no contact.
 fn assert_passes_under(s: Scenario, id: &str) -> RunReport {

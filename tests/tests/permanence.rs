@@ -3,32 +3,13 @@
 //! the vehicle stopped for it holds the vehicle until a pilot comes; what a moving object left
 //! is still cleared (`closed_loop.rs`, the crossing vehicle).
 
-use std::path::{Path, PathBuf};
-
 use autonomy::ForgettingRule;
 use sim::config::RunConfig;
 use sim::judge::EndReason;
 use sim::report::RunReport;
-use sim::run::{RunSetup, run};
-use sim::scenario::Scenario;
 
-fn scenario(name: &str) -> Scenario {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scenarios")
-        .join(format!("{name}.toml"));
-    Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Builds the offline map (mapping drive) in `map_dir` with `config`, then runs the closed loop.
-fn run_with(s: &Scenario, map_dir: &Path, config: RunConfig) -> RunReport {
-    sim::mapping::map_drive(s, &config, map_dir, &mut |_, _| {})
-        .unwrap_or_else(|e| panic!("{}: mapping drive: {e:#}", s.name));
-    let setup = RunSetup {
-        config,
-        ..RunSetup::new(map_dir.to_path_buf())
-    };
-    run(s, &setup).unwrap_or_else(|e| panic!("{}: {e:#}", s.name))
-}
+mod common;
+use common::{run_with, scenario};
 
 /// Stopped for a unit its airframe then hides, the jet waits and calls for a pilot: no contact,
 /// the pass closes as a stop, and the report names where the hidden obstacle is.
