@@ -1099,34 +1099,22 @@ impl MultiHeightMap {
         (x >= 0 && y >= 0 && x < w && y < h).then(|| (y * w + x) as usize)
     }
 
-    /// The cells the last revolution hit as obstacles, each with the levels it hit them in (bit
-    /// k: level k), in world-lattice order. Empty after a re-centre until the next insertion.
-    pub fn last_scan_hits(&self) -> Vec<(WorldCell, u32)> {
+    /// The cells the last revolution hit as obstacles, in any level, in world-lattice order.
+    /// Empty after a re-centre until the next insertion.
+    pub fn last_scan_hits(&self) -> Vec<WorldCell> {
         let width = self.geometry.width();
         let (x0, y0) = self.window_cell0();
-        let mut all: Vec<(WorldCell, u32)> = self
+        let mut all: Vec<WorldCell> = self
             .last_hits
             .iter()
-            .enumerate()
-            .flat_map(|(k, cells)| {
-                cells.iter().map(move |&i| {
-                    let i = i as usize;
-                    (
-                        ((i % width) as i64 + x0, (i / width) as i64 + y0),
-                        1u32 << k.min(31),
-                    )
-                })
+            .flatten()
+            .map(|&i| {
+                let i = i as usize;
+                ((i % width) as i64 + x0, (i / width) as i64 + y0)
             })
             .collect();
         all.sort_unstable();
-        all.dedup_by(|b, a| {
-            if a.0 == b.0 {
-                a.1 |= b.1;
-                true
-            } else {
-                false
-            }
-        });
+        all.dedup();
         all
     }
 
@@ -1520,7 +1508,7 @@ fn insert_level(
                 let at = ((i % width) as i64 + cell0.0, (i / width) as i64 + cell0.1);
                 let evidence = match spans.get(&at) {
                     // Down to the ground for what stands on it (its lowest hits are the
-                    // obstacle height up), never above its highest hit.
+                    // obstacle height up), up to its highest hit or h_k + 0.2 m.
                     Some(&(lo, hi)) if lo < ON_GROUND_BELOW_M => {
                         crosses(f64::NEG_INFINITY, f64::from(hi).max(clear_below))
                     }

@@ -331,11 +331,6 @@ impl Tracker {
             .retain(|c, _| (c.0 - cx).abs() <= half && (c.1 - cy).abs() <= half);
     }
 
-    /// Cells remembered (hit at least once and not pruned).
-    pub fn cell_count(&self) -> usize {
-        self.cells.len()
-    }
-
     /// Groups hits into objects: cells in buckets of the cluster gap, buckets joined to their
     /// eight neighbours.
     fn clusters(&self, hits: &[WorldCell]) -> Vec<Cluster> {

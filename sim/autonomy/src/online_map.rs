@@ -1,7 +1,7 @@
 //! The stack's online map: the offline multi-height map merged with what the LiDAR sees, kept
 //! around the vehicle's estimated pose, and the distance maps the collision checks read.
 
-use mapper::{CollisionModel, MovingObject, MultiHeightMap, Tracker, TrackerConfig, WorldCell};
+use mapper::{CollisionModel, MultiHeightMap, Tracker, TrackerConfig, WorldCell};
 use nalgebra::Point2;
 use serde::{Deserialize, Serialize};
 
@@ -60,8 +60,6 @@ pub struct OnlineMap {
     scan_period_s: f64,
     tracker: Tracker,
     revolutions: u64,
-    /// Cells the tracker cleared at the last update.
-    cleared: usize,
 }
 
 impl OnlineMap {
@@ -81,7 +79,6 @@ impl OnlineMap {
             scan_period_s,
             tracker,
             revolutions: 0,
-            cleared: 0,
         }
     }
 
@@ -99,14 +96,9 @@ impl OnlineMap {
         }
         self.map
             .insert_scan(&revolution.scan, Some(&self.self_filter))?;
-        let hits: Vec<WorldCell> = self
-            .map
-            .last_scan_hits()
-            .into_iter()
-            .map(|(c, _)| c)
-            .collect();
+        let hits = self.map.last_scan_hits();
         let clear = self.tracker.update(revolution.t_s, &hits);
-        self.cleared = self.map.clear_live(&clear);
+        self.map.clear_live(&clear);
         self.revolutions += 1;
         if self.revolutions.is_multiple_of(50) {
             // What the tracker remembers of cells: the window's square.
@@ -121,16 +113,6 @@ impl OnlineMap {
     /// since the window last held it - an offline-map obstacle, or never seen).
     pub fn last_hit_s(&self, cell: WorldCell) -> Option<f64> {
         self.tracker.last_hit_s(cell)
-    }
-
-    /// The moving objects seen in the last revolution.
-    pub fn moving_objects(&self) -> Vec<MovingObject> {
-        self.tracker.moving_objects()
-    }
-
-    /// Level cells the tracker handed back to the prior at the last update.
-    pub fn cleared_last_update(&self) -> usize {
-        self.cleared
     }
 
     /// The multi-height map (occupancy and distance maps per level).
