@@ -196,6 +196,41 @@ impl RunConfig {
         Ok(config)
     }
 
+    /// A configuration from a TOML table (a scenario's `[config]`, a campaign setting): the
+    /// message names the field at fault.
+    pub fn from_table(table: toml::Table) -> Result<Self, String> {
+        let config: RunConfig = toml::Value::Table(table)
+            .try_into()
+            .map_err(|e: toml::de::Error| e.message().to_string())?;
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// The run configuration of `scenario`: the defaults, its `[config]` over them, and the
+    /// file at `path` (a `--config` file) over that.
+    pub fn for_scenario(
+        scenario: &crate::scenario::Scenario,
+        path: Option<&std::path::Path>,
+    ) -> Result<Self, Error> {
+        let mut table = scenario.config.clone().unwrap_or_default();
+        let origin = scenario.path.display().to_string();
+        if let Some(p) = path {
+            // Read alone first: its mistakes are located in it.
+            Self::from_file(p)?;
+            let text = std::fs::read_to_string(p).map_err(|source| Error::Io {
+                what: "reading the run configuration",
+                path: p.to_path_buf(),
+                source,
+            })?;
+            let over: toml::Table = toml::from_str(&text)
+                .map_err(|e| crate::scenario::ScenarioError::toml(&p.display().to_string(), &text, &e))?;
+            for (k, v) in over {
+                crate::campaign::set_path(&mut table, &k, v);
+            }
+        }
+        Self::from_table(table).map_err(|message| Error::Config { origin, message })
+    }
+
     /// Reads a configuration file.
     pub fn from_file(path: &std::path::Path) -> Result<Self, Error> {
         let text = std::fs::read_to_string(path).map_err(|source| Error::Io {

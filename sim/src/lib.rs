@@ -13,11 +13,14 @@
 //!   verdicts), [`observer`] (what watches a run), [`report`], and [`run`], the loop.
 //! - [`replay`]: the Rerun recording and live view of a run (the only module that knows Rerun).
 //! - [`bench`]: the headline performance figures, measured without criterion.
+//! - [`campaign`]: campaigns - scenario families sampled, run in parallel, searched for
+//!   failures, summarised.
 //! - [`small_obstacles`]: the sweep that finds the smallest obstacle seen in time per speed.
 //! - [`demo`]: a mapping drive through a synthetic parking lot, exporting every level.
 //! - [`error`]: the library's typed errors.
 
 pub mod bench;
+pub mod campaign;
 pub mod config;
 pub mod demo;
 pub mod error;

@@ -72,6 +72,9 @@ enum Command {
     /// Sweep obstacle heights and speeds: the range each obstacle is first mapped at and whether
     /// the vehicle keeps off it.
     SmallObstacles(cli::small::SmallArgs),
+    /// Campaigns: scenario families sampled, run in parallel, searched for failures.
+    #[command(subcommand)]
+    Campaign(cli::campaign::CampaignCommand),
 }
 
 #[derive(Subcommand)]
@@ -126,6 +129,13 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 ExitCode::from(1)
             }
         }),
+        Command::Campaign(cmd) => cli::campaign::run(&cmd).map(|ok| {
+            if ok {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }),
         other => run_unit(other).map(|()| ExitCode::SUCCESS),
     }
 }
@@ -144,7 +154,7 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
         Command::SmallObstacles(args) => cli::small::run(&args),
         Command::Check(args) => cli::check::run(&args),
         Command::Map(args) => cli::run::map(&args),
-        Command::Run(_) => unreachable!("dispatched in run"),
+        Command::Run(_) | Command::Campaign(_) => unreachable!("dispatched in run"),
         Command::Scan(args) => cli::scan::run(&args),
         Command::Config => emit(&sim::config::RunConfig::default().to_toml()),
     }

@@ -60,7 +60,13 @@ pub enum ScenarioError {
 
 impl ScenarioError {
     /// An error located at byte `span` of `text`, with the field given.
-    fn at(file: &str, text: &str, span: Range<usize>, field: &str, message: String) -> Self {
+    pub(crate) fn at(
+        file: &str,
+        text: &str,
+        span: Range<usize>,
+        field: &str,
+        message: String,
+    ) -> Self {
         let (line, column, line_text) = locate(text, span.start);
         let width = text.get(span.clone()).map_or(1, |s| {
             s.lines().next().map_or(1, |l| l.chars().count().max(1))
@@ -364,6 +370,10 @@ pub struct ScenarioFile {
     /// Expectations about the whole run, beyond each obstacle's `expect`. Default none.
     #[serde(default)]
     pub expectations: ExpectationsSpec,
+    /// The run configuration this scenario runs with, as in a `--config` file (only what
+    /// differs from the defaults). A campaign's failure file carries its setting here. Default
+    /// none: the defaults.
+    pub config: Option<Spanned<toml::Table>>,
 }
 
 /// `[expectations]`: what must hold over the whole run, beside each obstacle's `expect`.
@@ -785,6 +795,8 @@ pub struct Scenario {
     pub danger_distance_m: Option<f64>,
     /// How the run must end (`[expectations] end`).
     pub expected_end: ExpectedEnd,
+    /// The `[config]` table (validated): the run configuration over the defaults.
+    pub config: Option<toml::Table>,
 }
 
 impl Scenario {
@@ -850,6 +862,11 @@ impl Resolver<'_> {
         self.rows(&spec.rows, &world, &route, &vehicle, &mut ids, &mut objects)?;
         let patches = self.patches(&spec.patches, &world, &mut ids)?;
         let obstacles = self.obstacles(&spec.obstacles, &world, &vehicle, &mut ids)?;
+        if let Some(c) = &spec.config {
+            crate::config::RunConfig::from_table(c.get_ref().clone()).map_err(|m| {
+                ScenarioError::at(self.file, self.text, c.span(), "config", m)
+            })?;
+        }
         Ok(Scenario {
             path: path.to_path_buf(),
             name: spec.name,
@@ -864,6 +881,7 @@ impl Resolver<'_> {
             obstacles,
             danger_distance_m: spec.expectations.danger_distance_m.map(|d| d.0),
             expected_end: spec.expectations.end.unwrap_or_default(),
+            config: spec.config.map(Spanned::into_inner),
         })
     }
 

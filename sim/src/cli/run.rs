@@ -100,14 +100,6 @@ impl RunArgs {
     }
 }
 
-/// The configuration in `path`, or the defaults.
-fn read_config(path: Option<&std::path::Path>) -> anyhow::Result<RunConfig> {
-    Ok(match path {
-        Some(p) => RunConfig::from_file(p)?,
-        None => RunConfig::default(),
-    })
-}
-
 fn build_map(
     scenario: &Scenario,
     config: &RunConfig,
@@ -129,7 +121,7 @@ pub fn map(args: &MapArgs) -> anyhow::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| default_map_dir(&scenario));
-    let config = read_config(args.config.as_deref())?;
+    let config = RunConfig::for_scenario(&scenario, args.config.as_deref())?;
     let m = build_map(&scenario, &config, &dir)?;
     crate::emit(&format!(
         "{}: mapped {:.0} m with {} revolutions into {} blocks; occupied cells per level {:?} (levels at {:?} m)\nwrote {}\n",
@@ -150,7 +142,7 @@ pub fn run_cmd(args: &RunArgs) -> anyhow::Result<bool> {
         "--laps 0: a run drives at least one lap"
     );
     let scenario = Scenario::from_file(&args.scenario)?;
-    let config = run_config(args)?;
+    let config = run_config(args, &scenario)?;
     let replay_options = args.replay_options();
     replay_options.validate()?;
     let dir = args
@@ -228,8 +220,8 @@ pub fn run_cmd(args: &RunArgs) -> anyhow::Result<bool> {
 }
 
 /// The run's configuration: the file's (or the defaults), with the flags' overrides.
-fn run_config(args: &RunArgs) -> anyhow::Result<RunConfig> {
-    let mut config = read_config(args.config.as_deref())?;
+fn run_config(args: &RunArgs, scenario: &Scenario) -> anyhow::Result<RunConfig> {
+    let mut config = RunConfig::for_scenario(scenario, args.config.as_deref())?;
     if args.sequential_sensing {
         config.schedule = Schedule::Sequential;
     }

@@ -1,0 +1,146 @@
+//! A campaign directory's `summary.md`, from its `results.jsonl`: per parameter setting the
+//! runs, failures, contacts, unmet expectations, false stops and needless deviations, clearance
+//! percentiles and lap times; for the falsifier, the generations; the error table of the
+//! failing variants. `taxi-sim campaign show DIR` prints it.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::execute::RunRecord;
+use crate::error::Result;
+
+/// Failing variants listed in the error table (the rest are in `results.jsonl`).
+const MAX_ROWS: usize = 100;
+
+/// The `p`-quantile (0..1) of sorted values, nearest rank.
+fn quantile(sorted: &[f64], p: f64) -> Option<f64> {
+    if sorted.is_empty() {
+        return None;
+    }
+    let i = ((p * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1;
+    Some(sorted[i])
+}
+
+fn m(x: Option<f64>) -> String {
+    x.map_or("-".into(), |v| format!("{v:.2}"))
+}
+
+/// The setting's label: its parameters, or `base` when none.
+pub fn setting_label(r: &RunRecord) -> String {
+    if r.parameters.is_empty() {
+        "base".into()
+    } else {
+        r.parameters
+            .iter()
+            .map(|(k, v)| format!("{k} = {v}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// The summary of `records` (sorted by index) with the directory's `campaign.json`.
+pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
+    let get = |k: &str| meta.get(k).map_or("?".into(), |v| v.to_string().trim_matches('"').to_string());
+    let mut s = format!(
+        "# Campaign: {}\n\nFile `{}`, sampler `{}`, seed {}: {} runs recorded.\n\n",
+        get("name"),
+        get("campaign"),
+        get("sampler"),
+        get("seed"),
+        records.len()
+    );
+    let failed: Vec<&RunRecord> = records.iter().filter(|r| r.failed).collect();
+    let first = failed.first().map(|r| r.index + 1);
+    let _ = writeln!(
+        s,
+        "Failures: {} of {} ({:.1} per 1000 runs); runs to the first failure: {}.\n",
+        failed.len(),
+        records.len(),
+        1000.0 * failed.len() as f64 / records.len().max(1) as f64,
+        first.map_or("none yet".into(), |n| n.to_string())
+    );
+    s += "## Per parameter setting\n\n| setting | runs | failed | runs with contact | contacts | unmet expectations | false stops | needless deviations | obstacle clearance p0 / p5 / p50 (m) | lap time p50 / max (s) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    let mut by_setting: BTreeMap<usize, Vec<&RunRecord>> = BTreeMap::new();
+    for r in records {
+        by_setting.entry(r.setting).or_default().push(r);
+    }
+    for rs in by_setting.values() {
+        let mut clear: Vec<f64> = rs.iter().filter_map(|r| r.obstacle_clearance_m).collect();
+        clear.sort_by(f64::total_cmp);
+        let mut laps: Vec<f64> = rs.iter().flat_map(|r| r.lap_times_s.iter().copied()).collect();
+        laps.sort_by(f64::total_cmp);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} / {} | {} / {} |",
+            setting_label(rs[0]),
+            rs.len(),
+            rs.iter().filter(|r| r.failed).count(),
+            rs.iter().filter(|r| r.contacts > 0).count(),
+            rs.iter().map(|r| r.contacts).sum::<usize>(),
+            rs.iter().filter(|r| !r.expectations_met).count(),
+            rs.iter().map(|r| r.false_stops).sum::<usize>(),
+            rs.iter().map(|r| r.needless_deviations).sum::<usize>(),
+            m(quantile(&clear, 0.0)),
+            m(quantile(&clear, 0.05)),
+            m(quantile(&clear, 0.5)),
+            m(quantile(&laps, 0.5)),
+            m(laps.last().copied()),
+        );
+    }
+    if get("sampler") == "falsify" {
+        s += &generations(meta, records);
+    }
+    let _ = writeln!(s, "\n## Failing variants\n");
+    if failed.is_empty() {
+        s += "None.\n";
+        return s;
+    }
+    s += "| index | setting | end | contacts | obstacle clearance (m) | what failed | drawn | scenario |\n|---|---|---|---|---|---|---|---|\n";
+    for r in failed.iter().take(MAX_ROWS) {
+        let drawn: Vec<String> = r.sampled.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | `{}` |",
+            r.index,
+            r.setting,
+            r.end,
+            r.contacts,
+            m(r.obstacle_clearance_m),
+            r.failures.join("; ").replace('|', "/"),
+            drawn.join(" ").replace('|', "/"),
+            r.failure_file.as_deref().unwrap_or("-")
+        );
+    }
+    if failed.len() > MAX_ROWS {
+        let _ = writeln!(s, "\n... and {} more in `results.jsonl` (`failed: true`).", failed.len() - MAX_ROWS);
+    }
+    s
+}
+
+/// The falsifier's generations: runs, failures and the lowest score of each.
+fn generations(meta: &serde_json::Value, records: &[RunRecord]) -> String {
+    let batch = meta.get("batch").and_then(|b| b.as_u64()).unwrap_or(1).max(1);
+    let mut by_gen: BTreeMap<u64, (usize, usize, f64)> = BTreeMap::new();
+    for r in records {
+        let e = by_gen.entry(r.sample / batch).or_insert((0, 0, f64::INFINITY));
+        e.0 += 1;
+        e.1 += usize::from(r.failed);
+        e.2 = e.2.min(r.score);
+    }
+    let mut s = format!("\n## Search ({batch} samples a generation)\n\n| generation | runs | failures | lowest score |\n|---|---|---|---|\n");
+    for (g, (n, f, low)) in by_gen {
+        let _ = writeln!(s, "| {g} | {n} | {f} | {low:.2} |");
+    }
+    s
+}
+
+/// Writes `dir/summary.md` from `records`.
+pub fn write(dir: &Path, records: &[RunRecord]) -> Result<()> {
+    let meta = std::fs::read_to_string(dir.join("campaign.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or_default();
+    mapper::write_atomically(&dir.join("summary.md"), render(&meta, records).as_bytes())?;
+    Ok(())
+}
