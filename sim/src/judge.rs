@@ -422,15 +422,18 @@ impl Judge {
     /// The verdicts: the run ended as `expected` (every lap driven, or waiting for a hidden
     /// obstacle), every obstacle passed as expected on every pass, no contact.
     pub fn verdict(self, end: EndReason, expected: ExpectedEnd, contacts: &[Contact]) -> Verdict {
-        let every_pass_met = self
-            .obstacles
-            .iter()
-            .all(|r| !r.passes.is_empty() && r.passes.iter().all(|p| p.met));
+        // A campaign's `end = "any"` accepts an obstacle never passed (one that appeared after
+        // the vehicle went by, or that it waited for until the end).
+        let unpassed_ok = expected == ExpectedEnd::Any;
+        let every_pass_met = self.obstacles.iter().all(|r| {
+            (unpassed_ok || !r.passes.is_empty()) && r.passes.iter().all(|p| p.met)
+        });
         let ended_as_expected = match expected {
             ExpectedEnd::Completed => {
                 end == EndReason::Completed && self.laps_completed() == self.laps
             }
             ExpectedEnd::WaitingForHiddenObstacle => end == EndReason::WaitingForHiddenObstacle,
+            ExpectedEnd::Any => end != EndReason::Interrupted,
             ExpectedEnd::StoppedForGood => {
                 matches!(
                     end,

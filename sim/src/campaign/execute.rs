@@ -157,6 +157,7 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
         ExpectedEnd::Completed => r.end == EndReason::Completed,
         ExpectedEnd::WaitingForHiddenObstacle => r.end == EndReason::WaitingForHiddenObstacle,
         ExpectedEnd::StoppedForGood => r.end != EndReason::Completed,
+        ExpectedEnd::Any => true,
     };
     if !end_met {
         failures.push(format!("ended {end}, expected {:?}", scenario.expected_end).to_lowercase());

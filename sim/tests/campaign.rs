@@ -1,0 +1,267 @@
+//! Campaigns end to end on the smoke campaign (`scenarios/campaigns/smoke.toml`, 20 runs of a
+//! car on a straight road): the results are the same whatever `--jobs`; a campaign resumes
+//! where it stopped, over a half-written last line, without running a variant twice; a stop
+//! leaves only whole runs; every failure file (and any variant written out) is reproduced by
+//! `taxi-sim run`; bad campaign files are refused with their place.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use sim::campaign::Campaign;
+use sim::campaign::execute::{RunOptions, RunRecord, read_results, run_campaign, variant};
+
+fn smoke_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/campaigns/smoke.toml")
+}
+
+fn smoke() -> Campaign {
+    Campaign::from_file(&smoke_path()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn run(campaign: &Campaign, out: &Path, jobs: usize, runs: Option<u64>) -> Vec<RunRecord> {
+    let stop = AtomicBool::new(false);
+    run_campaign(
+        campaign,
+        &RunOptions {
+            out: out.to_path_buf(),
+            jobs,
+            runs,
+            stop: &stop,
+            progress: &|_| {},
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+    .records
+}
+
+/// A record without its wall time (the one field identical runs differ in).
+fn timeless(r: &RunRecord) -> RunRecord {
+    RunRecord {
+        wall_time_s: 0.0,
+        ..r.clone()
+    }
+}
+
+/// The whole smoke campaign on two workers, once for every test of this file.
+fn full() -> &'static (tempfile::TempDir, Vec<RunRecord>) {
+    static FULL: OnceLock<(tempfile::TempDir, Vec<RunRecord>)> = OnceLock::new();
+    FULL.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let records = run(&smoke(), dir.path(), 2, None);
+        (dir, records)
+    })
+}
+
+#[test]
+fn the_smoke_campaign_runs_every_variant_under_every_setting() {
+    let (dir, records) = full();
+    assert_eq!(records.len(), 20);
+    assert!(records.iter().enumerate().all(|(i, r)| r.index == i as u64));
+    for pair in records.chunks(2) {
+        // A sample's two runs drew the same world and differ in the setting only.
+        assert_eq!(pair[0].sampled, pair[1].sampled);
+        assert_eq!((pair[0].setting, pair[1].setting), (0, 1));
+        assert_ne!(pair[0].parameters, pair[1].parameters);
+    }
+    // The results file is the records, one per line, by index.
+    assert_eq!(read_results(dir.path()).unwrap(), *records);
+    let summary = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
+    assert!(summary.contains("| autonomy.planner_safety_m = 0.4 | 10 |"), "{summary}");
+    assert!(summary.contains("| autonomy.planner_safety_m = 0.6 | 10 |"), "{summary}");
+    // Every failing variant and only those has a failure file, listed in the error table.
+    let files = std::fs::read_dir(dir.path().join("failures")).unwrap().count();
+    assert_eq!(files, records.iter().filter(|r| r.failed).count());
+    for r in records.iter().filter(|r| r.failed) {
+        assert!(!r.failures.is_empty() && (r.contacts > 0 || !r.expectations_met), "{r:?}");
+        assert!(summary.contains(&format!("`failures/{}.toml`", r.index)), "{summary}");
+    }
+    // One map served all 20 runs: the static world never changed.
+    assert_eq!(std::fs::read_dir(dir.path().join("maps")).unwrap().count(), 1);
+}
+
+#[test]
+fn results_are_the_same_whatever_jobs() {
+    let (_, records) = full();
+    let dir = tempfile::tempdir().unwrap();
+    let one = run(&smoke(), dir.path(), 1, Some(8));
+    assert_eq!(one.len(), 8);
+    for (a, b) in one.iter().zip(records) {
+        assert_eq!(timeless(a), timeless(b));
+    }
+}
+
+#[test]
+fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
+    let (_, records) = full();
+    let dir = tempfile::tempdir().unwrap();
+    let campaign = smoke();
+    let first = run(&campaign, dir.path(), 2, Some(3));
+    assert_eq!(first.len(), 3);
+    // A process killed in the middle of a line.
+    let results = dir.path().join("results.jsonl");
+    let mut text = std::fs::read_to_string(&results).unwrap();
+    text.push_str("{\"index\":3,\"sample\":1,\"se");
+    std::fs::write(&results, text).unwrap();
+    let stop = AtomicBool::new(false);
+    let outcome = run_campaign(
+        &campaign,
+        &RunOptions {
+            out: dir.path().to_path_buf(),
+            jobs: 2,
+            runs: Some(5),
+            stop: &stop,
+            progress: &|_| {},
+        },
+    )
+    .unwrap();
+    assert_eq!(outcome.ran, 2, "variants 3 and 4 only");
+    assert_eq!(outcome.records.len(), 5);
+    for (a, b) in outcome.records.iter().zip(records) {
+        assert_eq!(timeless(a), timeless(b));
+    }
+    // Another campaign's results are never mixed in.
+    let other = dir.path().join("other.toml");
+    let text = std::fs::read_to_string(smoke_path()).unwrap().replace("seed = 1", "seed = 2");
+    std::fs::write(&other, text.replace("\"../cone_in_path_car.toml\"", &format!("{:?}", smoke_path().parent().unwrap().join("../cone_in_path_car.toml")))).unwrap();
+    let e = run_campaign(
+        &Campaign::from_file(&other).unwrap(),
+        &RunOptions {
+            out: dir.path().to_path_buf(),
+            jobs: 1,
+            runs: Some(1),
+            stop: &stop,
+            progress: &|_| {},
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("campaign.json") && e.contains("another campaign"), "{e}");
+}
+
+#[test]
+fn a_stop_keeps_only_whole_runs_and_the_rest_runs_later() {
+    let (_, records) = full();
+    let dir = tempfile::tempdir().unwrap();
+    let campaign = smoke();
+    let stop = AtomicBool::new(false);
+    let outcome = run_campaign(
+        &campaign,
+        &RunOptions {
+            out: dir.path().to_path_buf(),
+            jobs: 1,
+            runs: Some(4),
+            stop: &stop,
+            progress: &|_| stop.store(true, Ordering::Relaxed),
+        },
+    )
+    .unwrap();
+    assert!(outcome.interrupted);
+    assert_eq!(outcome.records.len(), 1, "the run in flight when stopped finished: {:?}", outcome.records);
+    assert_eq!(read_results(dir.path()).unwrap().len(), 1);
+    let rest = run(&campaign, dir.path(), 2, Some(4));
+    assert_eq!(rest.len(), 4);
+    for (a, b) in rest.iter().zip(records) {
+        assert_eq!(timeless(a), timeless(b));
+    }
+}
+
+/// `taxi-sim run FILE --report`: the report's JSON.
+fn taxi_sim_run(file: &Path, work: &Path) -> serde_json::Value {
+    let report = work.join("report.json");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_taxi-sim"))
+        .arg("run")
+        .arg(file)
+        .arg("--map-dir")
+        .arg(work.join("map"))
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert!(
+        matches!(out.status.code(), Some(0 | 1)),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap()
+}
+
+/// The report agrees with the record: end, contacts, clearances, verdict.
+fn assert_reproduces(report: &serde_json::Value, r: &RunRecord) {
+    assert_eq!(report["end"].as_str(), Some(r.end.as_str()), "{}", r.index);
+    assert_eq!(report["contacts"].as_array().unwrap().len(), r.contacts);
+    assert_eq!(report["expectations_met"].as_bool(), Some(r.expectations_met));
+    let clearance: Vec<Option<f64>> = report["min_clearance_m"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(serde_json::Value::as_f64)
+        .collect();
+    assert_eq!(clearance, r.min_clearance_m, "{}", r.index);
+    assert_eq!(report["sim_time_s"].as_f64(), Some(r.sim_time_s));
+}
+
+#[test]
+fn failure_files_and_written_variants_reproduce_with_taxi_sim_run() {
+    let (dir, records) = full();
+    let campaign = smoke();
+    let work = tempfile::tempdir().unwrap();
+    // Every failure file as it is (its setting is in its `[config]`).
+    for r in records.iter().filter(|r| r.failed) {
+        let file = dir.path().join(r.failure_file.as_deref().unwrap());
+        let report = taxi_sim_run(&file, work.path());
+        assert_reproduces(&report, r);
+    }
+    // And a passing variant under the other setting, written out by hand.
+    let r = &records[1];
+    let v = variant(&campaign, 1, records);
+    let file = work.path().join("variant-1.toml");
+    std::fs::write(&file, &v.text).unwrap();
+    assert_reproduces(&taxi_sim_run(&file, work.path()), r);
+}
+
+#[test]
+fn bad_campaign_files_are_refused_with_their_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = smoke_path().parent().unwrap().join("../cone_in_path_car.toml");
+    let head = format!("name = \"x\"\nbase = {base:?}\nruns = 4\n");
+    let cases = [
+        ("runz = 3\n", "2:1", "unknown field `runz`"),
+        ("[[obstacles]]\nid = \"c\"\nalong_m = { uniform = [5.0, 1.0] }\n", "5:1", "uniform = [5, 1]"),
+        ("[[obstacles]]\nkind = \"cone\"\n", "5:1", "needs an `id`"),
+        ("[parameters]\n\"autonomy.planner_safty_m\" = [0.4]\n", "5:1", "planner_safty_m"),
+        ("sampler = \"sobol\"\n", "5:11", "unknown variant `sobol`"),
+    ];
+    for (i, (tail, place, words)) in cases.iter().enumerate() {
+        let text = if tail.starts_with("runz") {
+            format!("name = \"x\"\n{tail}base = {base:?}\nruns = 4\n")
+        } else {
+            format!("{head}\n{tail}")
+        };
+        let file = dir.path().join(format!("c{i}.toml"));
+        std::fs::write(&file, text).unwrap();
+        let e = Campaign::from_file(&file).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("c{i}.toml:{place}")) && e.contains(words),
+            "case {i}: {e}"
+        );
+    }
+}
+
+#[test]
+fn a_scenario_config_table_is_checked_and_used() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(
+        smoke_path().parent().unwrap().join("../cone_in_path_car.toml"),
+    )
+    .unwrap();
+    let file = dir.path().join("s.toml");
+    std::fs::write(&file, format!("{base}\n[config.autonomy]\nplanner_safty_m = 0.4\n")).unwrap();
+    let e = sim::scenario::Scenario::from_file(&file).unwrap_err().to_string();
+    assert!(e.contains("`config`") && e.contains("planner_safty_m"), "{e}");
+    std::fs::write(&file, format!("{base}\n[config.autonomy]\nplanner_safety_m = 0.4\n")).unwrap();
+    let s = sim::scenario::Scenario::from_file(&file).unwrap();
+    let c = sim::config::RunConfig::for_scenario(&s, None).unwrap();
+    assert_eq!(c.autonomy.planner_safety_m, 0.4);
+    assert_eq!(c.autonomy.avoider_safety_m, sim::config::RunConfig::default().autonomy.avoider_safety_m);
+}
