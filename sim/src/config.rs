@@ -222,8 +222,9 @@ impl RunConfig {
                 path: p.to_path_buf(),
                 source,
             })?;
-            let over: toml::Table = toml::from_str(&text)
-                .map_err(|e| crate::scenario::ScenarioError::toml(&p.display().to_string(), &text, &e))?;
+            let over: toml::Table = toml::from_str(&text).map_err(|e| {
+                crate::scenario::ScenarioError::toml(&p.display().to_string(), &text, &e)
+            })?;
             for (k, v) in over {
                 crate::campaign::set_path(&mut table, &k, v);
             }

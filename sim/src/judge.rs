@@ -425,9 +425,10 @@ impl Judge {
         // A campaign's `end = "any"` accepts an obstacle never passed (one that appeared after
         // the vehicle went by, or that it waited for until the end).
         let unpassed_ok = expected == ExpectedEnd::Any;
-        let every_pass_met = self.obstacles.iter().all(|r| {
-            (unpassed_ok || !r.passes.is_empty()) && r.passes.iter().all(|p| p.met)
-        });
+        let every_pass_met = self
+            .obstacles
+            .iter()
+            .all(|r| (unpassed_ok || !r.passes.is_empty()) && r.passes.iter().all(|p| p.met));
         let ended_as_expected = match expected {
             ExpectedEnd::Completed => {
                 end == EndReason::Completed && self.laps_completed() == self.laps

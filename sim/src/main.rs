@@ -54,6 +54,18 @@ enum Command {
         /// Laps of `bench loop` (default 1; 0: the scenario's own).
         #[arg(long, default_value_t = 1)]
         laps: u32,
+        /// Campaign of `bench campaign`.
+        #[arg(long, default_value = "scenarios/campaigns/parking_lot_random.toml")]
+        campaign: PathBuf,
+        /// `bench campaign`: variants a round, run both ways.
+        #[arg(long, default_value_t = 4)]
+        variants: u64,
+        /// `bench campaign`: rounds (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        rounds: usize,
+        /// `bench campaign`: runs at a time, both ways (default: the cores).
+        #[arg(long)]
+        jobs: Option<usize>,
     },
     /// Run a scenario in closed loop (builds its offline map first when missing or stale).
     /// Exit code 0 when every expectation held, 1 when one did not, 2 on bad input.
@@ -91,6 +103,9 @@ enum BenchTarget {
     Lidar,
     /// The closed loop on `--scenario`: real-time factor and wall time per stage.
     Loop,
+    /// A campaign's runs per hour against the same variants as separate `taxi-sim run`
+    /// processes.
+    Campaign,
 }
 
 /// Raised by [`emit`] when stdout's reader went away (`taxi-sim ... | head`): not an error.
@@ -149,7 +164,21 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
             samples,
             scenario,
             laps,
-        } => bench(what, json, samples, &scenario, laps),
+            campaign,
+            variants,
+            rounds,
+            jobs,
+        } => {
+            let campaign = sim::campaign::bench::CampaignBench {
+                campaign: &campaign,
+                variants,
+                rounds,
+                jobs: jobs
+                    .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+                exe: std::env::current_exe()?,
+            };
+            bench(what, json, samples, (&scenario, laps), &campaign)
+        }
         Command::Model(ModelCommand::Fit(args)) => cli::model::run(&args),
         Command::SmallObstacles(args) => cli::small::run(&args),
         Command::Check(args) => cli::check::run(&args),
@@ -220,8 +249,8 @@ fn bench(
     what: BenchTarget,
     json: bool,
     samples: usize,
-    scenario: &std::path::Path,
-    laps: u32,
+    (scenario, laps): (&std::path::Path, u32),
+    campaign: &sim::campaign::bench::CampaignBench<'_>,
 ) -> anyhow::Result<()> {
     let progress = ProgressBar::new_spinner();
     let mut report = |what: &str| progress.set_message(format!("measuring {what}"));
@@ -229,6 +258,7 @@ fn bench(
         BenchTarget::Mapper => sim::bench::mapper_figures(samples, &mut report),
         BenchTarget::Lidar => sim::bench::lidar_figures(samples, &mut report)?,
         BenchTarget::Loop => sim::bench::loop_figures(scenario, laps, &mut report)?,
+        BenchTarget::Campaign => sim::campaign::bench::campaign_figures(campaign, &mut report)?,
     };
     progress.finish_and_clear();
     let mut t = String::new();

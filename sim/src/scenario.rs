@@ -867,9 +867,8 @@ impl Resolver<'_> {
         let patches = self.patches(&spec.patches, &world, &mut ids)?;
         let obstacles = self.obstacles(&spec.obstacles, &world, &vehicle, &mut ids)?;
         if let Some(c) = &spec.config {
-            crate::config::RunConfig::from_table(c.get_ref().clone()).map_err(|m| {
-                ScenarioError::at(self.file, self.text, c.span(), "config", m)
-            })?;
+            crate::config::RunConfig::from_table(c.get_ref().clone())
+                .map_err(|m| ScenarioError::at(self.file, self.text, c.span(), "config", m))?;
         }
         Ok(Scenario {
             path: path.to_path_buf(),

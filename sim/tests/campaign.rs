@@ -67,17 +67,34 @@ fn the_smoke_campaign_runs_every_variant_under_every_setting() {
     // The results file is the records, one per line, by index.
     assert_eq!(read_results(dir.path()).unwrap(), *records);
     let summary = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
-    assert!(summary.contains("| autonomy.planner_safety_m = 0.4 | 10 |"), "{summary}");
-    assert!(summary.contains("| autonomy.planner_safety_m = 0.6 | 10 |"), "{summary}");
+    assert!(
+        summary.contains("| autonomy.planner_safety_m = 0.4 | 10 |"),
+        "{summary}"
+    );
+    assert!(
+        summary.contains("| autonomy.planner_safety_m = 0.6 | 10 |"),
+        "{summary}"
+    );
     // Every failing variant and only those has a failure file, listed in the error table.
-    let files = std::fs::read_dir(dir.path().join("failures")).unwrap().count();
+    let files = std::fs::read_dir(dir.path().join("failures"))
+        .unwrap()
+        .count();
     assert_eq!(files, records.iter().filter(|r| r.failed).count());
     for r in records.iter().filter(|r| r.failed) {
-        assert!(!r.failures.is_empty() && (r.contacts > 0 || !r.expectations_met), "{r:?}");
-        assert!(summary.contains(&format!("`failures/{}.toml`", r.index)), "{summary}");
+        assert!(
+            !r.failures.is_empty() && (r.contacts > 0 || !r.expectations_met),
+            "{r:?}"
+        );
+        assert!(
+            summary.contains(&format!("`failures/{}.toml`", r.index)),
+            "{summary}"
+        );
     }
     // One map served all 20 runs: the static world never changed.
-    assert_eq!(std::fs::read_dir(dir.path().join("maps")).unwrap().count(), 1);
+    assert_eq!(
+        std::fs::read_dir(dir.path().join("maps")).unwrap().count(),
+        1
+    );
 }
 
 #[test]
@@ -122,8 +139,23 @@ fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
     }
     // Another campaign's results are never mixed in.
     let other = dir.path().join("other.toml");
-    let text = std::fs::read_to_string(smoke_path()).unwrap().replace("seed = 1", "seed = 2");
-    std::fs::write(&other, text.replace("\"../cone_in_path_car.toml\"", &format!("{:?}", smoke_path().parent().unwrap().join("../cone_in_path_car.toml")))).unwrap();
+    let text = std::fs::read_to_string(smoke_path())
+        .unwrap()
+        .replace("seed = 1", "seed = 2");
+    std::fs::write(
+        &other,
+        text.replace(
+            "\"../cone_in_path_car.toml\"",
+            &format!(
+                "{:?}",
+                smoke_path()
+                    .parent()
+                    .unwrap()
+                    .join("../cone_in_path_car.toml")
+            ),
+        ),
+    )
+    .unwrap();
     let e = run_campaign(
         &Campaign::from_file(&other).unwrap(),
         &RunOptions {
@@ -136,7 +168,10 @@ fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
     )
     .unwrap_err()
     .to_string();
-    assert!(e.contains("campaign.json") && e.contains("another campaign"), "{e}");
+    assert!(
+        e.contains("campaign.json") && e.contains("another campaign"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -157,7 +192,12 @@ fn a_stop_keeps_only_whole_runs_and_the_rest_runs_later() {
     )
     .unwrap();
     assert!(outcome.interrupted);
-    assert_eq!(outcome.records.len(), 1, "the run in flight when stopped finished: {:?}", outcome.records);
+    assert_eq!(
+        outcome.records.len(),
+        1,
+        "the run in flight when stopped finished: {:?}",
+        outcome.records
+    );
     assert_eq!(read_results(dir.path()).unwrap().len(), 1);
     let rest = run(&campaign, dir.path(), 2, Some(4));
     assert_eq!(rest.len(), 4);
@@ -190,7 +230,10 @@ fn taxi_sim_run(file: &Path, work: &Path) -> serde_json::Value {
 fn assert_reproduces(report: &serde_json::Value, r: &RunRecord) {
     assert_eq!(report["end"].as_str(), Some(r.end.as_str()), "{}", r.index);
     assert_eq!(report["contacts"].as_array().unwrap().len(), r.contacts);
-    assert_eq!(report["expectations_met"].as_bool(), Some(r.expectations_met));
+    assert_eq!(
+        report["expectations_met"].as_bool(),
+        Some(r.expectations_met)
+    );
     let clearance: Vec<Option<f64>> = report["min_clearance_m"]
         .as_array()
         .unwrap()
@@ -223,13 +266,24 @@ fn failure_files_and_written_variants_reproduce_with_taxi_sim_run() {
 #[test]
 fn bad_campaign_files_are_refused_with_their_place() {
     let dir = tempfile::tempdir().unwrap();
-    let base = smoke_path().parent().unwrap().join("../cone_in_path_car.toml");
+    let base = smoke_path()
+        .parent()
+        .unwrap()
+        .join("../cone_in_path_car.toml");
     let head = format!("name = \"x\"\nbase = {base:?}\nruns = 4\n");
     let cases = [
         ("runz = 3\n", "2:1", "unknown field `runz`"),
-        ("[[obstacles]]\nid = \"c\"\nalong_m = { uniform = [5.0, 1.0] }\n", "5:1", "uniform = [5, 1]"),
+        (
+            "[[obstacles]]\nid = \"c\"\nalong_m = { uniform = [5.0, 1.0] }\n",
+            "5:1",
+            "uniform = [5, 1]",
+        ),
         ("[[obstacles]]\nkind = \"cone\"\n", "5:1", "needs an `id`"),
-        ("[parameters]\n\"autonomy.planner_safty_m\" = [0.4]\n", "5:1", "planner_safty_m"),
+        (
+            "[parameters]\n\"autonomy.planner_safty_m\" = [0.4]\n",
+            "5:1",
+            "planner_safty_m",
+        ),
         ("sampler = \"sobol\"\n", "5:11", "unknown variant `sobol`"),
     ];
     for (i, (tail, place, words)) in cases.iter().enumerate() {
@@ -252,16 +306,64 @@ fn bad_campaign_files_are_refused_with_their_place() {
 fn a_scenario_config_table_is_checked_and_used() {
     let dir = tempfile::tempdir().unwrap();
     let base = std::fs::read_to_string(
-        smoke_path().parent().unwrap().join("../cone_in_path_car.toml"),
+        smoke_path()
+            .parent()
+            .unwrap()
+            .join("../cone_in_path_car.toml"),
     )
     .unwrap();
     let file = dir.path().join("s.toml");
-    std::fs::write(&file, format!("{base}\n[config.autonomy]\nplanner_safty_m = 0.4\n")).unwrap();
-    let e = sim::scenario::Scenario::from_file(&file).unwrap_err().to_string();
-    assert!(e.contains("`config`") && e.contains("planner_safty_m"), "{e}");
-    std::fs::write(&file, format!("{base}\n[config.autonomy]\nplanner_safety_m = 0.4\n")).unwrap();
+    std::fs::write(
+        &file,
+        format!("{base}\n[config.autonomy]\nplanner_safty_m = 0.4\n"),
+    )
+    .unwrap();
+    let e = sim::scenario::Scenario::from_file(&file)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`config`") && e.contains("planner_safty_m"),
+        "{e}"
+    );
+    std::fs::write(
+        &file,
+        format!("{base}\n[config.autonomy]\nplanner_safety_m = 0.4\n"),
+    )
+    .unwrap();
     let s = sim::scenario::Scenario::from_file(&file).unwrap();
     let c = sim::config::RunConfig::for_scenario(&s, None).unwrap();
     assert_eq!(c.autonomy.planner_safety_m, 0.4);
-    assert_eq!(c.autonomy.avoider_safety_m, sim::config::RunConfig::default().autonomy.avoider_safety_m);
+    assert_eq!(
+        c.autonomy.avoider_safety_m,
+        sim::config::RunConfig::default().autonomy.avoider_safety_m
+    );
+}
+
+#[test]
+fn every_shipped_campaign_reads_and_its_first_variants_are_valid_scenarios() {
+    let dir = smoke_path().parent().unwrap().to_path_buf();
+    let mut names = Vec::new();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let campaign = Campaign::from_file(&path).unwrap_or_else(|e| panic!("{e}"));
+        for i in 0..8 {
+            let v = variant(&campaign, i, &[]);
+            sim::scenario::Scenario::from_str(&v.text, &campaign.variant_path(i))
+                .unwrap_or_else(|e| panic!("{} variant {i}: {e}\n{}", path.display(), v.text));
+        }
+        names.push(path.file_stem().unwrap().to_string_lossy().into_owned());
+    }
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "jet_wing_and_engine_paths",
+            "low_debris_car",
+            "parking_lot_random",
+            "smoke"
+        ]
+    );
 }

@@ -128,3 +128,68 @@ fn the_printed_default_configuration_reads_back_and_mistakes_are_located() {
         "{stderr}"
     );
 }
+
+/// `taxi-sim campaign run`, interrupted by Ctrl-C (SIGINT) once a run is recorded: it exits
+/// with whole runs only in `results.jsonl`, says how to resume, and `campaign show` prints the
+/// summary of what is there.
+#[test]
+fn a_campaign_stopped_by_ctrl_c_keeps_whole_runs_and_shows_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("smoke");
+    let child = Command::new(env!("CARGO_BIN_EXE_taxi-sim"))
+        .args([
+            "campaign",
+            "run",
+            "../scenarios/campaigns/smoke.toml",
+            "--jobs",
+            "1",
+            "--out",
+        ])
+        .arg(&out)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let results = out.join("results.jsonl");
+    let t = std::time::Instant::now();
+    while std::fs::read_to_string(&results).map_or(true, |s| s.is_empty()) {
+        assert!(t.elapsed().as_secs() < 300, "no run recorded in 300 s");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let done = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&done.stdout);
+    assert_eq!(done.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("interrupted: run the same command again to resume"),
+        "{stdout}"
+    );
+    let text = std::fs::read_to_string(&results).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(
+        !lines.is_empty() && lines.len() < 20 && text.ends_with('\n'),
+        "{text}"
+    );
+    for line in &lines {
+        let v: serde_json::Value = serde_json::from_str(line).unwrap();
+        assert!(
+            v["end"].as_str().is_some_and(|e| e != "interrupted"),
+            "{line}"
+        );
+    }
+    let (code, shown, stderr) = taxi_sim(&["campaign", "show", out.to_str().unwrap()]);
+    assert!(matches!(code, 0 | 1), "{stderr}");
+    assert!(
+        shown.contains(&format!("{} runs recorded", lines.len()))
+            && shown.contains("## Per parameter setting"),
+        "{shown}"
+    );
+    let (code, _, stderr) = taxi_sim(&["campaign", "show", dir.path().to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("not a campaign directory"), "{stderr}");
+}

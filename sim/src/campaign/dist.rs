@@ -132,7 +132,11 @@ impl Layout {
     /// Compiles `value`, found at `label`; the error names the label and what is wrong.
     pub fn compile(&mut self, label: &str, value: &Value) -> Result<Node, String> {
         match value {
-            Value::Table(t) if t.len() == 1 && DISTRIBUTIONS.contains(&t.keys().next().unwrap_or(&String::new()).as_str()) => {
+            Value::Table(t)
+                if t.len() == 1
+                    && DISTRIBUTIONS
+                        .contains(&t.keys().next().unwrap_or(&String::new()).as_str()) =>
+            {
                 let (name, arg) = t.iter().next().expect("one key");
                 self.distribution(label, name, arg)
             }
@@ -153,13 +157,18 @@ impl Layout {
 
     fn distribution(&mut self, label: &str, name: &str, arg: &Value) -> Result<Node, String> {
         let numbers = |what: &str| -> Result<(f64, f64), String> {
-            match arg.as_array().map(|a| a.iter().map(as_f64).collect::<Vec<_>>()) {
+            match arg
+                .as_array()
+                .map(|a| a.iter().map(as_f64).collect::<Vec<_>>())
+            {
                 Some(v) if v.len() == 2 && v.iter().all(Option::is_some) => {
                     let (lo, hi) = (v[0].unwrap_or(0.0), v[1].unwrap_or(0.0));
                     if lo.is_finite() && hi.is_finite() && lo <= hi {
                         Ok((lo, hi))
                     } else {
-                        Err(format!("{label}: {what} = [{lo}, {hi}]: needs finite lo <= hi"))
+                        Err(format!(
+                            "{label}: {what} = [{lo}, {hi}]: needs finite lo <= hi"
+                        ))
                     }
                 }
                 _ => Err(format!("{label}: {what} takes two numbers [lo, hi]")),
@@ -335,7 +344,9 @@ mod tests {
         let v: toml::Table = toml::from_str("a = { uniform = [4.0, 2.0] }").unwrap();
         let e = layout.compile("obstacles.c", &Value::Table(v)).unwrap_err();
         assert!(e.contains("obstacles.c.a: uniform = [4, 2]"), "{e}");
-        let v: toml::Table = toml::from_str("a = { normal = { mean = 0.0, sd = 0.0, min = -1.0, max = 1.0 } }").unwrap();
+        let v: toml::Table =
+            toml::from_str("a = { normal = { mean = 0.0, sd = 0.0, min = -1.0, max = 1.0 } }")
+                .unwrap();
         let e = layout.compile("p", &Value::Table(v)).unwrap_err();
         assert!(e.contains("p.a: normal needs sd > 0"), "{e}");
     }

@@ -20,7 +20,7 @@ use crate::judge::{EndReason, PassOutcome};
 use crate::observer::NoObserver;
 use crate::report::RunReport;
 use crate::run::{RunHandles, RunSetup, run_with};
-use crate::scenario::{ExpectedEnd, Expectation, Scenario};
+use crate::scenario::{Expectation, ExpectedEnd, Scenario};
 
 /// One pass-level outcome of an obstacle in a run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -116,7 +116,10 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
     let mut contacts_with: Vec<String> = r.contacts.iter().map(|c| c.object.clone()).collect();
     contacts_with.dedup();
     for c in &r.contacts {
-        failures.push(format!("contact: {} with {} at {:.1} s", c.part, c.object, c.time_s));
+        failures.push(format!(
+            "contact: {} with {} at {:.1} s",
+            c.part, c.object, c.time_s
+        ));
     }
     let (mut false_stops, mut needless, mut deviations) = (0, 0, 0);
     let mut obstacles = Vec::new();
@@ -125,7 +128,9 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
         for p in &o.passes {
             let expect_drive = matches!(o.expected, Expectation::PassUnder | Expectation::Deviate);
             false_stops += usize::from(p.outcome == PassOutcome::Stopped && expect_drive);
-            needless += usize::from(p.outcome == PassOutcome::Deviated && o.expected == Expectation::PassUnder);
+            needless += usize::from(
+                p.outcome == PassOutcome::Deviated && o.expected == Expectation::PassUnder,
+            );
             deviations += usize::from(p.outcome == PassOutcome::Deviated);
             if !p.met {
                 failures.push(format!(
@@ -134,25 +139,37 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
                     p.lap,
                     p.outcome,
                     o.expected,
-                    p.min_clearance_m.iter().copied().fold(f64::INFINITY, f64::min)
+                    p.min_clearance_m
+                        .iter()
+                        .copied()
+                        .fold(f64::INFINITY, f64::min)
                 ));
             }
         }
         let levels = o.passes.first().map_or(0, |p| p.min_clearance_m.len());
         let per_level: Vec<f64> = (0..levels)
-            .map(|k| o.passes.iter().map(|p| p.min_clearance_m[k]).fold(f64::INFINITY, f64::min))
+            .map(|k| {
+                o.passes
+                    .iter()
+                    .map(|p| p.min_clearance_m[k])
+                    .fold(f64::INFINITY, f64::min)
+            })
             .collect();
         obstacle_clearance = per_level.iter().copied().fold(obstacle_clearance, f64::min);
         obstacles.push(ObstacleOutcome {
             id: o.id.clone(),
             kind: o.kind.clone(),
             expect: o.expected.as_str().into(),
-            outcome: worst(o.passes.iter().map(|p| p.outcome)).map_or("not_passed".into(), |p| p.as_str().into()),
+            outcome: worst(o.passes.iter().map(|p| p.outcome))
+                .map_or("not_passed".into(), |p| p.as_str().into()),
             met: o.passes.iter().all(|p| p.met),
             min_clearance_m: per_level.into_iter().map(finite).collect(),
         });
     }
-    let end = serde_json::to_value(r.end).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default();
+    let end = serde_json::to_value(r.end)
+        .ok()
+        .and_then(|v| v.as_str().map(String::from))
+        .unwrap_or_default();
     let end_met = match scenario.expected_end {
         ExpectedEnd::Completed => r.end == EndReason::Completed,
         ExpectedEnd::WaitingForHiddenObstacle => r.end == EndReason::WaitingForHiddenObstacle,
@@ -167,7 +184,9 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
     }
     let failed = !r.contacts.is_empty() || !r.expectations_met;
     let clearance = finite(obstacle_clearance);
-    let score = clearance.unwrap_or(10.0).min(10.0) - if failed { 1.0 } else { 0.0 } - r.contacts.len() as f64;
+    let score = clearance.unwrap_or(10.0).min(10.0)
+        - if failed { 1.0 } else { 0.0 }
+        - r.contacts.len() as f64;
     let json = |v: &toml::Value| serde_json::to_value(v).unwrap_or(serde_json::Value::Null);
     RunRecord {
         index: v.index,
@@ -175,7 +194,10 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
         setting: v.setting,
         seed: scenario.seed,
         sampled: v.drawn.iter().map(|(k, x)| (k.clone(), json(x))).collect(),
-        parameters: campaign.settings[v.setting].iter().map(|(k, x)| (k.clone(), json(x))).collect(),
+        parameters: campaign.settings[v.setting]
+            .iter()
+            .map(|(k, x)| (k.clone(), json(x)))
+            .collect(),
         u: v.u.clone(),
         end,
         expectations_met: r.expectations_met,
@@ -215,13 +237,20 @@ pub fn static_world_key(scenario: &Scenario, config: &RunConfig) -> Result<Strin
         crate::mapping::map_config(config),
         config.lidar,
     );
-    Ok(format!("{:08x}{:06x}", crc32fast::hash(text.as_bytes()), text.len() & 0xff_ffff))
+    Ok(format!(
+        "{:08x}{:06x}",
+        crc32fast::hash(text.as_bytes()),
+        text.len() & 0xff_ffff
+    ))
 }
+
+/// One static world's map directory, once built (or why it could not be).
+type MapSlot = OnceLock<std::result::Result<PathBuf, String>>;
 
 /// The offline maps of a campaign directory, built once per static world.
 struct MapCache {
     dir: PathBuf,
-    entries: Mutex<HashMap<String, Arc<OnceLock<std::result::Result<PathBuf, String>>>>>,
+    entries: Mutex<HashMap<String, Arc<MapSlot>>>,
 }
 
 impl MapCache {
@@ -230,15 +259,27 @@ impl MapCache {
     /// place, so a map directory is never seen half written (by this process or another).
     fn get(&self, scenario_text: &str, scenario: &Scenario, config: &RunConfig) -> Result<PathBuf> {
         let key = static_world_key(scenario, config)?;
-        let cell = self.entries.lock().map_err(|_| Error::Invalid("map cache poisoned".into()))?.entry(key.clone()).or_default().clone();
+        let cell = self
+            .entries
+            .lock()
+            .map_err(|_| Error::Invalid("map cache poisoned".into()))?
+            .entry(key.clone())
+            .or_default()
+            .clone();
         cell.get_or_init(|| {
             let done = self.dir.join(&key);
             if done.join("manifest.json").exists() {
                 return Ok(done);
             }
-            let scratch = self.dir.join(format!("{key}.partial-{}", std::process::id()));
+            let scratch = self
+                .dir
+                .join(format!("{key}.partial-{}", std::process::id()));
             let build = || -> Result<()> {
-                std::fs::create_dir_all(&scratch).map_err(|source| Error::Io { what: "creating a map directory", path: scratch.clone(), source })?;
+                std::fs::create_dir_all(&scratch).map_err(|source| Error::Io {
+                    what: "creating a map directory",
+                    path: scratch.clone(),
+                    source,
+                })?;
                 // The map holds the scenario it was driven in: `fingerprint` reads it.
                 let file = scratch.join("scenario.toml");
                 mapper::write_atomically(&file, scenario_text.as_bytes())?;
@@ -251,7 +292,11 @@ impl MapCache {
                         let _ = std::fs::remove_dir_all(&scratch);
                         Ok(())
                     }
-                    Err(source) => Err(Error::Io { what: "moving a map into the cache", path: done.clone(), source }),
+                    Err(source) => Err(Error::Io {
+                        what: "moving a map into the cache",
+                        path: done.clone(),
+                        source,
+                    }),
                 }
             };
             build().map(|()| done).map_err(|e| e.to_string())
@@ -306,7 +351,13 @@ pub fn read_results(dir: &Path) -> Result<Vec<RunRecord>> {
     let text = match std::fs::read_to_string(&path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(source) => return Err(Error::Io { what: "reading the results", path, source }),
+        Err(source) => {
+            return Err(Error::Io {
+                what: "reading the results",
+                path,
+                source,
+            });
+        }
     };
     let lines: Vec<&str> = text.lines().collect();
     let mut records = Vec::with_capacity(lines.len());
@@ -319,7 +370,10 @@ pub fn read_results(dir: &Path) -> Result<Vec<RunRecord>> {
                 mapper::write_atomically(&path, kept.as_bytes())?;
             }
             Err(e) => {
-                return Err(Error::BadFile { path, message: format!("line {}: not a run record: {e}", i + 1) });
+                return Err(Error::BadFile {
+                    path,
+                    message: format!("line {}: not a run record: {e}", i + 1),
+                });
             }
         }
     }
@@ -352,7 +406,9 @@ pub fn proposals_for(campaign: &Campaign, g: u64, records: &[RunRecord]) -> Vec<
         }
         let mut scored: Vec<(f64, &[f64])> = by_sample.into_values().collect();
         scored.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let n = ((scored.len() as f64 * campaign.falsify.elite_fraction).ceil() as usize).max(1).min(scored.len());
+        let n = ((scored.len() as f64 * campaign.falsify.elite_fraction).ceil() as usize)
+            .max(1)
+            .min(scored.len());
         let elites: Vec<&[f64]> = scored[..n].iter().map(|s| s.1).collect();
         p = sampler::refit(&p, &elites, campaign.falsify.smoothing);
     }
@@ -371,13 +427,31 @@ pub fn variant(campaign: &Campaign, index: u64, records: &[RunRecord]) -> Varian
 }
 
 /// Runs one variant over the cache's map; `None` when the stop flag cut it short.
-fn run_variant(campaign: &Campaign, v: &Variant, maps: &MapCache, dir: &Path, stop: &AtomicBool, pool: &rayon::ThreadPool) -> Result<Option<RunRecord>> {
+fn run_variant(
+    campaign: &Campaign,
+    v: &Variant,
+    maps: &MapCache,
+    dir: &Path,
+    stop: &AtomicBool,
+    pool: &rayon::ThreadPool,
+) -> Result<Option<RunRecord>> {
     let scenario = Scenario::from_str(&v.text, &campaign.variant_path(v.index))?;
     let config = campaign.config(v.setting)?;
     let map_dir = maps.get(&v.text, &scenario, &config)?;
-    let setup = RunSetup { config, ..RunSetup::new(map_dir) };
+    let setup = RunSetup {
+        config,
+        ..RunSetup::new(map_dir)
+    };
     let report = pool.install(|| {
-        run_with(&scenario, &setup, RunHandles { stop: Some(stop), progress: &mut |_| {}, observer: &mut NoObserver })
+        run_with(
+            &scenario,
+            &setup,
+            RunHandles {
+                stop: Some(stop),
+                progress: &mut |_| {},
+                observer: &mut NoObserver,
+            },
+        )
     })?;
     if report.end == EndReason::Interrupted {
         return Ok(None);
@@ -422,7 +496,10 @@ fn run_parallel(
             .collect();
         handles
             .into_iter()
-            .map(|h| h.join().unwrap_or_else(|_| Err(Error::Invalid("a campaign worker panicked".into()))))
+            .map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| Err(Error::Invalid("a campaign worker panicked".into())))
+            })
             .collect()
     });
     let mut all = Vec::new();
@@ -438,8 +515,17 @@ struct Appender(Mutex<std::fs::File>, PathBuf);
 impl Appender {
     fn push(&self, r: &RunRecord) -> Result<()> {
         let line = serde_json::to_string(r)? + "\n";
-        let mut f = self.0.lock().map_err(|_| Error::Invalid("results file lock poisoned".into()))?;
-        f.write_all(line.as_bytes()).and_then(|()| f.flush()).map_err(|source| Error::Io { what: "appending to the results", path: self.1.clone(), source })
+        let mut f = self
+            .0
+            .lock()
+            .map_err(|_| Error::Invalid("results file lock poisoned".into()))?;
+        f.write_all(line.as_bytes())
+            .and_then(|()| f.flush())
+            .map_err(|source| Error::Io {
+                what: "appending to the results",
+                path: self.1.clone(),
+                source,
+            })
     }
 }
 
@@ -478,15 +564,30 @@ pub fn run_campaign(campaign: &Campaign, opts: &RunOptions<'_>) -> Result<Outcom
     let dir = &opts.out;
     for sub in ["failures", "maps"] {
         let p = dir.join(sub);
-        std::fs::create_dir_all(&p).map_err(|source| Error::Io { what: "creating the campaign directory", path: p, source })?;
+        std::fs::create_dir_all(&p).map_err(|source| Error::Io {
+            what: "creating the campaign directory",
+            path: p,
+            source,
+        })?;
     }
     claim(campaign, dir)?;
     let mut records = read_results(dir)?;
     let total = total_runs(campaign, opts.runs);
     let path = dir.join("results.jsonl");
-    let file = std::fs::OpenOptions::new().create(true).append(true).open(&path).map_err(|source| Error::Io { what: "opening the results", path: path.clone(), source })?;
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&path)
+        .map_err(|source| Error::Io {
+            what: "opening the results",
+            path: path.clone(),
+            source,
+        })?;
     let out = Appender(Mutex::new(file), path.clone());
-    let maps = MapCache { dir: dir.join("maps"), entries: Mutex::default() };
+    let maps = MapCache {
+        dir: dir.join("maps"),
+        entries: Mutex::default(),
+    };
     // The falsifier runs generation by generation; the others all at once.
     let step = match campaign.sampler {
         SamplerKind::Falsify => campaign.falsify.batch * campaign.settings.len() as u64,
@@ -497,7 +598,10 @@ pub fn run_campaign(campaign: &Campaign, opts: &RunOptions<'_>) -> Result<Outcom
     while start < total && !opts.stop.load(Ordering::Relaxed) {
         let end = (start + step).min(total);
         let have: std::collections::HashSet<u64> = records.iter().map(|r| r.index).collect();
-        let todo: Vec<Variant> = (start..end).filter(|i| !have.contains(i)).map(|i| variant(campaign, i, &records)).collect();
+        let todo: Vec<Variant> = (start..end)
+            .filter(|i| !have.contains(i))
+            .map(|i| variant(campaign, i, &records))
+            .collect();
         let fresh = run_parallel(&todo, opts.jobs.max(1), opts.stop, &|v, pool| {
             let rec = run_variant(campaign, v, &maps, dir, opts.stop, pool)?;
             if let Some(r) = &rec {
@@ -513,8 +617,16 @@ pub fn run_campaign(campaign: &Campaign, opts: &RunOptions<'_>) -> Result<Outcom
     }
     let interrupted = opts.stop.load(Ordering::Relaxed);
     // Sorted by index: the file is the same whatever --jobs (wall times aside).
-    let text: String = records.iter().map(|r| serde_json::to_string(r).map(|l| l + "\n")).collect::<std::result::Result<_, _>>()?;
+    let text: String = records
+        .iter()
+        .map(|r| serde_json::to_string(r).map(|l| l + "\n"))
+        .collect::<std::result::Result<_, _>>()?;
     mapper::write_atomically(&path, text.as_bytes())?;
     super::summary::write(dir, &records)?;
-    Ok(Outcome { records, ran, total, interrupted })
+    Ok(Outcome {
+        records,
+        ran,
+        total,
+        interrupted,
+    })
 }

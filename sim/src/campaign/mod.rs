@@ -9,6 +9,7 @@
 //! distributions into a plain scenario text ([`Campaign::variant`]) that `taxi-sim run` runs
 //! alone. [`execute`] runs them in parallel into `results.jsonl`; [`summary`] reads that back.
 
+pub mod bench;
 pub mod dist;
 pub mod execute;
 pub mod sampler;
@@ -148,7 +149,13 @@ pub struct Variant {
 }
 
 /// An error at the span of a campaign file.
-fn at(file: &str, text: &str, span: std::ops::Range<usize>, field: &str, m: String) -> ScenarioError {
+fn at(
+    file: &str,
+    text: &str,
+    span: std::ops::Range<usize>,
+    field: &str,
+    m: String,
+) -> ScenarioError {
     ScenarioError::at(file, text, span, field, m)
 }
 
@@ -173,25 +180,51 @@ impl Campaign {
             .unwrap_or_else(|| Path::new(""))
             .join(spec.base.get_ref());
         let base_text = std::fs::read_to_string(&base_path).map_err(|e| {
-            at(&file, text, spec.base.span(), "base", format!("cannot read {}: {e}", base_path.display()))
+            at(
+                &file,
+                text,
+                spec.base.span(),
+                "base",
+                format!("cannot read {}: {e}", base_path.display()),
+            )
         })?;
         let base = Scenario::from_str(&base_text, &base_path)?;
         let base_doc: Table = toml::from_str(&base_text)
             .map_err(|e| ScenarioError::toml(&base_path.display().to_string(), &base_text, &e))?;
         if *spec.runs.get_ref() == 0 {
-            return Err(at(&file, text, spec.runs.span(), "runs", "must be at least 1".into()).into());
+            return Err(at(
+                &file,
+                text,
+                spec.runs.span(),
+                "runs",
+                "must be at least 1".into(),
+            )
+            .into());
         }
         let grid_steps = spec.grid_steps.as_ref().map_or(3, |g| *g.get_ref());
         if let Some(g) = &spec.grid_steps
             && *g.get_ref() == 0
         {
-            return Err(at(&file, text, g.span(), "grid_steps", "must be at least 1".into()).into());
+            return Err(at(
+                &file,
+                text,
+                g.span(),
+                "grid_steps",
+                "must be at least 1".into(),
+            )
+            .into());
         }
         let f = &spec.falsify;
-        if f.batch == 0 || !(f.elite_fraction > 0.0 && f.elite_fraction <= 1.0) || !(0.0..=1.0).contains(&f.smoothing) {
+        if f.batch == 0
+            || !(f.elite_fraction > 0.0 && f.elite_fraction <= 1.0)
+            || !(0.0..=1.0).contains(&f.smoothing)
+        {
             return Err(crate::Error::Config {
                 origin: format!("{file}: [falsify]"),
-                message: format!("batch = {} must be >= 1, elite_fraction = {} in (0, 1], smoothing = {} in [0, 1]", f.batch, f.elite_fraction, f.smoothing),
+                message: format!(
+                    "batch = {} must be >= 1, elite_fraction = {} in (0, 1], smoothing = {} in [0, 1]",
+                    f.batch, f.elite_fraction, f.smoothing
+                ),
             });
         }
         let mut layout = Layout::default();
@@ -214,14 +247,17 @@ impl Campaign {
                 return Err(e(o.span(), &field, m.into()));
             };
             let node = layout
-                .compile(&format!("obstacles.{id}"), &Value::Table(o.get_ref().clone()))
+                .compile(
+                    &format!("obstacles.{id}"),
+                    &Value::Table(o.get_ref().clone()),
+                )
                 .map_err(|m| e(o.span(), &field, m))?;
             obstacles.push(node);
         }
         let pool = match &spec.pool {
-            Some(p) => Some(
-                compile_pool(&mut layout, p.get_ref()).map_err(|m| e(p.span(), "pool", m))?,
-            ),
+            Some(p) => {
+                Some(compile_pool(&mut layout, p.get_ref()).map_err(|m| e(p.span(), "pool", m))?)
+            }
             None => None,
         };
         let (settings, span) = match &spec.parameters {
@@ -259,8 +295,19 @@ impl Campaign {
         };
         // Variant 0 must be a valid scenario: a mistake shows now, not after the first run.
         let v = campaign.variant_at(0, &vec![0.5; campaign.layout.dims.len()]);
-        Scenario::from_str(&v.text, &campaign.variant_path(0)).map_err(|e| crate::Error::Invalid(format!("{file}: variant 0 is not a valid scenario: {e}")))?;
+        Scenario::from_str(&v.text, &campaign.variant_path(0)).map_err(|e| {
+            crate::Error::Invalid(format!("{file}: variant 0 is not a valid scenario: {e}"))
+        })?;
         Ok(campaign)
+    }
+
+    /// Samples the same family another way (the digest follows: results of the two samplers
+    /// never share a directory).
+    pub fn set_sampler(&mut self, kind: SamplerKind) {
+        if kind != self.sampler {
+            self.sampler = kind;
+            self.digest = format!("{}-{}", self.digest, kind.as_str());
+        }
     }
 
     /// The base scenario.
@@ -299,10 +346,18 @@ impl Campaign {
             }
         }
         if let Some((count, _, slots)) = &self.pool {
-            let n = count.sample(u, &self.layout, &mut drawn).as_integer().unwrap_or(0).max(0) as usize;
+            let n = count
+                .sample(u, &self.layout, &mut drawn)
+                .as_integer()
+                .unwrap_or(0)
+                .max(0) as usize;
             for (k, slot) in slots.iter().take(n).enumerate() {
                 if let Value::Table(mut o) = slot.sample(u, &self.layout, &mut drawn) {
-                    let id = o.get("id").and_then(Value::as_str).unwrap_or("pool").to_string();
+                    let id = o
+                        .get("id")
+                        .and_then(Value::as_str)
+                        .unwrap_or("pool")
+                        .to_string();
                     o.insert("id".into(), Value::String(format!("{id}_{}", k + 1)));
                     added.push(o);
                 }
@@ -311,21 +366,40 @@ impl Campaign {
         for o in added {
             put_obstacle(&mut doc, o, &route);
         }
-        absolutize(&mut doc, self.base.path.parent().unwrap_or_else(|| Path::new("")));
+        absolutize(
+            &mut doc,
+            self.base.path.parent().unwrap_or_else(|| Path::new("")),
+        );
         let setting_table = self.settings[setting].clone();
         if !setting_table.is_empty() {
-            let config = doc.entry("config").or_insert_with(|| Value::Table(Table::new()));
+            let config = doc
+                .entry("config")
+                .or_insert_with(|| Value::Table(Table::new()));
             if let Value::Table(c) = config {
                 for (path, v) in setting_table {
                     set_path(c, &path, v);
                 }
             }
         }
-        let text = self.header(index, sample, setting, &drawn) + &toml::to_string(&doc).unwrap_or_default();
-        Variant { index, sample, setting, u: u.to_vec(), drawn, text }
+        let text = self.header(index, sample, setting, &drawn)
+            + &toml::to_string(&doc).unwrap_or_default();
+        Variant {
+            index,
+            sample,
+            setting,
+            u: u.to_vec(),
+            drawn,
+            text,
+        }
     }
 
-    fn header(&self, index: u64, sample: u64, setting: usize, drawn: &BTreeMap<String, Value>) -> String {
+    fn header(
+        &self,
+        index: u64,
+        sample: u64,
+        setting: usize,
+        drawn: &BTreeMap<String, Value>,
+    ) -> String {
         let mut h = format!(
             "# Variant {index} (sample {sample}, setting {setting}) of campaign \"{}\" ({}), seed {}.\n# Run it alone: taxi-sim run <this file>\n",
             self.name,
@@ -352,9 +426,15 @@ fn compile_pool(layout: &mut Layout, p: &PoolSpec) -> Result<(Node, usize, Vec<N
         _ => return Err("count: an integer >= 0 or { int = [lo, hi] } with lo >= 0".into()),
     };
     if p.obstacles.is_empty() || max > 100 {
-        return Err("needs at least one template in [[pool.obstacles]] and a count of at most 100".into());
+        return Err(
+            "needs at least one template in [[pool.obstacles]] and a count of at most 100".into(),
+        );
     }
-    if let Some(i) = p.obstacles.iter().position(|o| o.get("id").and_then(Value::as_str).is_none()) {
+    if let Some(i) = p
+        .obstacles
+        .iter()
+        .position(|o| o.get("id").and_then(Value::as_str).is_none())
+    {
         return Err(format!("obstacles[{i}]: a template needs an `id`"));
     }
     let templates = Value::Array(p.obstacles.iter().cloned().map(Value::Table).collect());
@@ -412,7 +492,9 @@ pub fn set_path(doc: &mut Table, path: &str, value: Value) {
     };
     match rest {
         Some(rest) => {
-            let entry = doc.entry(head).or_insert_with(|| Value::Table(Table::new()));
+            let entry = doc
+                .entry(head)
+                .or_insert_with(|| Value::Table(Table::new()));
             if !entry.is_table() {
                 *entry = Value::Table(Table::new());
             }
@@ -446,15 +528,25 @@ fn put_obstacle(doc: &mut Table, mut o: Table, route: &RoutePath) {
             o.insert(k, v);
         }
     }
-    let num = |v: Option<Value>| v.and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)));
+    let num = |v: Option<Value>| {
+        v.and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
+    };
     if let Some(s) = num(o.remove("along_m")) {
         let d = num(o.remove("offset_m")).unwrap_or(0.0);
         let (p, heading) = route.at(s);
         let left = nalgebra::Vector2::new(-heading.sin(), heading.cos());
         let at = |d: f64| p + left * d;
         if let Some(Value::Array(c)) = o.remove("crossing_m") {
-            let (a, b) = (num(c.first().cloned()).unwrap_or(-5.0), num(c.get(1).cloned()).unwrap_or(5.0));
-            let path = [at(d + a), at(d + b)].map(|q| Value::Array(vec![Value::Float(round_mm(q.x)), Value::Float(round_mm(q.y))]));
+            let (a, b) = (
+                num(c.first().cloned()).unwrap_or(-5.0),
+                num(c.get(1).cloned()).unwrap_or(5.0),
+            );
+            let path = [at(d + a), at(d + b)].map(|q| {
+                Value::Array(vec![
+                    Value::Float(round_mm(q.x)),
+                    Value::Float(round_mm(q.y)),
+                ])
+            });
             o.insert("path_m".into(), Value::Array(path.to_vec()));
             o.remove("x_m");
             o.remove("y_m");
@@ -466,8 +558,14 @@ fn put_obstacle(doc: &mut Table, mut o: Table, route: &RoutePath) {
             o.insert("yaw_rad".into(), Value::Float(round_mm(heading + yaw)));
         }
     }
-    let id = o.get("id").and_then(Value::as_str).unwrap_or_default().to_string();
-    let list = doc.entry("obstacles").or_insert_with(|| Value::Array(Vec::new()));
+    let id = o
+        .get("id")
+        .and_then(Value::as_str)
+        .unwrap_or_default()
+        .to_string();
+    let list = doc
+        .entry("obstacles")
+        .or_insert_with(|| Value::Array(Vec::new()));
     let Value::Array(list) = list else { return };
     let existing = list.iter_mut().find_map(|v| match v {
         Value::Table(t) if t.get("id").and_then(Value::as_str) == Some(id.as_str()) => Some(t),

@@ -7,8 +7,8 @@
 //! a pure function of (campaign seed, sample index, and for `falsify` the scores of the earlier
 //! generations).
 
-use rand::{RngExt as _, SeedableRng as _};
 use rand::rngs::StdRng;
+use rand::{RngExt as _, SeedableRng as _};
 use serde::{Deserialize, Serialize};
 
 use super::dist::{Continuous, Dimension};
@@ -256,10 +256,20 @@ mod tests {
         let elites: Vec<Vec<f64>> = (0..10).map(|i| vec![0.9 + 0.005 * i as f64, 0.1]).collect();
         let refs: Vec<&[f64]> = elites.iter().map(Vec::as_slice).collect();
         let p1 = refit(&p0, &refs, 0.7);
-        let Proposal::Continuous(Some((m, s))) = p1[0] else { panic!() };
-        assert!((m - (0.7 * 0.9225 + 0.3 * 0.5)).abs() < 1e-9 && s >= MIN_SD, "{m} {s}");
-        let Proposal::Discrete(w) = &p1[1] else { panic!() };
-        assert!(w[0] > 0.7 && w[1..].iter().all(|&x| x >= MIN_WEIGHT / 1.1), "{w:?}");
+        let Proposal::Continuous(Some((m, s))) = p1[0] else {
+            panic!()
+        };
+        assert!(
+            (m - (0.7 * 0.9225 + 0.3 * 0.5)).abs() < 1e-9 && s >= MIN_SD,
+            "{m} {s}"
+        );
+        let Proposal::Discrete(w) = &p1[1] else {
+            panic!()
+        };
+        assert!(
+            w[0] > 0.7 && w[1..].iter().all(|&x| x >= MIN_WEIGHT / 1.1),
+            "{w:?}"
+        );
         // Draws follow: most land near the elites.
         let near = (0..200)
             .filter(|&i| {

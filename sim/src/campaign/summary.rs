@@ -41,7 +41,10 @@ pub fn setting_label(r: &RunRecord) -> String {
 
 /// The summary of `records` (sorted by index) with the directory's `campaign.json`.
 pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
-    let get = |k: &str| meta.get(k).map_or("?".into(), |v| v.to_string().trim_matches('"').to_string());
+    let get = |k: &str| {
+        meta.get(k)
+            .map_or("?".into(), |v| v.to_string().trim_matches('"').to_string())
+    };
     let mut s = format!(
         "# Campaign: {}\n\nFile `{}`, sampler `{}`, seed {}: {} runs recorded.\n\n",
         get("name"),
@@ -68,7 +71,10 @@ pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
     for rs in by_setting.values() {
         let mut clear: Vec<f64> = rs.iter().filter_map(|r| r.obstacle_clearance_m).collect();
         clear.sort_by(f64::total_cmp);
-        let mut laps: Vec<f64> = rs.iter().flat_map(|r| r.lap_times_s.iter().copied()).collect();
+        let mut laps: Vec<f64> = rs
+            .iter()
+            .flat_map(|r| r.lap_times_s.iter().copied())
+            .collect();
         laps.sort_by(f64::total_cmp);
         let _ = writeln!(
             s,
@@ -113,22 +119,34 @@ pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
         );
     }
     if failed.len() > MAX_ROWS {
-        let _ = writeln!(s, "\n... and {} more in `results.jsonl` (`failed: true`).", failed.len() - MAX_ROWS);
+        let _ = writeln!(
+            s,
+            "\n... and {} more in `results.jsonl` (`failed: true`).",
+            failed.len() - MAX_ROWS
+        );
     }
     s
 }
 
 /// The falsifier's generations: runs, failures and the lowest score of each.
 fn generations(meta: &serde_json::Value, records: &[RunRecord]) -> String {
-    let batch = meta.get("batch").and_then(|b| b.as_u64()).unwrap_or(1).max(1);
+    let batch = meta
+        .get("batch")
+        .and_then(|b| b.as_u64())
+        .unwrap_or(1)
+        .max(1);
     let mut by_gen: BTreeMap<u64, (usize, usize, f64)> = BTreeMap::new();
     for r in records {
-        let e = by_gen.entry(r.sample / batch).or_insert((0, 0, f64::INFINITY));
+        let e = by_gen
+            .entry(r.sample / batch)
+            .or_insert((0, 0, f64::INFINITY));
         e.0 += 1;
         e.1 += usize::from(r.failed);
         e.2 = e.2.min(r.score);
     }
-    let mut s = format!("\n## Search ({batch} samples a generation)\n\n| generation | runs | failures | lowest score |\n|---|---|---|---|\n");
+    let mut s = format!(
+        "\n## Search ({batch} samples a generation)\n\n| generation | runs | failures | lowest score |\n|---|---|---|---|\n"
+    );
     for (g, (n, f, low)) in by_gen {
         let _ = writeln!(s, "| {g} | {n} | {f} | {low:.2} |");
     }

@@ -36,6 +36,10 @@ pub struct CampaignRunArgs {
     /// Variants 0..N (default: the campaign's `runs`).
     #[arg(long)]
     pub runs: Option<u64>,
+    /// Sampler instead of the file's (`grid`, `random`, `halton`, `falsify`): the same family
+    /// searched another way (its results go to another directory).
+    #[arg(long)]
+    pub sampler: Option<String>,
 }
 
 /// Runs `taxi-sim campaign ...`; returns whether no run failed.
@@ -60,18 +64,26 @@ pub fn run(cmd: &CampaignCommand) -> anyhow::Result<bool> {
 fn run_args(args: &CampaignRunArgs) -> anyhow::Result<bool> {
     anyhow::ensure!(args.jobs != Some(0), "--jobs 0: at least one");
     anyhow::ensure!(args.runs != Some(0), "--runs 0: at least one");
-    let campaign = Campaign::from_file(&args.campaign)?;
+    let mut campaign = Campaign::from_file(&args.campaign)?;
+    if let Some(name) = &args.sampler {
+        let kind: sim::campaign::SamplerKind =
+            serde_json::from_value(serde_json::Value::String(name.clone())).map_err(|_| {
+                anyhow::anyhow!("--sampler {name}: expected grid, random, halton or falsify")
+            })?;
+        campaign.set_sampler(kind);
+    }
     let jobs = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let total = total_runs(&campaign, args.runs);
-    let before = read_results(&args.out)?.iter().filter(|r| r.index < total).count();
+    let before = read_results(&args.out)?
+        .iter()
+        .filter(|r| r.index < total)
+        .count();
     let bar = ProgressBar::new(total);
     bar.set_style(
-        ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} runs, {msg} [{elapsed} < {eta}]",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {msg} [{elapsed} < {eta}]")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar.set_position(before as u64);
     eprintln!(
