@@ -90,6 +90,10 @@ fn the_smoke_campaign_runs_every_variant_under_every_setting() {
             "{summary}"
         );
     }
+    // The chart: a point per run, and the two of the legend.
+    let svg = std::fs::read_to_string(dir.path().join("clearance.svg")).unwrap();
+    assert_eq!(svg.matches("<circle").count(), records.len() + 2);
+    assert!(summary.contains("(clearance.svg)"));
     // One map served all 20 runs: the static world never changed.
     assert_eq!(
         std::fs::read_dir(dir.path().join("maps")).unwrap().count(),

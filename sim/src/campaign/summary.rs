@@ -53,6 +53,7 @@ pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
         get("seed"),
         records.len()
     );
+    s += "![Smallest clearance to an obstacle per run, failures in red](clearance.svg)\n\n";
     let failed: Vec<&RunRecord> = records.iter().filter(|r| r.failed).collect();
     let first = failed.first().map(|r| r.index + 1);
     let _ = writeln!(
@@ -155,10 +156,65 @@ fn generations(meta: &serde_json::Value, records: &[RunRecord]) -> String {
 
 /// Writes `dir/summary.md` from `records`.
 pub fn write(dir: &Path, records: &[RunRecord]) -> Result<()> {
-    let meta = std::fs::read_to_string(dir.join("campaign.json"))
+    let meta: serde_json::Value = std::fs::read_to_string(dir.join("campaign.json"))
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok())
         .unwrap_or_default();
+    let name = meta
+        .get("name")
+        .and_then(|n| n.as_str())
+        .unwrap_or("campaign");
+    chart(dir, name, records)?;
     mapper::write_atomically(&dir.join("summary.md"), render(&meta, records).as_bytes())?;
     Ok(())
+}
+
+/// Writes `dir/clearance.svg`: each run's smallest clearance to a run-time obstacle against its
+/// index, failures in red - where a search converges, and how far the passing runs keep off.
+pub fn chart(dir: &Path, title: &str, records: &[RunRecord]) -> Result<()> {
+    use plotters::prelude::*;
+    let path = dir.join("clearance.svg");
+    let tmp = dir.join(".clearance.svg.partial");
+    let top = records
+        .iter()
+        .filter_map(|r| r.obstacle_clearance_m)
+        .fold(0.5_f64, f64::max)
+        .min(5.0);
+    let draw = || -> std::result::Result<(), Box<dyn std::error::Error>> {
+        let root = SVGBackend::new(&tmp, (900, 420)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..records.len().max(1) as f64, 0.0..top * 1.05)?;
+        chart
+            .configure_mesh()
+            .x_desc("run (index)")
+            .y_desc("smallest clearance to an obstacle, m")
+            .draw()?;
+        for (failed, colour, label) in [(false, BLUE, "passed"), (true, RED, "failed")] {
+            chart
+                .draw_series(records.iter().filter(|r| r.failed == failed).map(|r| {
+                    let y = r.obstacle_clearance_m.unwrap_or(top).clamp(0.0, top);
+                    Circle::new((r.index as f64, y), 2, colour.filled())
+                }))?
+                .label(label)
+                .legend(move |(x, y)| Circle::new((x, y), 3, colour.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE)
+            .draw()?;
+        root.present()?;
+        Ok(())
+    };
+    draw().map_err(|e| crate::Error::Invalid(format!("{}: drawing: {e}", path.display())))?;
+    std::fs::rename(&tmp, &path).map_err(|source| crate::Error::Io {
+        what: "moving the chart into place",
+        path,
+        source,
+    })
 }
