@@ -69,6 +69,9 @@ pub struct RunRecord {
     pub contacts: usize,
     /// The objects touched.
     pub contacts_with: Vec<String>,
+    /// Contacts that began while the vehicle stood still (something ran into it).
+    #[serde(default)]
+    pub contacts_while_stopped: usize,
     /// Per run-time obstacle.
     pub obstacles: Vec<ObstacleOutcome>,
     /// Smallest ground-truth clearance per level to any object, metres.
@@ -115,9 +118,18 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
     let mut failures = Vec::new();
     let mut contacts_with: Vec<String> = r.contacts.iter().map(|c| c.object.clone()).collect();
     contacts_with.dedup();
+    let standing = |t: f64| {
+        r.stops
+            .iter()
+            .any(|s| s.start_s <= t && s.end_s.is_none_or(|e| t <= e))
+    };
+    let mut contacts_while_stopped = 0;
     for c in &r.contacts {
+        let still = standing(c.time_s);
+        contacts_while_stopped += usize::from(still);
+        let how = if still { " (standing)" } else { "" };
         failures.push(format!(
-            "contact: {} with {} at {:.1} s",
+            "contact{how}: {} with {} at {:.1} s",
             c.part, c.object, c.time_s
         ));
     }
@@ -205,6 +217,7 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
         failures,
         contacts: r.contacts.len(),
         contacts_with,
+        contacts_while_stopped,
         obstacles,
         min_clearance_m: r.min_clearance_m.iter().copied().map(finite).collect(),
         obstacle_clearance_m: clearance,

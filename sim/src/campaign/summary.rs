@@ -64,7 +64,7 @@ pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
         1000.0 * failed.len() as f64 / records.len().max(1) as f64,
         first.map_or("none yet".into(), |n| n.to_string())
     );
-    s += "## Per parameter setting\n\n| setting | runs | failed | runs with contact | contacts | unmet expectations | false stops | needless deviations | obstacle clearance p0 / p5 / p50 (m) | lap time p50 / max (s) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    s += "## Per parameter setting\n\n| setting | runs | failed | runs with contact | contacts (standing) | unmet expectations | false stops | needless deviations | obstacle clearance p0 / p5 / p50 (m) | lap time p50 / max (s) |\n|---|---|---|---|---|---|---|---|---|---|\n";
     let mut by_setting: BTreeMap<usize, Vec<&RunRecord>> = BTreeMap::new();
     for r in records {
         by_setting.entry(r.setting).or_default().push(r);
@@ -77,9 +77,10 @@ pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
             .flat_map(|r| r.lap_times_s.iter().copied())
             .collect();
         laps.sort_by(f64::total_cmp);
+        let standing: usize = rs.iter().map(|r| r.contacts_while_stopped).sum();
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} / {} | {} / {} |",
+            "| {} | {} | {} | {} | {} ({standing}) | {} | {} | {} | {} / {} / {} | {} / {} |",
             setting_label(rs[0]),
             rs.len(),
             rs.iter().filter(|r| r.failed).count(),
