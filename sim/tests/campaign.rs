@@ -371,3 +371,42 @@ fn every_shipped_campaign_reads_and_its_first_variants_are_valid_scenarios() {
         ]
     );
 }
+
+/// A draw the scenario rules refuse (here a cone on the start pose) is recorded as `invalid`,
+/// left out of the statistics, and the campaign goes on; the grid visits both choices.
+#[test]
+fn an_invalid_variant_is_recorded_and_the_campaign_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = smoke_path()
+        .parent()
+        .unwrap()
+        .join("../cone_in_path_car.toml");
+    let file = dir.path().join("c.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "name = \"x\"\nbase = {base:?}\nruns = 10\nsampler = \"grid\"\n\n[[obstacles]]\nid = \"cone_on_centreline\"\nalong_m = {{ choice = [0.0, 60.0] }}\n"
+        ),
+    )
+    .unwrap();
+    let records = run(
+        &Campaign::from_file(&file).unwrap(),
+        &dir.path().join("out"),
+        2,
+        None,
+    );
+    assert_eq!(records.len(), 2, "the grid has two points");
+    assert_eq!(records[0].end, "invalid");
+    assert!(
+        !records[0].failed && records[0].failures[0].contains("overlap"),
+        "{:?}",
+        records[0]
+    );
+    assert_eq!(records[1].end, "completed");
+    let summary = std::fs::read_to_string(dir.path().join("out/summary.md")).unwrap();
+    assert!(
+        summary.contains("1 variants were not valid scenarios"),
+        "{summary}"
+    );
+    assert!(summary.contains("| base | 1 |"), "{summary}");
+}

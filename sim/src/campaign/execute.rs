@@ -448,7 +448,12 @@ fn run_variant(
     stop: &AtomicBool,
     pool: &rayon::ThreadPool,
 ) -> Result<Option<RunRecord>> {
-    let scenario = Scenario::from_str(&v.text, &campaign.variant_path(v.index))?;
+    let scenario = match Scenario::from_str(&v.text, &campaign.variant_path(v.index)) {
+        Ok(s) => s,
+        // A draw the scenario rules refuse (an obstacle over the start pose...): recorded,
+        // kept out of the statistics, and the campaign goes on.
+        Err(e) => return Ok(Some(invalid(campaign, v, &e.to_string()))),
+    };
     let config = campaign.config(v.setting)?;
     let map_dir = maps.get(&v.text, &scenario, &config)?;
     let setup = RunSetup {
@@ -475,6 +480,46 @@ fn run_variant(
     }
     Ok(Some(rec))
 }
+
+/// The record of a variant that is not a valid scenario: `end` is `invalid`, the reason in
+/// `failures`; not a failure, and scored as a clear run so the falsifier does not chase it.
+fn invalid(campaign: &Campaign, v: &Variant, why: &str) -> RunRecord {
+    let json = |x: &toml::Value| serde_json::to_value(x).unwrap_or(serde_json::Value::Null);
+    RunRecord {
+        index: v.index,
+        sample: v.sample,
+        setting: v.setting,
+        seed: 0,
+        sampled: v.drawn.iter().map(|(k, x)| (k.clone(), json(x))).collect(),
+        parameters: campaign.settings[v.setting]
+            .iter()
+            .map(|(k, x)| (k.clone(), json(x)))
+            .collect(),
+        u: v.u.clone(),
+        end: INVALID.into(),
+        expectations_met: false,
+        failed: false,
+        failures: vec![why.to_string()],
+        contacts: 0,
+        contacts_with: Vec::new(),
+        contacts_while_stopped: 0,
+        obstacles: Vec::new(),
+        min_clearance_m: Vec::new(),
+        obstacle_clearance_m: None,
+        stops: 0,
+        deviations: 0,
+        false_stops: 0,
+        needless_deviations: 0,
+        lap_times_s: Vec::new(),
+        sim_time_s: 0.0,
+        wall_time_s: 0.0,
+        score: 10.0,
+        failure_file: None,
+    }
+}
+
+/// The `end` of a variant that is not a valid scenario.
+pub const INVALID: &str = "invalid";
 
 /// Runs `each` over `todo` on `jobs` worker threads, each pulling the next variant; a worker
 /// runs a variant's stages on its own rayon pool of `jobs / todo` threads (one when there are

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::execute::RunRecord;
+use super::execute::{INVALID, RunRecord};
 use crate::error::Result;
 
 /// Failing variants listed in the error table (the rest are in `results.jsonl`).
@@ -54,6 +54,22 @@ pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
         records.len()
     );
     s += "![Smallest clearance to an obstacle per run, failures in red](clearance.svg)\n\n";
+    let invalid: Vec<&RunRecord> = records.iter().filter(|r| r.end == INVALID).collect();
+    if let Some(first) = invalid.first() {
+        let _ = writeln!(
+            s,
+            "{} variants were not valid scenarios and are left out below (the first, {}: {}).\n",
+            invalid.len(),
+            first.index,
+            first.failures.join("; ").lines().next().unwrap_or("")
+        );
+    }
+    let valid: Vec<RunRecord> = records
+        .iter()
+        .filter(|r| r.end != INVALID)
+        .cloned()
+        .collect();
+    let records = valid.as_slice();
     let failed: Vec<&RunRecord> = records.iter().filter(|r| r.failed).collect();
     let first = failed.first().map(|r| r.index + 1);
     let _ = writeln!(
