@@ -293,10 +293,13 @@ impl Campaign {
             obstacles,
             pool,
         };
-        // Variant 0 must be a valid scenario: a mistake shows now, not after the first run.
+        // The variant at the centre of every draw must be a valid scenario: a mistake in the
+        // file shows now, not after the first run.
         let v = campaign.variant_at(0, &vec![0.5; campaign.layout.dims.len()]);
         Scenario::from_str(&v.text, &campaign.variant_path(0)).map_err(|e| {
-            crate::Error::Invalid(format!("{file}: variant 0 is not a valid scenario: {e}"))
+            crate::Error::Invalid(format!(
+                "{file}: the variant at the centre of the draws is not a valid scenario: {e}"
+            ))
         })?;
         Ok(campaign)
     }
@@ -366,6 +369,17 @@ impl Campaign {
         for o in added {
             put_obstacle(&mut doc, o, &route);
         }
+        doc.insert(
+            "name".into(),
+            Value::String(format!("{} - variant {index}", self.name)),
+        );
+        doc.insert(
+            "description".into(),
+            Value::String(format!(
+                "Variant {index} of the campaign {:?} (base: {:?}).",
+                self.name, self.base.name
+            )),
+        );
         absolutize(
             &mut doc,
             self.base.path.parent().unwrap_or_else(|| Path::new("")),
