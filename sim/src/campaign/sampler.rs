@@ -1,8 +1,8 @@
 //! Samplers: which point of the unit cube each sample is drawn at. `grid` (every combination of
 //! levels), `random` (independent uniform draws), `halton` (a low-discrepancy sequence with a
 //! seeded shift) and `falsify`, a cross-entropy search: samples come in generations, the first
-//! uniform, each next one drawn from per-dimension distributions (a truncated normal on [0, 1]
-//! for a continuous variation, category weights for a discrete one) fitted to the lowest-scoring
+//! uniform, each next one drawn from per-dimension bin weights (ten bins of [0, 1) for a
+//! continuous variation, a bin per category for a discrete one) fitted to the lowest-scoring
 //! runs so far - toward the smallest clearance, contacts and unmet expectations. Every point is
 //! a pure function of (campaign seed, sample index, and for `falsify` the scores of the earlier
 //! generations).
@@ -11,7 +11,7 @@ use rand::rngs::StdRng;
 use rand::{RngExt as _, SeedableRng as _};
 use serde::{Deserialize, Serialize};
 
-use super::dist::{Continuous, Dimension};
+use super::dist::Dimension;
 
 /// How samples are chosen.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -115,32 +115,36 @@ pub fn halton_point(dims: usize, seed: u64, sample: u64) -> Vec<f64> {
         .collect()
 }
 
-/// The search distribution of one dimension.
+/// The search distribution of one dimension: weights of equal bins of [0, 1) (a discrete
+/// variation's categories when it has at most [`MAX_BINS`], else [`BINS`] bins), drawn
+/// uniformly within the bin. Bins, not a normal: what fails is often in two places at once
+/// (debris under the left or the right wheels, not between them), which one bell cannot hold.
 #[derive(Clone, Debug, PartialEq)]
-pub enum Proposal {
-    /// A normal truncated to [0, 1]; `None`: uniform (the first generation).
-    Continuous(Option<(f64, f64)>),
-    /// Category weights (summing to 1).
-    Discrete(Vec<f64>),
-}
+pub struct Proposal(pub Vec<f64>);
 
-/// Smallest standard deviation of a continuous proposal, on [0, 1].
-const MIN_SD: f64 = 0.03;
-/// Smallest weight of a category: no category is ever ruled out.
+/// Bins of a continuous variation.
+pub const BINS: usize = 10;
+/// Most categories given a bin each.
+pub const MAX_BINS: usize = 20;
+/// Smallest weight of a bin, before normalising: no part of a variation is ever ruled out.
 const MIN_WEIGHT: f64 = 0.02;
+
+fn bins_of(d: &Dimension) -> usize {
+    match d.categories {
+        Some(c) if c <= MAX_BINS => c,
+        _ => BINS,
+    }
+}
 
 /// The first generation's proposals: uniform.
 pub fn initial(dims: &[Dimension]) -> Vec<Proposal> {
     dims.iter()
-        .map(|d| match d.categories {
-            Some(c) => Proposal::Discrete(vec![1.0 / c as f64; c]),
-            None => Proposal::Continuous(None),
-        })
+        .map(|d| Proposal(vec![1.0 / bins_of(d) as f64; bins_of(d)]))
         .collect()
 }
 
-/// The next proposals: each dimension fitted to the elite points, blended with the previous by
-/// `smoothing` (the new fit's weight).
+/// The next proposals: each dimension's bin weights fitted to the elite points, blended with
+/// the previous by `smoothing` (the new fit's weight), floored, normalised.
 pub fn refit(previous: &[Proposal], elites: &[&[f64]], smoothing: f64) -> Vec<Proposal> {
     if elites.is_empty() {
         return previous.to_vec();
@@ -149,29 +153,19 @@ pub fn refit(previous: &[Proposal], elites: &[&[f64]], smoothing: f64) -> Vec<Pr
     previous
         .iter()
         .enumerate()
-        .map(|(d, p)| match p {
-            Proposal::Continuous(old) => {
-                let mean = elites.iter().map(|u| u[d]).sum::<f64>() / n;
-                let var = elites.iter().map(|u| (u[d] - mean).powi(2)).sum::<f64>() / n;
-                let (m0, s0) = old.unwrap_or((0.5, 1.0 / 12f64.sqrt()));
-                let m = smoothing * mean + (1.0 - smoothing) * m0;
-                let s = smoothing * var.sqrt() + (1.0 - smoothing) * s0;
-                Proposal::Continuous(Some((m, s.max(MIN_SD))))
+        .map(|(d, Proposal(w))| {
+            let k = w.len();
+            let mut counts = vec![0.0; k];
+            for u in elites {
+                counts[((u[d] * k as f64).floor() as usize).min(k - 1)] += 1.0;
             }
-            Proposal::Discrete(w) => {
-                let k = w.len();
-                let mut counts = vec![0.0; k];
-                for u in elites {
-                    counts[((u[d] * k as f64).floor() as usize).min(k - 1)] += 1.0;
-                }
-                let blended: Vec<f64> = w
-                    .iter()
-                    .zip(&counts)
-                    .map(|(w, c)| (smoothing * c / n + (1.0 - smoothing) * w).max(MIN_WEIGHT))
-                    .collect();
-                let total: f64 = blended.iter().sum();
-                Proposal::Discrete(blended.iter().map(|w| w / total).collect())
-            }
+            let blended: Vec<f64> = w
+                .iter()
+                .zip(&counts)
+                .map(|(w, c)| (smoothing * c / n + (1.0 - smoothing) * w).max(MIN_WEIGHT))
+                .collect();
+            let total: f64 = blended.iter().sum();
+            Proposal(blended.iter().map(|w| w / total).collect())
         })
         .collect()
 }
@@ -181,31 +175,17 @@ pub fn propose(proposals: &[Proposal], seed: u64, sample: u64) -> Vec<f64> {
     let mut rng = rng_of(seed, sample);
     proposals
         .iter()
-        .map(|p| {
+        .map(|Proposal(w)| {
             let (a, b): (f64, f64) = (rng.random(), rng.random());
-            match p {
-                Proposal::Continuous(None) => a,
-                Proposal::Continuous(Some((mean, sd))) => {
-                    let dist = Continuous::Normal {
-                        mean: mean.clamp(0.0, 1.0),
-                        sd: *sd,
-                        min: 0.0,
-                        max: 1.0,
-                    };
-                    dist.at(a).min(1.0 - 1e-12)
-                }
-                Proposal::Discrete(w) => {
-                    let mut acc = 0.0;
-                    let k = w
-                        .iter()
-                        .position(|w| {
-                            acc += w;
-                            a < acc
-                        })
-                        .unwrap_or(w.len() - 1);
-                    (k as f64 + b) / w.len() as f64
-                }
-            }
+            let mut acc = 0.0;
+            let k = w
+                .iter()
+                .position(|w| {
+                    acc += w;
+                    a < acc
+                })
+                .unwrap_or(w.len() - 1);
+            ((k as f64 + b) / w.len() as f64).min(1.0 - 1e-12)
         })
         .collect()
 }
@@ -250,33 +230,32 @@ mod tests {
     }
 
     #[test]
-    fn refit_moves_toward_the_elites() {
+    fn refit_moves_toward_the_elites_in_two_places_at_once() {
         let d = dims(&[None, Some(4)]);
         let p0 = initial(&d);
-        let elites: Vec<Vec<f64>> = (0..10).map(|i| vec![0.9 + 0.005 * i as f64, 0.1]).collect();
+        assert_eq!(p0[0].0.len(), BINS);
+        // Elites in two places of the first dimension (bins 1 and 8), one category of the second.
+        let elites: Vec<Vec<f64>> = (0..10)
+            .map(|i| vec![if i % 2 == 0 { 0.15 } else { 0.85 }, 0.1])
+            .collect();
         let refs: Vec<&[f64]> = elites.iter().map(Vec::as_slice).collect();
         let p1 = refit(&p0, &refs, 0.7);
-        let Proposal::Continuous(Some((m, s))) = p1[0] else {
-            panic!()
-        };
+        let w = &p1[0].0;
+        let expected = (0.7 * 0.5 + 0.3 * 0.1) / (2.0 * 0.38 + 8.0 * 0.03);
         assert!(
-            (m - (0.7 * 0.9225 + 0.3 * 0.5)).abs() < 1e-9 && s >= MIN_SD,
-            "{m} {s}"
-        );
-        let Proposal::Discrete(w) = &p1[1] else {
-            panic!()
-        };
-        assert!(
-            w[0] > 0.7 && w[1..].iter().all(|&x| x >= MIN_WEIGHT / 1.1),
+            (w[1] - expected).abs() < 1e-9 && (w[8] - expected).abs() < 1e-9,
             "{w:?}"
         );
-        // Draws follow: most land near the elites.
-        let near = (0..200)
-            .filter(|&i| {
-                let u = propose(&p1, 3, i);
-                u[1] < 0.25 && u[0] > 0.5
-            })
+        assert!(w[4] < 0.05, "{w:?}");
+        let c = &p1[1].0;
+        assert!(c[0] > 0.7 && c[1..].iter().all(|&x| x > 0.0), "{c:?}");
+        // Draws follow: most land in one of the two places, few between.
+        let u: Vec<f64> = (0..400).map(|i| propose(&p1, 3, i)[0]).collect();
+        let near = u
+            .iter()
+            .filter(|&&x| (0.1..0.2).contains(&x) || (0.8..0.9).contains(&x))
             .count();
-        assert!(near > 120, "{near} of 200");
+        let between = u.iter().filter(|&&x| (0.4..0.6).contains(&x)).count();
+        assert!(near > 280 && between < 40, "{near} near, {between} between");
     }
 }
