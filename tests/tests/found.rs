@@ -60,3 +60,41 @@ fn fixme_the_car_stops_short_of_low_debris_and_calls_a_pilot() {
     assert_eq!(pass.outcome, sim::judge::PassOutcome::Stopped);
     assert!((0.1..0.2).contains(&pass.min_clearance_m[0]), "{pass:?}");
 }
+
+/// FIXME (README, Known problems): in about one in two hundred passes of the parking-lot
+/// campaign the car goes round a cone under its wing's path that it should pass under; here a
+/// 0.48 m cone 1.69 m right of the route (the wing is at 0.70 m) on the first aisle. Found by
+/// the parking-lot campaign (variant 487); not yet explained.
+#[test]
+fn fixme_the_car_goes_round_a_cone_it_should_pass_under() {
+    let r = run_found(&found("parking_lot_variant_487"));
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
+    let cone = r.obstacles.iter().find(|o| o.id == "cone_wing_1").unwrap();
+    assert_eq!(cone.passes[0].outcome, sim::judge::PassOutcome::Deviated);
+    assert!(!cone.passes[0].met);
+    let others_met = r
+        .obstacles
+        .iter()
+        .filter(|o| o.id != "cone_wing_1")
+        .all(|o| o.passes.iter().all(|p| p.met));
+    assert!(others_met, "{:?}", r.obstacles);
+}
+
+/// FIXME (README, Known problems): the car goes round a 0.98 m container 0.11 m right of the
+/// route 0.19 m from it, inside the danger distance (0.2 m). Found by the parking-lot campaign
+/// (variant 505).
+#[test]
+fn fixme_the_car_passes_a_container_inside_the_danger_distance() {
+    let r = run_found(&found("parking_lot_variant_505"));
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
+    let o = r.obstacles.iter().find(|o| o.id == "cone_path_1").unwrap();
+    let p = &o.passes[0];
+    assert_eq!(p.outcome, sim::judge::PassOutcome::Deviated);
+    let closest = p
+        .min_clearance_m
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    assert!((0.15..0.2).contains(&closest), "{p:?}");
+    assert!(!p.met);
+}
