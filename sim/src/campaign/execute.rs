@@ -113,6 +113,15 @@ fn worst(outcomes: impl Iterator<Item = PassOutcome>) -> Option<PassOutcome> {
     outcomes.max_by_key(rank)
 }
 
+/// Drawn or set values as JSON, by label.
+fn as_json<'a>(
+    pairs: impl Iterator<Item = (&'a String, &'a toml::Value)>,
+) -> BTreeMap<String, serde_json::Value> {
+    pairs
+        .map(|(k, x)| (k.clone(), serde_json::to_value(x).unwrap_or_default()))
+        .collect()
+}
+
 /// The record of a run of variant `v`.
 pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunReport) -> RunRecord {
     let mut failures = Vec::new();
@@ -199,17 +208,13 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
     let score = clearance.unwrap_or(10.0).min(10.0)
         - if failed { 1.0 } else { 0.0 }
         - r.contacts.len() as f64;
-    let json = |v: &toml::Value| serde_json::to_value(v).unwrap_or(serde_json::Value::Null);
     RunRecord {
         index: v.index,
         sample: v.sample,
         setting: v.setting,
         seed: scenario.seed,
-        sampled: v.drawn.iter().map(|(k, x)| (k.clone(), json(x))).collect(),
-        parameters: campaign.settings[v.setting]
-            .iter()
-            .map(|(k, x)| (k.clone(), json(x)))
-            .collect(),
+        sampled: as_json(v.drawn.iter()),
+        parameters: as_json(campaign.settings[v.setting].iter().map(|(k, x)| (k, x))),
         u: v.u.clone(),
         end,
         expectations_met: r.expectations_met,
@@ -484,17 +489,13 @@ fn run_variant(
 /// The record of a variant that is not a valid scenario: `end` is `invalid`, the reason in
 /// `failures`; not a failure, and scored as a clear run so the falsifier does not chase it.
 fn invalid(campaign: &Campaign, v: &Variant, why: &str) -> RunRecord {
-    let json = |x: &toml::Value| serde_json::to_value(x).unwrap_or(serde_json::Value::Null);
     RunRecord {
         index: v.index,
         sample: v.sample,
         setting: v.setting,
         seed: 0,
-        sampled: v.drawn.iter().map(|(k, x)| (k.clone(), json(x))).collect(),
-        parameters: campaign.settings[v.setting]
-            .iter()
-            .map(|(k, x)| (k.clone(), json(x)))
-            .collect(),
+        sampled: as_json(v.drawn.iter()),
+        parameters: as_json(campaign.settings[v.setting].iter().map(|(k, x)| (k, x))),
         u: v.u.clone(),
         end: INVALID.into(),
         expectations_met: false,
