@@ -10,10 +10,12 @@
 //! - [`urdf`]: URDF -> vehicle-frame [`Part`]s.   - [`spec`]: the sidecar.
 //! - [`fit`]: levels and circle covers.           - [`report`]: coverage / overshoot by sampling.
 //! - [`carmen`]: CARMEN collision files.          - [`svg`]: a picture per model.
+//! - [`exact`]: the exact reference (part footprints against the maps) a circle model is measured by.
 //! - [`vehicle`]: the shipped vehicles (`praetor600`, `iara_car`, `iara_car_fake_wing`).
 
 pub mod carmen;
 pub mod error;
+pub mod exact;
 pub mod fit;
 pub mod footprint;
 pub mod io;
