@@ -86,6 +86,23 @@ pub fn level_of(underside_m: f64, heights_m: &[f64]) -> usize {
         .unwrap_or(0)
 }
 
+/// Candidate heights of interest from a vehicle's geometry: the undersides of its parts off the
+/// ground (above `min_m`), each lowered by `margin_m` (a level must sit just under the parts it
+/// lets pass over an obstacle, as the thesis' 1.1 m under the Praetor's 1.2 m wing root) and
+/// rounded down to 5 cm; undersides that give the same candidate count once. Sorted, without 0.
+pub fn proposed_heights(parts: &[Part], min_m: f64, margin_m: f64) -> Vec<f64> {
+    let mut out: Vec<f64> = parts
+        .iter()
+        .map(Part::underside_m)
+        .filter(|u| *u > min_m)
+        .map(|u| ((u - margin_m) * 20.0 + 1e-9).floor() / 20.0)
+        .filter(|h| *h > 0.0)
+        .collect();
+    out.sort_by(f64::total_cmp);
+    out.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    out
+}
+
 /// Checks heights of interest: h_0 = 0, strictly increasing, finite.
 pub fn check_heights(heights_m: &[f64]) -> std::result::Result<(), String> {
     match heights_m.first() {

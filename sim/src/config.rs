@@ -80,6 +80,10 @@ pub struct MappingConfig {
     pub distance_map_half_size_m: Option<f64>,
     /// How live occupancy no longer seen fades to the offline map.
     pub forgetting: ForgettingConfig,
+    /// The heights of interest of the map's levels and of the circle model, metres (h_0 = 0,
+    /// increasing). Default `None`: the vehicle's (`heights_of_interest_m` in its sidecar). A
+    /// tuning sweep sets it; the offline map follows (its fingerprint holds the levels).
+    pub heights_of_interest_m: Option<Vec<f64>>,
 }
 
 /// Height above the ground from which a return is an obstacle whatever the consecutive-beam
@@ -110,6 +114,7 @@ impl Default for MappingConfig {
             },
             distance_map_half_size_m: None,
             forgetting: ForgettingConfig::default(),
+            heights_of_interest_m: None,
         }
     }
 }
@@ -274,6 +279,10 @@ impl RunConfig {
         if let Some(h) = self.mapping.distance_map_half_size_m {
             positive("mapping.distance_map_half_size_m", h)?;
         }
+        if let Some(h) = &self.mapping.heights_of_interest_m {
+            aircraft::fit::check_heights(h)
+                .map_err(|m| format!("mapping.heights_of_interest_m = {h:?}: {m}"))?;
+        }
         positive(
             "mapping.forgetting.time_constant_s",
             self.mapping.forgetting.time_constant_s,
@@ -315,11 +324,20 @@ impl RunConfig {
         Ok(())
     }
 
+    /// The heights of interest this configuration gives `vehicle`: its own unless
+    /// `mapping.heights_of_interest_m` says otherwise.
+    pub fn heights_of_interest_m<'a>(&'a self, vehicle: &'a aircraft::Vehicle) -> &'a [f64] {
+        self.mapping
+            .heights_of_interest_m
+            .as_deref()
+            .unwrap_or(&vehicle.spec.heights_of_interest_m)
+    }
+
     /// The circle model this configuration gives `vehicle`.
     pub fn collision_model(&self, vehicle: &aircraft::Vehicle) -> Result<CollisionModel, Error> {
-        let heights = &vehicle.spec.heights_of_interest_m;
+        let heights = &self.heights_of_interest_m(vehicle).to_vec();
         Ok(match &self.collision_model {
-            CollisionModelConfig::Vehicle => vehicle.fit()?.model,
+            CollisionModelConfig::Vehicle => vehicle.fit_with(heights, &vehicle.spec.fit)?.model,
             CollisionModelConfig::Fit { options } => vehicle.fit_with(heights, options)?.model,
             CollisionModelConfig::Circles { circles } => {
                 CollisionModel::new(circles.clone(), heights.clone()).map_err(|e| {
@@ -391,6 +409,14 @@ mod tests {
                 "pose_source.white_sigma_m",
             ),
             ("[autonomy]\nstep_m = 0.0\n", "autonomy.step_m"),
+            (
+                "[mapping]\nheights_of_interest_m = [0.5, 1.0]\n",
+                "mapping.heights_of_interest_m",
+            ),
+            (
+                "[mapping]\nheights_of_interest_m = [0.0, 1.0, 1.0]\n",
+                "mapping.heights_of_interest_m",
+            ),
         ] {
             let e = RunConfig::from_toml(text, "f.toml")
                 .unwrap_err()

@@ -38,6 +38,7 @@ pub mod scenario;
 pub mod scene;
 pub mod schedule;
 pub mod small_obstacles;
+pub mod tune;
 pub mod world;
 
 pub use error::{Error, Result};

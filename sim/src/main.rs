@@ -87,12 +87,18 @@ enum Command {
     /// Campaigns: scenario families sampled, run in parallel, searched for failures.
     #[command(subcommand)]
     Campaign(cli::campaign::CampaignCommand),
+    /// Tune the collision model: run a campaign whose parameters are model settings, then
+    /// compare them (Pareto front, exact reference, recommended model, pictures).
+    /// Exit code 0 when a setting had no unsafe run, 1 when none did, 2 on bad input.
+    Tune(cli::tune::TuneArgs),
 }
 
 #[derive(Subcommand)]
 enum ModelCommand {
     /// Fit a vehicle's height-tagged circle model and print coverage per level.
     Fit(cli::model::ModelFitArgs),
+    /// Print every part's underside and the candidate heights of interest they give.
+    Levels(cli::model::ModelLevelsArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -151,6 +157,13 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 ExitCode::from(1)
             }
         }),
+        Command::Tune(args) => cli::tune::run(&args).map(|ok| {
+            if ok {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }),
         other => run_unit(other).map(|()| ExitCode::SUCCESS),
     }
 }
@@ -180,10 +193,13 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
             bench(what, json, samples, (&scenario, laps), &campaign)
         }
         Command::Model(ModelCommand::Fit(args)) => cli::model::run(&args),
+        Command::Model(ModelCommand::Levels(args)) => cli::model::levels(&args),
         Command::SmallObstacles(args) => cli::small::run(&args),
         Command::Check(args) => cli::check::run(&args),
         Command::Map(args) => cli::run::map(&args),
-        Command::Run(_) | Command::Campaign(_) => unreachable!("dispatched in run"),
+        Command::Run(_) | Command::Campaign(_) | Command::Tune(_) => {
+            unreachable!("dispatched in run")
+        }
         Command::Scan(args) => cli::scan::run(&args),
         Command::Config => emit(&sim::config::RunConfig::default().to_toml()),
     }

@@ -56,7 +56,7 @@ pub fn fingerprint(scenario: &Scenario, config: &RunConfig) -> Result<String> {
         source,
     })?);
     h.update(format!("{:?}", scenario.vehicle.vehicle).as_bytes());
-    h.update(format!("{:?}", levels_of(scenario)?).as_bytes());
+    h.update(format!("{:?}", levels_of(scenario, config)?).as_bytes());
     h.update(format!("{:?}{:?}{MAP_FORMAT}", map_config(config), config.lidar).as_bytes());
     Ok(format!("{:08x}", h.finalize()))
 }
@@ -154,12 +154,13 @@ pub fn self_filter_model(vehicle: &aircraft::Vehicle) -> Result<mapper::Collisio
         .model)
 }
 
-/// The levels a scenario's vehicle asks for: its heights of interest, cumulative, under its
-/// ceiling (`aircraft::Vehicle::ceiling_m`: its top plus its overhead clearance).
-pub fn levels_of(scenario: &Scenario) -> Result<Levels> {
+/// The levels a scenario's vehicle asks for under `config`: its heights of interest (or the
+/// configuration's), cumulative, under its ceiling (`aircraft::Vehicle::ceiling_m`: its top plus
+/// its overhead clearance).
+pub fn levels_of(scenario: &Scenario, config: &RunConfig) -> Result<Levels> {
     let vehicle = &scenario.vehicle.vehicle;
     Ok(Levels::new(
-        vehicle.spec.heights_of_interest_m.clone(),
+        config.heights_of_interest_m(vehicle).to_vec(),
         mapper::LevelMode::Cumulative,
         Some(vehicle.ceiling_m()),
     )?)
@@ -175,7 +176,7 @@ pub fn map_drive(
 ) -> Result<MapManifest> {
     let vehicle = &scenario.vehicle.vehicle;
     let self_filter = self_filter_model(vehicle)?;
-    let levels = levels_of(scenario)?;
+    let levels = levels_of(scenario, config)?;
     let blocks_dir = out.join("blocks");
     if blocks_dir.exists() {
         std::fs::remove_dir_all(&blocks_dir).map_err(|source| Error::Io {

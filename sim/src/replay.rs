@@ -1160,7 +1160,7 @@ fn grpc_sink(url: &str) -> Result<GrpcSink> {
 
 impl Observer for Replay {
     fn start(&mut self, run: &RunStart<'_>) -> Result<()> {
-        let levels = crate::mapping::levels_of(run.scenario)?;
+        let levels = crate::mapping::levels_of(run.scenario, run.config)?;
         self.level_heights_m = levels.heights_m().to_vec();
         self.levels = Some(levels);
         self.obstacle_test = run.config.mapping.map.obstacle_test;

@@ -417,7 +417,7 @@ impl<'a> Rig<'a> {
         };
         let map = MultiHeightMap::with_stores(
             map_config,
-            crate::mapping::levels_of(scenario)?,
+            crate::mapping::levels_of(scenario, &config)?,
             Point2::from(start.translation.vector),
             Some(&setup.map_dir.join("blocks")),
             Some(live.path()),

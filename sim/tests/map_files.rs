@@ -104,7 +104,7 @@ fn the_fingerprint_changes_with_the_vehicles_ceiling() {
     let mut scenario = scenario();
     let config = RunConfig::default();
     let before = fingerprint(&scenario, &config).unwrap();
-    let levels = sim::mapping::levels_of(&scenario).unwrap();
+    let levels = sim::mapping::levels_of(&scenario, &sim::config::RunConfig::default()).unwrap();
     assert!(
         (levels.ceiling_m().unwrap() - 2.622).abs() < 1e-3,
         "{levels:?}"
@@ -112,7 +112,7 @@ fn the_fingerprint_changes_with_the_vehicles_ceiling() {
     scenario.vehicle.vehicle.spec.overhead_clearance_m = 0.3;
     let after = fingerprint(&scenario, &config).unwrap();
     assert_ne!(before, after);
-    let levels = sim::mapping::levels_of(&scenario).unwrap();
+    let levels = sim::mapping::levels_of(&scenario, &sim::config::RunConfig::default()).unwrap();
     assert!(
         (levels.ceiling_m().unwrap() - 2.522).abs() < 1e-3,
         "{levels:?}"

@@ -251,7 +251,7 @@ pub fn static_world_key(scenario: &Scenario, config: &RunConfig) -> Result<Strin
         scenario.vehicle.vehicle,
         scenario.vehicle.world_from_start,
         scenario.seed,
-        crate::mapping::levels_of(scenario)?,
+        crate::mapping::levels_of(scenario, config)?,
         crate::mapping::map_config(config),
         config.lidar,
     );

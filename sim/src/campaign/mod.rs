@@ -267,9 +267,18 @@ impl Campaign {
             ),
             None => (vec![Vec::new()], 0..0),
         };
-        // Every setting must make a valid run configuration over the base's.
+        // Every setting must make a valid run configuration over the base's, and a circle
+        // model of the base's vehicle.
         for s in &settings {
-            config_of(&base_doc, s).map_err(|m| e(span.clone(), "parameters", m))?;
+            let config = config_of(&base_doc, s).map_err(|m| e(span.clone(), "parameters", m))?;
+            config.collision_model(&base.vehicle.vehicle).map_err(|m| {
+                let shown: Vec<String> = s.iter().map(|(k, v)| format!("{k} = {v}")).collect();
+                e(
+                    span.clone(),
+                    "parameters",
+                    format!("the setting {{ {} }}: {m}", shown.join(", ")),
+                )
+            })?;
         }
         let mut h = crc32fast::Hasher::new();
         h.update(text.as_bytes());

@@ -190,6 +190,7 @@ pub fn write(dir: &Path, records: &[RunRecord]) -> Result<()> {
 /// index, failures in red - where a search converges, and how far the passing runs keep off.
 pub fn chart(dir: &Path, title: &str, records: &[RunRecord]) -> Result<()> {
     use plotters::prelude::*;
+    crate::tune::draw::register_font();
     let path = dir.join("clearance.svg");
     let tmp = dir.join(".clearance.svg.partial");
     let top = records

@@ -57,11 +57,15 @@ pub fn run(cmd: &CampaignCommand) -> anyhow::Result<bool> {
             crate::emit(&text)?;
             Ok(records.iter().all(|r| !r.failed))
         }
-        CampaignCommand::Run(args) => run_args(args),
+        CampaignCommand::Run(args) => {
+            let (failed, interrupted) = run_args(args)?;
+            Ok(failed == 0 && !interrupted)
+        }
     }
 }
 
-fn run_args(args: &CampaignRunArgs) -> anyhow::Result<bool> {
+/// Runs (or resumes) the campaign of `args`; returns the failed runs and whether Ctrl-C cut it.
+pub(crate) fn run_args(args: &CampaignRunArgs) -> anyhow::Result<(usize, bool)> {
     anyhow::ensure!(args.jobs != Some(0), "--jobs 0: at least one");
     anyhow::ensure!(args.runs != Some(0), "--runs 0: at least one");
     let mut campaign = Campaign::from_file(&args.campaign)?;
@@ -130,5 +134,5 @@ fn run_args(args: &CampaignRunArgs) -> anyhow::Result<bool> {
         },
         args.out.join("summary.md").display()
     ))?;
-    Ok(failed == 0 && !outcome.interrupted)
+    Ok((failed, outcome.interrupted))
 }

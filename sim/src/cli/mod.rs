@@ -7,3 +7,4 @@ pub mod model;
 pub mod run;
 pub mod scan;
 pub mod small;
+pub mod tune;

@@ -1,4 +1,5 @@
-//! `taxi-sim model fit`: fits a vehicle's circle collision model and prints the per-level table;
+//! `taxi-sim model fit`: fits a vehicle's circle collision model and prints the per-level table
+//! (`model levels`: the parts' undersides and the heights of interest they suggest);
 //! optionally writes an SVG picture and a CARMEN collision file (atomically).
 
 use std::path::PathBuf;
@@ -63,4 +64,50 @@ pub fn run(args: &ModelFitArgs) -> anyhow::Result<()> {
         crate::emit(&format!("wrote {}\n", path.display()))?;
     }
     Ok(())
+}
+
+/// Arguments of `taxi-sim model levels`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ModelLevelsArgs {
+    /// A shipped vehicle (praetor600, a320, iara_car, iara_car_fake_wing) or a sidecar TOML path.
+    pub description: String,
+    /// How far under a part's underside its level goes, metres.
+    #[arg(long, default_value_t = 0.1)]
+    pub margin: f64,
+    /// Parts lower than this are on the ground level, metres.
+    #[arg(long, default_value_t = 0.15)]
+    pub min: f64,
+}
+
+/// Runs `taxi-sim model levels`: every part's underside and top, and the candidate heights of
+/// interest they give (for a tuning campaign's `mapping.heights_of_interest_m`).
+pub fn levels(args: &ModelLevelsArgs) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        args.margin.is_finite() && args.margin >= 0.0 && args.min.is_finite(),
+        "--margin {} and --min {}: finite, margin >= 0",
+        args.margin,
+        args.min
+    );
+    let vehicle = aircraft::Vehicle::load(&args.description)
+        .with_context(|| format!("loading vehicle `{}`", args.description))?;
+    let mut parts: Vec<&aircraft::Part> = vehicle.parts.iter().collect();
+    parts.sort_by(|a, b| a.underside_m().total_cmp(&b.underside_m()));
+    let mut s = format!(
+        "{}: heights of interest in the sidecar {:?}\n{:<28} {:>11} {:>8}\n",
+        vehicle.spec.name, vehicle.spec.heights_of_interest_m, "part", "underside_m", "top_m"
+    );
+    for p in parts {
+        s += &format!(
+            "{:<28} {:>11.3} {:>8.3}\n",
+            format!("{}#{}", p.link, p.collision_index),
+            p.underside_m(),
+            p.top_m()
+        );
+    }
+    let proposed = aircraft::fit::proposed_heights(&vehicle.parts, args.min, args.margin);
+    s += &format!(
+        "candidate heights (undersides above {} m, less {} m): {proposed:?}\n",
+        args.min, args.margin
+    );
+    crate::emit(&s)
 }
