@@ -90,6 +90,51 @@ fn cost_colour(x: f64, lo: f64, hi: f64) -> RGBColor {
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
 
+/// One scatter panel: each setting at `at(f)`, coloured by `colour(f)`, large when on the
+/// Pareto front, ringed when recommended, labelled with its index.
+fn scatter<DB: DrawingBackend>(
+    panel: &DrawingArea<DB, Shift>,
+    figures: &[SettingFigures],
+    recommended: Option<usize>,
+    (x_desc, y_desc): (&str, &str),
+    at: &dyn Fn(&SettingFigures) -> (f64, f64),
+    colour: &dyn Fn(&SettingFigures) -> RGBColor,
+) -> DrawResult {
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    let x_top = figures.iter().map(|f| at(f).0).fold(0.1, f64::max) * 1.15;
+    let y_top = figures.iter().map(|f| at(f).1).fold(1.0, f64::max) * 1.15;
+    let mut chart = ChartBuilder::on(panel)
+        .margin(14)
+        .x_label_area_size(44)
+        .y_label_area_size(56)
+        .build_cartesian_2d(-0.03 * x_top..x_top, -0.03 * y_top..y_top)
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(e)?;
+    for f in figures {
+        let p = at(f);
+        let size = if f.non_dominated { 7 } else { 4 };
+        chart
+            .draw_series([Circle::new(p, size, colour(f).filled())])
+            .map_err(e)?;
+        if Some(f.setting) == recommended {
+            chart
+                .draw_series([Circle::new(p, 11, BLACK.stroke_width(2))])
+                .map_err(e)?;
+        }
+        let label = ("sans-serif", 12).into_font().color(&BLACK);
+        chart
+            .draw_series([Text::new(format!("{}", f.setting), p, label)])
+            .map_err(e)?;
+    }
+    Ok(())
+}
+
 fn pareto_on<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     title: &str,
@@ -99,66 +144,49 @@ fn pareto_on<DB: DrawingBackend>(
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     root.fill(&WHITE).map_err(e)?;
     let root = root.titled(title, ("sans-serif", 20)).map_err(e)?;
-    let panels = root.split_evenly((1, 2));
+    let height = root.dim_in_pixel().1;
+    let (main, foot) = root.split_vertically(height.saturating_sub(30));
+    let panels = main.split_evenly((1, 2));
     let (lo, hi) = figures
         .iter()
         .map(|f| f.probe.circle_ns)
         .fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
-    let y_top = figures
-        .iter()
-        .map(|f| 100.0 * f.unsafe_rate())
-        .fold(10.0, f64::max)
-        * 1.1;
-    type XOf = fn(&SettingFigures) -> f64;
-    let axes: [(&str, XOf); 2] = [
-        ("false stops + needless deviations per run", |f| {
-            f.conservative_rate()
-        }),
-        ("false alarms against the exact reference, %", |f| {
-            100.0 * f.probe.comparison.false_alarm_rate()
-        }),
-    ];
-    for (panel, (x_desc, x_of)) in panels.iter().zip(axes) {
-        let x_top = figures.iter().map(x_of).fold(0.1, f64::max) * 1.15;
-        let mut chart = ChartBuilder::on(panel)
-            .margin(14)
-            .x_label_area_size(60)
-            .y_label_area_size(56)
-            .build_cartesian_2d(-0.02 * x_top..x_top, -0.02 * y_top..y_top)
-            .map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_desc(x_desc)
-            .y_desc("unsafe runs, %")
-            .label_style(("sans-serif", 13))
-            .draw()
-            .map_err(e)?;
-        for f in figures {
-            let p = (x_of(f), 100.0 * f.unsafe_rate());
-            let c = cost_colour(f.probe.circle_ns, lo, hi);
-            let size = if f.non_dominated { 7 } else { 4 };
-            chart
-                .draw_series([Circle::new(p, size, c.filled())])
-                .map_err(e)?;
-            if Some(f.setting) == recommended {
-                chart
-                    .draw_series([Circle::new(p, 11, BLACK.stroke_width(2))])
-                    .map_err(e)?;
-            }
-            chart
-                .draw_series([Text::new(
-                    format!("{}", f.setting),
-                    (p.0, p.1),
-                    ("sans-serif", 12).into_font().color(&BLACK),
-                )])
-                .map_err(e)?;
-        }
-    }
-    root.draw(&Text::new(
-        format!(
-            "colour: ns per pose check, {lo:.0} (dark) to {hi:.0} (yellow); large: on the Pareto front; ringed: recommended; numbers: settings"
+    scatter(
+        &panels[0],
+        figures,
+        recommended,
+        (
+            "safe failures per run (false stops, needless deviations, pilot calls)",
+            "unsafe runs, %",
         ),
-        (14, root.dim_in_pixel().1 as i32 - 18),
+        &|f| (f.conservative_rate(), 100.0 * f.unsafe_rate()),
+        &|f| cost_colour(f.probe.circle_ns, lo, hi),
+    )?;
+    scatter(
+        &panels[1],
+        figures,
+        recommended,
+        (
+            "false alarms against the exact reference, %",
+            "ns per pose check",
+        ),
+        &|f| {
+            (
+                100.0 * f.probe.comparison.false_alarm_rate(),
+                f.probe.circle_ns,
+            )
+        },
+        &|f| match (f.unsafe_runs > 0, f.failed_runs > f.unsafe_runs) {
+            (true, _) => RGBColor(214, 39, 40),
+            (false, true) => RGBColor(255, 127, 14),
+            _ => RGBColor(31, 119, 180),
+        },
+    )?;
+    foot.draw(&Text::new(
+        format!(
+            "left: ns per check {lo:.0} (dark) to {hi:.0} (yellow); right: red unsafe, orange a safe failure, blue neither; large: Pareto front; ringed: recommended"
+        ),
+        (14, 6),
         ("sans-serif", 13).into_font().color(&BLACK),
     ))
     .map_err(e)?;

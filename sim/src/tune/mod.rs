@@ -66,13 +66,14 @@ impl SettingFigures {
         ratio(self.unsafe_runs, self.runs)
     }
 
-    /// False stops and needless deviations per run.
+    /// Runs that failed without being unsafe - a false stop, a needless deviation, a pilot
+    /// called or a time-out where the run should have completed - per run.
     pub fn conservative_rate(&self) -> f64 {
-        ratio(self.false_stops + self.needless_deviations, self.runs)
+        ratio(self.failed_runs.saturating_sub(self.unsafe_runs), self.runs)
     }
 
-    /// The objectives, all minimised: unsafe runs, conservatism in the loop and against the
-    /// exact reference, lap time, ns per check.
+    /// The objectives, all minimised: unsafe runs, conservatism in the loop (safe failures) and
+    /// against the exact reference (false alarms), lap time, ns per check.
     fn objectives(&self) -> [f64; 5] {
         [
             self.unsafe_rate(),
@@ -351,7 +352,7 @@ pub fn to_csv(figures: &[&SettingFigures]) -> String {
 /// The table of the README and `tune.md`.
 pub fn to_markdown(figures: &[SettingFigures], recommended: Option<usize>) -> String {
     let mut s = String::from(
-        "| setting | circles | levels | runs | unsafe | contacts | min clearance, m | false stops | needless dev. | false alarms (exact) | misses (beyond lookup) | ns/check (exact) | front |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
+        "| setting | circles | runs | unsafe | contacts | min clearance, m | safe failures | false stops | needless dev. | false alarms (exact) | misses (beyond lookup) | ns/check (exact) | front |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
     );
     for f in figures {
         let c = &f.probe.comparison;
@@ -362,15 +363,15 @@ pub fn to_markdown(figures: &[SettingFigures], recommended: Option<usize>) -> St
         };
         let _ = writeln!(
             s,
-            "| {}: {} | {} | {:?} | {} | {} | {} | {} | {} | {} | {:.1} % of {} | {} ({}) | {:.0} ({:.0}) | {} |",
+            "| {}: {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.1} % of {} | {} ({}) | {:.0} ({:.0}) | {} |",
             f.setting,
             f.label,
             f.circles,
-            f.heights_m,
             f.runs,
             f.unsafe_runs,
             f.contacts,
             f.min_clearance_m.map_or("-".into(), |v| format!("{v:.2}")),
+            f.failed_runs.saturating_sub(f.unsafe_runs),
             f.false_stops,
             f.needless_deviations,
             100.0 * c.false_alarm_rate(),
@@ -400,7 +401,7 @@ pub fn write_outputs(
     mapper::write_atomically(&dir.join("settings.csv"), to_csv(&all).as_bytes())?;
     mapper::write_atomically(&dir.join("pareto.csv"), to_csv(&front).as_bytes())?;
     let mut md = format!(
-        "# Tuning: {}\n\n{} settings, {} on the Pareto front. Objectives (all minimised): unsafe runs (a contact, or an obstacle passed inside the danger distance), false stops and needless deviations per run, false alarms of the circle check against the exact reference (poses near obstacles of the setting's offline map, at the avoider's safety distance), mean lap time, ns per pose check.\n\n",
+        "# Tuning: {}\n\n{} settings, {} on the Pareto front. Objectives (all minimised): unsafe runs (a contact, or an obstacle passed inside the danger distance), safe failures per run (an expectation unmet without a contact: a false stop, a needless deviation, a pilot called where the run should complete), false alarms of the circle check against the exact reference (poses near obstacles of the setting's offline map, at the avoider's safety distance), mean lap time, ns per pose check.\n\n",
         campaign.name,
         figures.len(),
         front.len()
@@ -479,6 +480,7 @@ mod tests {
         f.runs = 10;
         f.unsafe_runs = unsafe_runs;
         f.false_stops = false_stops;
+        f.failed_runs = unsafe_runs + false_stops;
         f.mean_lap_s = Some(100.0);
         f.probe.circle_ns = ns;
         f
