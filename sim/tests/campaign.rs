@@ -9,7 +9,7 @@ use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use sim::campaign::Campaign;
-use sim::campaign::execute::{RunOptions, RunRecord, read_results, run_campaign, variant};
+use sim::campaign::execute::{RunOptions, RunRecord, Shard, read_results, run_campaign, variant};
 
 fn smoke_path() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/campaigns/smoke.toml")
@@ -24,6 +24,8 @@ fn run(campaign: &Campaign, out: &Path, jobs: usize, runs: Option<u64>) -> Vec<R
     run_campaign(
         campaign,
         &RunOptions {
+            shard: None,
+            maps_dir: None,
             out: out.to_path_buf(),
             jobs,
             runs,
@@ -128,6 +130,8 @@ fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
     let outcome = run_campaign(
         &campaign,
         &RunOptions {
+            shard: None,
+            maps_dir: None,
             out: dir.path().to_path_buf(),
             jobs: 2,
             runs: Some(5),
@@ -163,6 +167,8 @@ fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
     let e = run_campaign(
         &Campaign::from_file(&other).unwrap(),
         &RunOptions {
+            shard: None,
+            maps_dir: None,
             out: dir.path().to_path_buf(),
             jobs: 1,
             runs: Some(1),
@@ -187,6 +193,8 @@ fn a_stop_keeps_only_whole_runs_and_the_rest_runs_later() {
     let outcome = run_campaign(
         &campaign,
         &RunOptions {
+            shard: None,
+            maps_dir: None,
             out: dir.path().to_path_buf(),
             jobs: 1,
             runs: Some(4),
@@ -367,7 +375,11 @@ fn every_shipped_campaign_reads_and_its_first_variants_are_valid_scenarios() {
             "jet_wing_and_engine_paths",
             "low_debris_car",
             "parking_lot_random",
-            "smoke"
+            "smoke",
+            "tune_a320",
+            "tune_car",
+            "tune_praetor",
+            "tune_smoke"
         ]
     );
 }
@@ -409,4 +421,140 @@ fn an_invalid_variant_is_recorded_and_the_campaign_goes_on() {
         "{summary}"
     );
     assert!(summary.contains("| base | 1 |"), "{summary}");
+}
+
+fn run_shard(campaign: &Campaign, out: &Path, maps: &Path, shard: Shard) -> Vec<RunRecord> {
+    let stop = AtomicBool::new(false);
+    run_campaign(
+        campaign,
+        &RunOptions {
+            shard: Some(shard),
+            maps_dir: Some(maps.to_path_buf()),
+            out: out.to_path_buf(),
+            jobs: 1,
+            runs: None,
+            stop: &stop,
+            progress: &|_| {},
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+    .records
+}
+
+#[test]
+fn shards_merged_equal_the_single_machine_run_and_a_lost_shard_is_named_and_rerun() {
+    let (full_dir, records) = full();
+    let root = tempfile::tempdir().unwrap();
+    let maps = root.path().join("maps");
+    let campaign = smoke();
+    let dirs: Vec<PathBuf> = (0..4)
+        .map(|i| root.path().join(format!("shard-{i}")))
+        .collect();
+    // Shards 0, 1 and 3 run; shard 2 is lost (a node went down).
+    for i in [0u64, 1, 3] {
+        let got = run_shard(
+            &campaign,
+            &dirs[i as usize],
+            &maps,
+            Shard { index: i, count: 4 },
+        );
+        assert!(got.iter().all(|r| r.index % 4 == i), "{i}");
+        assert_eq!(got.len(), 5);
+    }
+    // One map for all three shards, in the shared cache, and no scratch left behind.
+    let cached: Vec<_> = std::fs::read_dir(&maps).unwrap().collect();
+    assert_eq!(cached.len(), 1, "{cached:?}");
+    // A shard's directory refuses another shard of the campaign.
+    let stop = AtomicBool::new(false);
+    let e = run_campaign(
+        &campaign,
+        &RunOptions {
+            shard: Some(Shard { index: 2, count: 4 }),
+            maps_dir: Some(maps.clone()),
+            out: dirs[0].clone(),
+            jobs: 1,
+            runs: None,
+            stop: &stop,
+            progress: &|_| {},
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("shard 0/4") && e.contains("shard 2/4"), "{e}");
+
+    let merged = root.path().join("merged");
+    let exe = env!("CARGO_BIN_EXE_taxi-sim");
+    let out = std::process::Command::new(exe)
+        .args(["campaign", "merge", "--out"])
+        .arg(&merged)
+        .args(&dirs[..2])
+        .arg(&dirs[3])
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{said}");
+    assert!(
+        said.contains("missing 5 variants: 2, 6, 10, 14, 18"),
+        "{said}"
+    );
+    assert!(said.contains("--only-missing"), "{said}");
+    // The missing ones, run into the merged directory.
+    let status = std::process::Command::new(exe)
+        .args(["campaign", "run"])
+        .arg(smoke_path())
+        .arg("--out")
+        .arg(&merged)
+        .args(["--only-missing", "--jobs", "2", "--maps-dir"])
+        .arg(&maps)
+        .status()
+        .unwrap();
+    assert!(status.code().is_some_and(|c| c <= 1), "{status}");
+    let all = read_results(&merged).unwrap();
+    assert_eq!(all.len(), records.len());
+    for (a, b) in all.iter().zip(records) {
+        assert_eq!(timeless(a), timeless(b), "variant {}", b.index);
+    }
+    // The same failure files as the single-machine run.
+    for r in records.iter().filter(|r| r.failed) {
+        let f = r.failure_file.as_ref().unwrap();
+        assert_eq!(
+            std::fs::read_to_string(merged.join(f)).unwrap(),
+            std::fs::read_to_string(full_dir.path().join(f)).unwrap()
+        );
+    }
+    // --only-missing refuses a directory with nothing to complete.
+    let empty = root.path().join("empty");
+    let out = std::process::Command::new(exe)
+        .args(["campaign", "run"])
+        .arg(smoke_path())
+        .arg("--out")
+        .arg(&empty)
+        .arg("--only-missing")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("holds no results"));
+}
+
+#[test]
+fn the_falsifier_cannot_be_sharded() {
+    let mut campaign = smoke();
+    campaign.set_sampler(sim::campaign::SamplerKind::Falsify);
+    let dir = tempfile::tempdir().unwrap();
+    let stop = AtomicBool::new(false);
+    let e = run_campaign(
+        &campaign,
+        &RunOptions {
+            shard: Some(Shard { index: 0, count: 2 }),
+            maps_dir: None,
+            out: dir.path().to_path_buf(),
+            jobs: 1,
+            runs: Some(2),
+            stop: &stop,
+            progress: &|_| {},
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("cannot be split"), "{e}");
 }

@@ -39,6 +39,8 @@ fn in_process(campaign: &Campaign, n: u64, jobs: usize, dir: &Path) -> Result<f6
     run_campaign(
         campaign,
         &RunOptions {
+            shard: None,
+            maps_dir: None,
             out: dir.to_path_buf(),
             jobs,
             runs: Some(n),

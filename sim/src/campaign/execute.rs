@@ -289,9 +289,18 @@ impl MapCache {
             if done.join("manifest.json").exists() {
                 return Ok(done);
             }
-            let scratch = self
-                .dir
-                .join(format!("{key}.partial-{}", std::process::id()));
+            // Unique across the machines of a shared filesystem, not only across processes.
+            let nonce = std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_nanos());
+            let host = std::fs::read_to_string("/proc/sys/kernel/hostname")
+                .unwrap_or_default()
+                .trim()
+                .to_string();
+            let scratch = self.dir.join(format!(
+                "{key}.partial-{host}-{}-{nonce}",
+                std::process::id()
+            ));
             let build = || -> Result<()> {
                 std::fs::create_dir_all(&scratch).map_err(|source| Error::Io {
                     what: "creating a map directory",
@@ -324,10 +333,74 @@ impl MapCache {
     }
 }
 
+/// One shard of a campaign split across machines: the variants `i` with `i % count == index`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    /// This shard, `0..count`.
+    pub index: u64,
+    /// Shards in all.
+    pub count: u64,
+}
+
+impl Shard {
+    /// Parses `I/N` (0 <= I < N), or `auto/N`, which takes `I` from `SLURM_ARRAY_TASK_ID` (a
+    /// Slurm array task) or `JOB_COMPLETION_INDEX` (a Kubernetes indexed Job) through `env`.
+    pub fn parse(
+        text: &str,
+        env: &dyn Fn(&str) -> Option<String>,
+    ) -> std::result::Result<Self, String> {
+        let (i, n) = text
+            .split_once('/')
+            .ok_or_else(|| format!("--shard {text}: expected I/N or auto/N"))?;
+        let count: u64 = n
+            .trim()
+            .parse()
+            .ok()
+            .filter(|n| *n >= 1)
+            .ok_or_else(|| format!("--shard {text}: N must be a whole number >= 1"))?;
+        let (i, from) = if i.trim() == "auto" {
+            ["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX"]
+                .iter()
+                .find_map(|k| env(k).map(|v| (v, *k)))
+                .ok_or_else(|| {
+                    format!("--shard {text}: neither SLURM_ARRAY_TASK_ID nor JOB_COMPLETION_INDEX is set")
+                })?
+        } else {
+            (i.trim().to_string(), "--shard")
+        };
+        let index: u64 = i
+            .trim()
+            .parse()
+            .map_err(|_| format!("--shard {text}: {from} = {i:?} is not a whole number"))?;
+        if index >= count {
+            return Err(format!(
+                "--shard {text}: {from} = {index} is not below N = {count} (shards are numbered from 0)"
+            ));
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// Whether variant `i` belongs to this shard.
+    pub fn holds(&self, i: u64) -> bool {
+        i % self.count == self.index
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
 /// How a campaign is run.
 pub struct RunOptions<'a> {
     /// Output directory.
     pub out: PathBuf,
+    /// Run only this shard's variants (default: all).
+    pub shard: Option<Shard>,
+    /// Where the offline maps are cached (default `out/maps`); shards on a shared filesystem
+    /// share one.
+    pub maps_dir: Option<PathBuf>,
     /// Parallel runs (threads).
     pub jobs: usize,
     /// Variants: indices `0..runs` (default the campaign's `runs`).
@@ -589,9 +662,9 @@ impl Appender {
 }
 
 /// Checks (or writes) `DIR/campaign.json`: a directory holds the results of one campaign.
-fn claim(campaign: &Campaign, dir: &Path) -> Result<()> {
+fn claim(campaign: &Campaign, dir: &Path, shard: Option<Shard>, total: u64) -> Result<()> {
     let path = dir.join("campaign.json");
-    let mine = serde_json::json!({
+    let mut mine = serde_json::json!({
         "campaign": campaign.path.display().to_string(),
         "name": campaign.name,
         "digest": campaign.digest,
@@ -599,9 +672,28 @@ fn claim(campaign: &Campaign, dir: &Path) -> Result<()> {
         "sampler": campaign.sampler.as_str(),
         "batch": campaign.falsify.batch,
         "seed": campaign.seed,
+        "total": total,
     });
+    if let Some(s) = shard {
+        mine["shard"] = serde_json::Value::String(s.to_string());
+    }
     if let Ok(text) = std::fs::read_to_string(&path) {
         let theirs: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+        if theirs.get("shard") != mine.get("shard") {
+            let show = |v: &serde_json::Value| {
+                v.get("shard")
+                    .and_then(|s| s.as_str())
+                    .map_or("the whole campaign".to_string(), |s| format!("shard {s}"))
+            };
+            return Err(Error::BadFile {
+                path,
+                message: format!(
+                    "this directory holds {} of this campaign, not {}; give another --out",
+                    show(&theirs),
+                    show(&mine)
+                ),
+            });
+        }
         if theirs.get("digest") != mine.get("digest") {
             return Err(Error::BadFile {
                 path,
@@ -621,17 +713,22 @@ fn claim(campaign: &Campaign, dir: &Path) -> Result<()> {
 /// Runs the campaign's variants not yet in `opts.out`.
 pub fn run_campaign(campaign: &Campaign, opts: &RunOptions<'_>) -> Result<Outcome> {
     let dir = &opts.out;
-    for sub in ["failures", "maps"] {
-        let p = dir.join(sub);
+    let maps_dir = opts.maps_dir.clone().unwrap_or_else(|| dir.join("maps"));
+    for p in [dir.join("failures"), maps_dir] {
         std::fs::create_dir_all(&p).map_err(|source| Error::Io {
             what: "creating the campaign directory",
             path: p,
             source,
         })?;
     }
-    claim(campaign, dir)?;
-    let mut records = read_results(dir)?;
+    if opts.shard.is_some() && campaign.sampler == SamplerKind::Falsify {
+        return Err(Error::Invalid(
+            "--shard: the falsify sampler's generations depend on every earlier run, so it cannot be split; use random or halton".into(),
+        ));
+    }
     let total = total_runs(campaign, opts.runs);
+    claim(campaign, dir, opts.shard, total)?;
+    let mut records = read_results(dir)?;
     let path = dir.join("results.jsonl");
     let file = std::fs::OpenOptions::new()
         .create(true)
@@ -644,7 +741,7 @@ pub fn run_campaign(campaign: &Campaign, opts: &RunOptions<'_>) -> Result<Outcom
         })?;
     let out = Appender(Mutex::new(file), path.clone());
     let maps = MapCache {
-        dir: dir.join("maps"),
+        dir: opts.maps_dir.clone().unwrap_or_else(|| dir.join("maps")),
         entries: Mutex::default(),
     };
     // The falsifier runs generation by generation; the others all at once.
@@ -658,7 +755,7 @@ pub fn run_campaign(campaign: &Campaign, opts: &RunOptions<'_>) -> Result<Outcom
         let end = (start + step).min(total);
         let have: std::collections::HashSet<u64> = records.iter().map(|r| r.index).collect();
         let todo: Vec<Variant> = (start..end)
-            .filter(|i| !have.contains(i))
+            .filter(|i| !have.contains(i) && opts.shard.is_none_or(|s| s.holds(*i)))
             .map(|i| variant(campaign, i, &records))
             .collect();
         let fresh = run_parallel(&todo, opts.jobs.max(1), opts.stop, &|v, pool| {

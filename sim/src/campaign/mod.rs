@@ -12,6 +12,7 @@
 pub mod bench;
 pub mod dist;
 pub mod execute;
+pub mod merge;
 pub mod sampler;
 pub mod summary;
 

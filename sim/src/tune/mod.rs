@@ -245,10 +245,12 @@ pub fn figures(
     Ok(out)
 }
 
-/// Relative tolerance of each objective: differences within it are no difference. The rates
-/// are counted exactly; lap times vary by a fraction of a percent between equivalent runs;
-/// timings drift by 10-40 % on this kind of machine, so a check must be 25 % cheaper to count.
-const TOLERANCE: [f64; 5] = [0.0, 0.0, 0.0, 0.01, 0.25];
+/// Relative tolerance of each objective: differences within it are no difference. Runs are
+/// counted exactly; a false-alarm rate from a few thousand poses carries a sampling error of
+/// about a fifth of itself (1.4 % of 2300 clear poses: +-0.25 points); lap times vary by a
+/// fraction of a percent between equivalent runs; timings drift by 10-40 % on this kind of
+/// machine, so a check must be 25 % cheaper to count.
+const TOLERANCE: [f64; 5] = [0.0, 0.0, 0.2, 0.01, 0.25];
 
 /// `a` no worse than `b` on objective `k`.
 fn no_worse(a: f64, b: f64, k: usize) -> bool {

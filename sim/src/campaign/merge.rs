@@ -1,0 +1,213 @@
+//! Merging the output directories of a campaign's shards (`taxi-sim campaign merge`) into one
+//! directory equal to the single-machine run: the records by index, the failure files, the
+//! summary and its chart; and which variants no shard recorded.
+
+use std::path::{Path, PathBuf};
+
+use super::execute::{RunRecord, read_results};
+use crate::error::{Error, Result};
+
+/// What a merge found.
+#[derive(Debug)]
+pub struct Merged {
+    /// Every record, by index.
+    pub records: Vec<RunRecord>,
+    /// Variants asked for (the largest `total` of the shards).
+    pub total: u64,
+    /// Indices below `total` no shard recorded.
+    pub missing: Vec<u64>,
+}
+
+fn meta_of(dir: &Path) -> Result<serde_json::Value> {
+    let path = dir.join("campaign.json");
+    let text = std::fs::read_to_string(&path).map_err(|source| Error::Io {
+        what: "reading a shard's campaign.json (is it a campaign directory?)",
+        path: path.clone(),
+        source,
+    })?;
+    serde_json::from_str(&text).map_err(|e| Error::BadFile {
+        path,
+        message: format!("not a campaign.json: {e}"),
+    })
+}
+
+/// `3, 7-9, 12`: indices as ranges.
+pub fn ranges(indices: &[u64]) -> String {
+    let mut out: Vec<String> = Vec::new();
+    let mut i = 0;
+    while i < indices.len() {
+        let mut j = i;
+        while j + 1 < indices.len() && indices[j + 1] == indices[j] + 1 {
+            j += 1;
+        }
+        out.push(if i == j {
+            indices[i].to_string()
+        } else {
+            format!("{}-{}", indices[i], indices[j])
+        });
+        i = j + 1;
+    }
+    out.join(", ")
+}
+
+/// Merges the shard directories `dirs` into `out` (created; it must not hold another campaign's
+/// results). Every shard must belong to the same campaign (its digest) and split it the same
+/// number of ways. Two shards holding the same variant must agree on it (wall time aside).
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
+    let first = dirs
+        .first()
+        .ok_or_else(|| Error::Invalid("campaign merge: no shard directories given".into()))?;
+    let meta = meta_of(first)?;
+    let count_of = |m: &serde_json::Value| {
+        m.get("shard")
+            .and_then(|s| s.as_str())
+            .and_then(|s| s.split_once('/'))
+            .map(|(_, n)| n.to_string())
+    };
+    let mut total = 0u64;
+    let mut by_index: std::collections::BTreeMap<u64, (RunRecord, &Path)> = Default::default();
+    for dir in dirs {
+        let m = meta_of(dir)?;
+        if m.get("digest") != meta.get("digest") || count_of(&m) != count_of(&meta) {
+            return Err(Error::BadFile {
+                path: dir.join("campaign.json"),
+                message: format!(
+                    "not a shard of the same campaign as {} (digest {} split {} ways, here {} split {} ways)",
+                    first.display(),
+                    meta.get("digest").unwrap_or(&serde_json::Value::Null),
+                    count_of(&meta).unwrap_or("1".into()),
+                    m.get("digest").unwrap_or(&serde_json::Value::Null),
+                    count_of(&m).unwrap_or("1".into()),
+                ),
+            });
+        }
+        total = total.max(m.get("total").and_then(|t| t.as_u64()).unwrap_or(0));
+        for r in read_results(dir)? {
+            match by_index.get(&r.index) {
+                Some((old, from)) if !same_run(old, &r) => {
+                    return Err(Error::Invalid(format!(
+                        "variant {} differs between {} and {}: were they run with different versions of taxi-sim?",
+                        r.index,
+                        from.display(),
+                        dir.display()
+                    )));
+                }
+                Some(_) => {}
+                None => {
+                    by_index.insert(r.index, (r, dir.as_path()));
+                }
+            }
+        }
+    }
+    std::fs::create_dir_all(out.join("failures")).map_err(|source| Error::Io {
+        what: "creating the merged directory",
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let mut merged_meta = meta.clone();
+    if let Some(m) = merged_meta.as_object_mut() {
+        m.remove("shard");
+        m.insert("total".into(), total.into());
+        m.insert(
+            "merged_from".into(),
+            dirs.iter().map(|d| d.display().to_string()).collect(),
+        );
+    }
+    let path = out.join("campaign.json");
+    if let Ok(theirs) = meta_of(out)
+        && theirs.get("digest") != meta.get("digest")
+    {
+        return Err(Error::BadFile {
+            path,
+            message: "this directory holds another campaign's results; give another --out".into(),
+        });
+    }
+    mapper::write_atomically(
+        &path,
+        serde_json::to_string_pretty(&merged_meta)?.as_bytes(),
+    )?;
+    for (r, from) in by_index.values() {
+        if let Some(f) = &r.failure_file {
+            let text = std::fs::read(from.join(f)).map_err(|source| Error::Io {
+                what: "reading a shard's failure file",
+                path: from.join(f),
+                source,
+            })?;
+            mapper::write_atomically(&out.join(f), &text)?;
+        }
+    }
+    let records: Vec<RunRecord> = by_index.into_values().map(|(r, _)| r).collect();
+    let text: String = records
+        .iter()
+        .map(|r| serde_json::to_string(r).map(|l| l + "\n"))
+        .collect::<std::result::Result<_, _>>()?;
+    mapper::write_atomically(&out.join("results.jsonl"), text.as_bytes())?;
+    super::summary::write(out, &records)?;
+    let have: std::collections::HashSet<u64> = records.iter().map(|r| r.index).collect();
+    let missing = (0..total).filter(|i| !have.contains(i)).collect();
+    Ok(Merged {
+        records,
+        total,
+        missing,
+    })
+}
+
+/// Two records of one variant agree on everything but the wall time.
+fn same_run(a: &RunRecord, b: &RunRecord) -> bool {
+    let timeless = |r: &RunRecord| RunRecord {
+        wall_time_s: 0.0,
+        ..r.clone()
+    };
+    timeless(a) == timeless(b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn indices_print_as_ranges() {
+        assert_eq!(ranges(&[]), "");
+        assert_eq!(ranges(&[3]), "3");
+        assert_eq!(ranges(&[3, 7, 8, 9, 12]), "3, 7-9, 12");
+    }
+
+    #[test]
+    fn a_shard_is_parsed_from_the_flag_or_the_scheduler_and_checked() {
+        use super::super::execute::Shard;
+        let none = |_: &str| None;
+        assert_eq!(Shard::parse("2/4", &none), Ok(Shard { index: 2, count: 4 }));
+        let slurm = |k: &str| (k == "SLURM_ARRAY_TASK_ID").then(|| "3".to_string());
+        assert_eq!(
+            Shard::parse("auto/4", &slurm),
+            Ok(Shard { index: 3, count: 4 })
+        );
+        let k8s = |k: &str| (k == "JOB_COMPLETION_INDEX").then(|| "0".to_string());
+        assert_eq!(
+            Shard::parse("auto/2", &k8s),
+            Ok(Shard { index: 0, count: 2 })
+        );
+        for (text, env, says) in [
+            (
+                "4/4",
+                &none as &dyn Fn(&str) -> Option<String>,
+                "not below N = 4",
+            ),
+            ("1/0", &none, "N must be"),
+            ("x/3", &none, "not a whole number"),
+            ("auto/3", &none, "neither SLURM_ARRAY_TASK_ID"),
+            (
+                "auto/3",
+                &slurm,
+                "SLURM_ARRAY_TASK_ID = 3 is not below N = 3",
+            ),
+            ("3", &none, "expected I/N"),
+        ] {
+            let e = Shard::parse(text, env).unwrap_err();
+            assert!(e.contains(says), "{text}: {e}");
+        }
+        let s = Shard { index: 1, count: 3 };
+        let held: Vec<u64> = (0..10).filter(|i| s.holds(*i)).collect();
+        assert_eq!(held, vec![1, 4, 7]);
+    }
+}
