@@ -276,32 +276,23 @@ pub fn mark_front(figures: &mut [SettingFigures]) {
     }
 }
 
-/// The recommended setting: among the safest (fewest unsafe runs), the least conservative in
-/// the loop, then against the exact reference, then the fastest lap, then the cheapest check
-/// (each within its tolerance), then the fewest circles and the least map memory.
+/// The recommended setting, by a cascade over the settings with runs: keep the safest (fewest
+/// unsafe runs), of those the least conservative in the loop, then those within tolerance of the
+/// fewest false alarms, of the fastest lap, of the cheapest check; then the fewest circles, the
+/// least map memory, the lowest index. Each step keeps what is near the best of the step before
+/// it, so the answer does not depend on the order of the settings.
 pub fn recommend(figures: &[SettingFigures]) -> Option<usize> {
-    let mut best: Option<&SettingFigures> = None;
-    for f in figures.iter().filter(|f| f.runs > 0) {
-        let Some(b) = best else {
-            best = Some(f);
-            continue;
-        };
-        let (x, y) = (f.objectives(), b.objectives());
-        let decided = (0..5).find_map(|k| {
-            if better(x[k], y[k], k) {
-                Some(true)
-            } else if better(y[k], x[k], k) {
-                Some(false)
-            } else {
-                None
-            }
-        });
-        let wins = decided.unwrap_or((f.circles, f.map_bytes) < (b.circles, b.map_bytes));
-        if wins {
-            best = Some(f);
-        }
+    let mut keep: Vec<&SettingFigures> = figures.iter().filter(|f| f.runs > 0).collect();
+    for k in 0..5 {
+        let best = keep
+            .iter()
+            .map(|f| f.objectives()[k])
+            .fold(f64::INFINITY, f64::min);
+        keep.retain(|f| no_worse(f.objectives()[k], best, k));
     }
-    best.map(|f| f.setting)
+    keep.into_iter()
+        .min_by_key(|f| (f.circles, f.map_bytes, f.setting))
+        .map(|f| f.setting)
 }
 
 fn csv_field(s: &str) -> String {
@@ -514,6 +505,25 @@ mod tests {
         mark_front(&mut twins);
         assert!(twins.iter().all(|f| f.non_dominated));
         assert_eq!(recommend(&twins), Some(0));
+        // The answer does not depend on the order of the settings: a chain of near ties (each
+        // within tolerance of the next, the ends not) still picks the one near the best.
+        let mut chain = vec![
+            fig(0, 0, 0, 100.0),
+            fig(1, 0, 0, 100.0),
+            fig(2, 0, 0, 100.0),
+        ];
+        for (f, fa) in chain.iter_mut().zip([0.050, 0.045, 0.038]) {
+            f.probe.comparison.poses = 1000;
+            f.probe.comparison.false_alarms = (fa * 1000.0) as usize;
+        }
+        for (f, n) in chain.iter_mut().zip([30, 40, 50]) {
+            f.circles = n;
+        }
+        // 0 is within tolerance of 1 but not of the best (2); of 1 and 2, 1 has fewer circles.
+        let forward = recommend(&chain);
+        chain.reverse();
+        assert_eq!(forward, recommend(&chain));
+        assert_eq!(forward, Some(1));
         // A setting with no run is never recommended.
         let mut empty = fig(0, 0, 0, 1.0);
         empty.runs = 0;
