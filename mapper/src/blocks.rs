@@ -303,11 +303,14 @@ fn bad_value(spec: &BlockSpec, block: &Block) -> Option<String> {
 }
 
 /// Writes `bytes` to `path` atomically: a temporary file in the same directory, synced, then renamed.
+/// The directory is created if it does not exist.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
+    // Every command writes through here: a missing folder is created, the same for all.
+    std::fs::create_dir_all(dir).map_err(|e| MapError::io(dir, e))?;
     // tempfile creates 0600 files; a map or a picture is for others to read too.
     let mut builder = tempfile::Builder::new();
     #[cfg(unix)]
