@@ -38,6 +38,13 @@ impl GridGeometry {
         height: usize,
     ) -> Result<Self> {
         positive("resolution_m", resolution_m)?;
+        // A cell of a micrometre or less is a mistake, and 1 / resolution must stay finite.
+        if resolution_m < 1e-6 {
+            return Err(MapError::invalid(
+                "resolution_m",
+                format!("{resolution_m} m: cells must be at least 1e-6 m"),
+            ));
+        }
         finite("origin_m.x", origin_m.x)?;
         finite("origin_m.y", origin_m.y)?;
         if width == 0 || height == 0 {
@@ -274,6 +281,17 @@ mod tests {
         let centre = g.center_of(Cell { x: 3, y: 1 });
         assert!((centre.x - (-1.0 + 0.7)).abs() < 1e-12 && (centre.y - 2.3).abs() < 1e-12);
         assert_eq!(g.cell_of(&centre), Some(Cell { x: 3, y: 1 }));
+    }
+
+    #[test]
+    fn a_resolution_whose_inverse_overflows_is_refused() {
+        // 1e-320 is positive and finite, but 1 / 1e-320 is infinite (found by fuzzing the ROS
+        // map reader).
+        for r in [1e-320, 1e-9] {
+            let e = GridGeometry::new(Point2::origin(), r, 10, 10).unwrap_err();
+            assert!(e.to_string().contains("resolution_m"), "{e}");
+        }
+        assert!(GridGeometry::new(Point2::origin(), 1e-6, 10, 10).is_ok());
     }
 
     /// The hand-written floor equals `f64::floor` everywhere, infinities and huge values included.

@@ -254,6 +254,12 @@ impl RunConfig {
 
     /// Checks the values a run relies on; the message names the field.
     pub fn validate(&self) -> Result<(), String> {
+        // No number of a configuration may be NaN or infinite, whatever field it is in.
+        if let Ok(v) = toml::Value::try_from(self)
+            && let Some((path, x)) = non_finite(&v, String::new())
+        {
+            return Err(format!("{path} = {x}: must be a finite number"));
+        }
         let positive = |field: &str, v: f64| {
             if v.is_finite() && v > 0.0 {
                 Ok(())
@@ -351,6 +357,26 @@ impl RunConfig {
     }
 }
 
+/// The dotted path and value of the first non-finite float in `v`.
+fn non_finite(v: &toml::Value, path: String) -> Option<(String, f64)> {
+    let join = |k: &str| {
+        if path.is_empty() {
+            k.to_string()
+        } else {
+            format!("{path}.{k}")
+        }
+    };
+    match v {
+        toml::Value::Float(x) if !x.is_finite() => Some((path, *x)),
+        toml::Value::Table(t) => t.iter().find_map(|(k, x)| non_finite(x, join(k))),
+        toml::Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| non_finite(x, format!("{path}[{i}]"))),
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -409,6 +435,11 @@ mod tests {
                 "pose_source.white_sigma_m",
             ),
             ("[autonomy]\nstep_m = 0.0\n", "autonomy.step_m"),
+            (
+                "[lidar]\natmosphere_attenuation_rate = nan\n",
+                "lidar.atmosphere_attenuation_rate",
+            ),
+            ("[autonomy]\nw_offset = inf\n", "autonomy.w_offset"),
             (
                 "[mapping]\nheights_of_interest_m = [0.5, 1.0]\n",
                 "mapping.heights_of_interest_m",
