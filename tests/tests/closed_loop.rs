@@ -333,3 +333,43 @@ fn a_run_is_the_same_whatever_the_thread_count() {
     }
     assert!(reports.iter().all(|r| *r == reports[0]));
 }
+
+/// The mapping drive writes the same map files, byte for byte, whatever the number of threads:
+/// every block (log-odds, remission, checksum), the exports and the manifest.
+#[test]
+fn the_offline_map_is_the_same_whatever_the_thread_count() {
+    let s = scenario("straight_cone_under_wing");
+    let mut maps = Vec::new();
+    for threads in [1, 2, 4] {
+        let dir = tempfile::tempdir().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            sim::mapping::map_drive(&s, &RunConfig::default(), dir.path(), &mut |_, _| {})
+        })
+        .unwrap();
+        let mut files: Vec<(String, Vec<u8>)> = Vec::new();
+        for sub in ["", "blocks"] {
+            for entry in std::fs::read_dir(dir.path().join(sub)).unwrap() {
+                let p = entry.unwrap().path();
+                if p.is_file() {
+                    let name = format!("{sub}/{}", p.file_name().unwrap().to_string_lossy());
+                    files.push((name, std::fs::read(&p).unwrap()));
+                }
+            }
+        }
+        files.sort();
+        assert!(files.iter().filter(|(n, _)| n.ends_with(".tsmb")).count() >= 4);
+        maps.push((threads, files));
+    }
+    for (threads, files) in &maps[1..] {
+        let names: Vec<&String> = files.iter().map(|(n, _)| n).collect();
+        let first: Vec<&String> = maps[0].1.iter().map(|(n, _)| n).collect();
+        assert_eq!(names, first, "{threads} threads");
+        for ((n, a), (_, b)) in files.iter().zip(&maps[0].1) {
+            assert!(a == b, "{n} differs with {threads} threads");
+        }
+    }
+}
