@@ -31,8 +31,8 @@ pub struct RunConfig {
     pub pose_source: PoseSourceConfig,
     /// The vehicle's circle model the stack checks. Default: the vehicle's own fit.
     pub collision_model: CollisionModelConfig,
-    /// Faults injected into the loop. None are modelled yet: the table exists so that files and
-    /// reports keep their shape when they are.
+    /// Faults injected between the world and the stack (`crate::faults`): lost revolutions,
+    /// beam dropout, dead beams, range noise, spurious returns. None by default.
     pub faults: FaultsConfig,
 }
 
@@ -183,10 +183,7 @@ pub enum CollisionModelConfig {
     },
 }
 
-/// Faults injected into the loop: none are modelled yet.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FaultsConfig {}
+pub use crate::faults::FaultsConfig;
 
 impl RunConfig {
     /// Reads a configuration from TOML text; `origin` names it in errors (a file's path), which
@@ -285,6 +282,8 @@ impl RunConfig {
         if let Some(h) = self.mapping.distance_map_half_size_m {
             positive("mapping.distance_map_half_size_m", h)?;
         }
+        self.faults.validate()?;
+        positive("autonomy.watchdog_s", self.autonomy.watchdog_s)?;
         if let Some(h) = &self.mapping.heights_of_interest_m {
             aircraft::fit::check_heights(h)
                 .map_err(|m| format!("mapping.heights_of_interest_m = {h:?}: {m}"))?;

@@ -24,6 +24,7 @@ pub mod campaign;
 pub mod config;
 pub mod demo;
 pub mod error;
+pub mod faults;
 pub mod judge;
 pub mod lidar;
 pub mod mapping;

@@ -137,6 +137,11 @@ pub enum Event {
         /// Its time, seconds.
         time_s: f64,
     },
+    /// The stack's watchdog stopped the vehicle (no fresh LiDAR revolution) or let it go again.
+    Watchdog {
+        /// True when it began holding the vehicle, false when revolutions returned.
+        holding: bool,
+    },
     /// The vehicle went by a run-time obstacle.
     Pass {
         /// The obstacle's id.

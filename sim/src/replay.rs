@@ -1265,6 +1265,14 @@ impl Observer for Replay {
                 TextLogLevel::INFO,
             ),
             Event::BackOnRoute => ("back on the route".to_string(), TextLogLevel::INFO),
+            Event::Watchdog { holding: true } => (
+                "watchdog: no fresh LiDAR revolution, stopping".to_string(),
+                TextLogLevel::WARN,
+            ),
+            Event::Watchdog { holding: false } => (
+                "watchdog: revolutions are back".to_string(),
+                TextLogLevel::INFO,
+            ),
             Event::Contact(c) => (
                 format!("contact: {} ({:?}) touched by {}", c.object, c.kind, c.part),
                 TextLogLevel::ERROR,

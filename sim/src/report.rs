@@ -48,6 +48,9 @@ pub struct RunReport {
     pub time_split_s: TimeSplit,
     /// The configuration the run ran with.
     pub config: RunConfig,
+    /// What the faults did: lost revolutions, dropped and spurious returns, watchdog stops.
+    #[serde(default)]
+    pub faults: crate::faults::FaultCounts,
 }
 
 /// The obstacle a vehicle waits for without seeing it.

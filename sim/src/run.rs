@@ -152,6 +152,14 @@ struct Rig<'a> {
     timeout_s: f64,
     split: TimeSplit,
     wall: Instant,
+    /// Which revolutions the faults lose.
+    lost: crate::faults::LostRevolutions,
+    /// What the faults did (the casts run on other threads: atomics, summed at the end).
+    dropped_returns: std::sync::atomic::AtomicU64,
+    spurious_returns: std::sync::atomic::AtomicU64,
+    fault_counts: crate::faults::FaultCounts,
+    /// Whether the watchdog held the vehicle at the last step.
+    watchdog_holding: bool,
     /// The live map's scratch directory, removed with the rig.
     _live: tempfile::TempDir,
 }
@@ -192,6 +200,12 @@ impl<'a> Rig<'a> {
             }
             if self.step.is_multiple_of(self.steps_per_scan) {
                 self.revolution(tasks, &truth, observer)?;
+            }
+            let holding = self.driver.watchdog_tripped();
+            if holding != self.watchdog_holding {
+                self.watchdog_holding = holding;
+                self.fault_counts.watchdog_stops += u64::from(holding);
+                observer.event(self.t_s, &Event::Watchdog { holding })?;
             }
             let physics = Instant::now();
             let command = self.driver.command();
@@ -241,9 +255,24 @@ impl<'a> Rig<'a> {
         };
         let (world, lidar) = (&self.world, &self.lidar);
         let (index, seed, t_s) = (self.step / self.steps_per_scan, self.seed, self.t_s);
+        let faults = &self.config.faults;
+        if faults.any() && self.lost.is_lost(faults, seed, index) {
+            // It never reaches the stack.
+            self.fault_counts.lost_revolutions += 1;
+            return Ok(());
+        }
+        self.driver.on_revolution(t_s);
+        let (dropped, spurious) = (&self.dropped_returns, &self.spurious_returns);
         let capture = || -> Result<Captured> {
             let t0 = Instant::now();
-            let taken = lidar.scan(world, &SweepPoses::still(*truth), index, seed);
+            let mut taken = lidar.scan(world, &SweepPoses::still(*truth), index, seed);
+            if faults.any() {
+                let mut counts = crate::faults::FaultCounts::default();
+                taken.scan = crate::faults::degrade(&taken.scan, faults, seed, index, &mut counts)?;
+                taken.owners.truncate(0);
+                dropped.fetch_add(counts.dropped_returns, Ordering::Relaxed);
+                spurious.fetch_add(counts.spurious_returns, Ordering::Relaxed);
+            }
             let scan = if estimate == *truth {
                 taken.scan
             } else {
@@ -479,6 +508,11 @@ impl<'a> Rig<'a> {
             timeout_s: 60.0 + 4.0 * total_m / scenario.route.speed_m_s,
             split: TimeSplit::default(),
             wall: Instant::now(),
+            lost: crate::faults::LostRevolutions::default(),
+            dropped_returns: Default::default(),
+            spurious_returns: Default::default(),
+            fault_counts: crate::faults::FaultCounts::default(),
+            watchdog_holding: false,
             config,
             _live: live,
         })
@@ -547,6 +581,11 @@ impl<'a> Rig<'a> {
             wall_time_s,
             real_time_factor: self.t_s / wall_time_s.max(1e-9),
             time_split_s: self.split,
+            faults: crate::faults::FaultCounts {
+                dropped_returns: self.dropped_returns.load(Ordering::Relaxed),
+                spurious_returns: self.spurious_returns.load(Ordering::Relaxed),
+                ..self.fault_counts
+            },
             config: self.config,
         }
     }

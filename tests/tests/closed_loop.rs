@@ -373,3 +373,60 @@ fn the_offline_map_is_the_same_whatever_the_thread_count() {
         }
     }
 }
+
+/// Bursts of lost LiDAR revolutions (5 in a row, 0.5 s, longer than the 0.3 s watchdog): the
+/// watchdog holds the car each time, it drives on when revolutions return, passes over the cone
+/// under its wing as expected and touches nothing; the same faults give the same run. With the
+/// watchdog off (a limit longer than the run) it never holds.
+#[test]
+fn the_watchdog_holds_the_car_through_lost_revolutions_and_it_drives_on() {
+    let s = scenario("straight_cone_under_wing");
+    let dir = tempfile::tempdir().unwrap();
+    sim::mapping::map_drive(&s, &RunConfig::default(), dir.path(), &mut |_, _| {}).unwrap();
+    let mut config = RunConfig::default();
+    config.faults.lost_revolution_probability = 0.02;
+    config.faults.lost_burst_revolutions = 5;
+    let go = |config: &RunConfig| {
+        let setup = RunSetup {
+            config: config.clone(),
+            ..RunSetup::new(dir.path().to_path_buf())
+        };
+        run(&s, &setup).unwrap()
+    };
+    let a = go(&config);
+    assert!(a.faults.lost_revolutions >= 10, "{:?}", a.faults);
+    assert!(a.faults.watchdog_stops >= 1, "{:?}", a.faults);
+    assert!(a.contacts.is_empty() && a.expectations_met, "{a:#?}");
+    assert_eq!(a.end, EndReason::Completed);
+    let b = go(&config);
+    assert_eq!((a.faults, a.lap_times_s.clone()), (b.faults, b.lap_times_s));
+    config.autonomy.watchdog_s = 1000.0;
+    let blind = go(&config);
+    assert_eq!(blind.faults.watchdog_stops, 0);
+    assert_eq!(blind.faults.lost_revolutions, a.faults.lost_revolutions);
+}
+
+/// Degraded returns - 30 % dropout, the three lowest beams dead, 2 cm more range noise, two
+/// spurious returns a revolution - and the car still passes over the cone and touches nothing.
+#[test]
+fn the_car_copes_with_dropout_dead_beams_noise_and_spurious_returns() {
+    let s = scenario("straight_cone_under_wing");
+    let dir = tempfile::tempdir().unwrap();
+    sim::mapping::map_drive(&s, &RunConfig::default(), dir.path(), &mut |_, _| {}).unwrap();
+    let mut config = RunConfig::default();
+    config.faults.beam_dropout_probability = 0.3;
+    config.faults.dead_beams = vec![0, 1, 2];
+    config.faults.extra_range_noise_m = 0.02;
+    config.faults.spurious_returns_per_revolution = 2.0;
+    let setup = RunSetup {
+        config,
+        ..RunSetup::new(dir.path().to_path_buf())
+    };
+    let r = run(&s, &setup).unwrap();
+    assert!(
+        r.faults.dropped_returns > 1_000_000 && r.faults.spurious_returns > 100,
+        "{:?}",
+        r.faults
+    );
+    assert!(r.contacts.is_empty() && r.expectations_met, "{r:#?}");
+}

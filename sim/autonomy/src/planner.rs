@@ -79,6 +79,10 @@ pub struct AutonomyConfig {
     /// stop within it. Default none (no cap): for the IARA car, every obstacle of 0.12 m and up
     /// is mapped 28.8 m ahead or more at up to 8 m/s, farther than it needs at its top speed.
     pub detection_range_m: Option<f64>,
+    /// The watchdog: with no fresh LiDAR revolution for this long the vehicle is brought to a
+    /// stop (it would be planning blind), and drives on when revolutions return, seconds.
+    /// Default 0.3 (three revolutions at 10 Hz).
+    pub watchdog_s: f64,
 }
 
 impl Default for AutonomyConfig {
@@ -101,6 +105,7 @@ impl Default for AutonomyConfig {
             hidden_after_s: 2.0,
             pilot_call_after_s: 10.0,
             detection_range_m: None,
+            watchdog_s: 0.3,
         }
     }
 }

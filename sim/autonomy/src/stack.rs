@@ -78,6 +78,8 @@ pub struct Driver {
     plan: Option<Plan>,
     speed_command_m_s: f64,
     status: DriverStatus,
+    /// When the last revolution arrived, seconds (the watchdog's clock).
+    last_revolution_s: Option<f64>,
 }
 
 impl Driver {
@@ -102,6 +104,22 @@ impl Driver {
             plan: None,
             speed_command_m_s: 0.0,
             status: DriverStatus::Driving,
+            last_revolution_s: None,
+        }
+    }
+
+    /// A LiDAR revolution taken at `t_s` arrived (it is mapped and planned from as the schedule
+    /// says): the watchdog's clock starts over.
+    pub fn on_revolution(&mut self, t_s: f64) {
+        self.last_revolution_s = Some(t_s);
+    }
+
+    /// Whether the watchdog holds the vehicle now: revolutions have arrived before, but none for
+    /// longer than `watchdog_s` (by the odometry's clock).
+    pub fn watchdog_tripped(&self) -> bool {
+        match (self.last_revolution_s, self.last_odometry) {
+            (Some(r), Some(o)) => o.t_s - r > self.config.watchdog_s,
+            _ => false,
         }
     }
 
@@ -261,7 +279,12 @@ impl Driver {
             _ => 0.0,
         };
         Command {
-            speed_m_s: self.speed_command_m_s,
+            // Blind (no fresh revolution), the vehicle stops; it drives on when they return.
+            speed_m_s: if self.watchdog_tripped() {
+                0.0
+            } else {
+                self.speed_command_m_s
+            },
             steering_rad: steering,
         }
     }

@@ -97,6 +97,9 @@ pub struct RunRecord {
     pub score: f64,
     /// The failure file, relative to the campaign directory.
     pub failure_file: Option<String>,
+    /// What injected faults did (`[faults]` of the run configuration).
+    #[serde(default)]
+    pub faults: crate::faults::FaultCounts,
 }
 
 fn finite(x: f64) -> Option<f64> {
@@ -235,6 +238,7 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
         wall_time_s: r.wall_time_s,
         score,
         failure_file: failed.then(|| format!("failures/{}.toml", v.index)),
+        faults: r.faults,
     }
 }
 
@@ -589,6 +593,7 @@ fn invalid(campaign: &Campaign, v: &Variant, why: &str) -> RunRecord {
         wall_time_s: 0.0,
         score: 10.0,
         failure_file: None,
+        faults: Default::default(),
     }
 }
 

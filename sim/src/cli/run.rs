@@ -278,6 +278,14 @@ pub fn table(r: &RunReport) -> String {
                 "  (waiting for a hidden obstacle: pilot called)",
         }
     );
+    let f = &r.faults;
+    if *f != sim::faults::FaultCounts::default() {
+        let _ = writeln!(
+            t,
+            "faults: {} revolutions lost, {} returns dropped, {} spurious returns; the watchdog held the vehicle {} times",
+            f.lost_revolutions, f.dropped_returns, f.spurious_returns, f.watchdog_stops
+        );
+    }
     if let Some(w) = &r.waiting_for {
         let _ = writeln!(
             t,
