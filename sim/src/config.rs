@@ -32,7 +32,8 @@ pub struct RunConfig {
     /// The vehicle's circle model the stack checks. Default: the vehicle's own fit.
     pub collision_model: CollisionModelConfig,
     /// Faults injected between the world and the stack (`crate::faults`): lost revolutions,
-    /// beam dropout, dead beams, range noise, spurious returns. None by default.
+    /// beam dropout, dead beams, range noise, spurious returns, pose bias and drift. None by
+    /// default.
     pub faults: FaultsConfig,
 }
 

@@ -1,6 +1,7 @@
 //! Faults injected between the world and the stack under test: revolutions lost (singly or in
-//! bursts), beams that drop out (at random, or dead for the whole run), extra range noise, and
-//! spurious returns (rain- or dust-like, near the sensor). Every draw is seeded by the run's
+//! bursts), beams that drop out (at random, or dead for the whole run), extra range noise,
+//! spurious returns (rain- or dust-like, near the sensor), and a pose estimate biased or drifting
+//! beyond its source's own error. Every draw is seeded by the run's
 //! seed and the revolution's index, so a run with faults is as reproducible as one without.
 
 use mapper::{Return, Scan};
@@ -25,6 +26,14 @@ pub struct FaultsConfig {
     /// Mean number of spurious returns a revolution (Poisson): points 1-15 m from the sensor in
     /// random columns and beams, where a raindrop or dust would answer. Default 0.
     pub spurious_returns_per_revolution: f64,
+    /// A constant error of the pose estimate beyond the pose source's own, in the vehicle frame:
+    /// `[along, across]` metres (positive: the estimate is ahead, left of the truth). Default 0.
+    pub pose_bias_m: [f64; 2],
+    /// A constant heading error of the estimate, radians. Default 0.
+    pub pose_bias_rad: f64,
+    /// An across-track error growing with time (a localizer drifting off), metres per second.
+    /// Default 0.
+    pub pose_drift_m_per_s: f64,
 }
 
 impl Default for FaultsConfig {
@@ -36,6 +45,9 @@ impl Default for FaultsConfig {
             dead_beams: Vec::new(),
             extra_range_noise_m: 0.0,
             spurious_returns_per_revolution: 0.0,
+            pose_bias_m: [0.0, 0.0],
+            pose_bias_rad: 0.0,
+            pose_drift_m_per_s: 0.0,
         }
     }
 }
@@ -90,6 +102,23 @@ impl FaultsConfig {
     /// Whether any fault is on.
     pub fn any(&self) -> bool {
         *self != FaultsConfig::default()
+    }
+
+    /// The pose estimate at `t_s` with the pose faults applied (`estimate` unchanged without).
+    pub fn bias_pose(
+        &self,
+        t_s: f64,
+        estimate: &nalgebra::Isometry2<f64>,
+    ) -> nalgebra::Isometry2<f64> {
+        let across = self.pose_bias_m[1] + self.pose_drift_m_per_s * t_s;
+        if self.pose_bias_m[0] == 0.0 && across == 0.0 && self.pose_bias_rad == 0.0 {
+            return *estimate;
+        }
+        estimate
+            * nalgebra::Isometry2::new(
+                nalgebra::Vector2::new(self.pose_bias_m[0], across),
+                self.pose_bias_rad,
+            )
     }
 }
 
@@ -187,6 +216,29 @@ pub fn degrade(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_pose_bias_is_in_the_vehicle_frame_and_a_drift_grows_with_time() {
+        use nalgebra::{Isometry2, Vector2};
+        let truth = Isometry2::new(Vector2::new(10.0, 5.0), std::f64::consts::FRAC_PI_2);
+        assert_eq!(FaultsConfig::default().bias_pose(3.0, &truth), truth);
+        let f = FaultsConfig {
+            pose_bias_m: [0.5, 0.2],
+            pose_drift_m_per_s: 0.01,
+            ..FaultsConfig::default()
+        };
+        // Heading north: ahead is +y, left is -x; at 10 s the drift adds 0.1 m to the left.
+        let e = f.bias_pose(10.0, &truth);
+        assert!((e.translation.x - (10.0 - 0.3)).abs() < 1e-12, "{e}");
+        assert!((e.translation.y - 5.5).abs() < 1e-12, "{e}");
+        assert!((e.rotation.angle() - truth.rotation.angle()).abs() < 1e-12);
+        let turned = FaultsConfig {
+            pose_bias_rad: 0.05,
+            ..FaultsConfig::default()
+        }
+        .bias_pose(0.0, &truth);
+        assert!((turned.rotation.angle() - truth.rotation.angle() - 0.05).abs() < 1e-12);
+    }
 
     #[test]
     fn bursts_lose_consecutive_revolutions_at_the_rate_asked_and_the_same_ones_each_run() {

@@ -195,7 +195,11 @@ impl<'a> Rig<'a> {
                 speed_m_s: self.state.speed_m_s,
                 steering_rad: self.state.steering_rad,
             });
-            if let Some(estimate) = self.pose_source.publish(self.t_s, &truth) {
+            if let Some(mut estimate) = self.pose_source.publish(self.t_s, &truth) {
+                estimate.world_from_vehicle = self
+                    .config
+                    .faults
+                    .bias_pose(self.t_s, &estimate.world_from_vehicle);
                 self.driver.on_pose(estimate);
             }
             if self.step.is_multiple_of(self.steps_per_scan) {
