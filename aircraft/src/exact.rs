@@ -212,6 +212,22 @@ impl Comparison {
         }
     }
 
+    /// Adds the counts of `other` (poses checked elsewhere) to these.
+    pub fn absorb(&mut self, other: &Comparison) {
+        let first = self.poses == 0;
+        self.poses += other.poses;
+        self.exact_collisions += other.exact_collisions;
+        self.circle_collisions += other.circle_collisions;
+        self.false_alarms += other.false_alarms;
+        self.misses += other.misses;
+        self.misses_beyond_lookup += other.misses_beyond_lookup;
+        self.max_excess_m = if first {
+            other.max_excess_m
+        } else {
+            self.max_excess_m.max(other.max_excess_m)
+        };
+    }
+
     /// False alarms per pose the exact reference finds clear (0 when there is none).
     pub fn false_alarm_rate(&self) -> f64 {
         let clear = self.poses - self.exact_collisions;

@@ -11,7 +11,7 @@
 pub mod draw;
 pub mod probe;
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -199,7 +199,9 @@ pub fn figures(
     opts: TuneOptions,
     progress: &dyn Fn(usize, usize),
 ) -> Result<Vec<SettingFigures>> {
-    let mut maps_by_key: HashMap<(String, String), Vec<mapper::DistanceMaps>> = HashMap::new();
+    // By map directory: its name is the digest of everything the map depends on (its settings
+    // included), so settings that share a directory share the maps.
+    let mut maps_by_dir: HashMap<std::path::PathBuf, Vec<mapper::DistanceMaps>> = HashMap::new();
     let vehicle = &campaign.base().vehicle.vehicle;
     let mut out = Vec::new();
     let n = campaign.settings.len();
@@ -219,18 +221,14 @@ pub fn figures(
         f.map_bytes = heights.len() as u64 * cells * 12;
         f.heights_m = heights.clone();
         if let Some((scenario, map_dir)) = setting_world(campaign, dir, records, setting)? {
-            let key = (
-                map_dir.display().to_string(),
-                format!("{:?}", config.mapping.map),
-            );
-            if !maps_by_key.contains_key(&key) {
+            if !maps_by_dir.contains_key(&map_dir) {
                 let maps = probe::distance_maps(&scenario, &config, &map_dir)?;
-                maps_by_key.insert(key.clone(), maps);
+                maps_by_dir.insert(map_dir.clone(), maps);
             }
             let footprints = vehicle.fit_with(&heights, &aircraft::FitOptions::default())?;
             let exact = aircraft::exact::ExactModel::from_fit(&footprints);
             f.probe = probe::probe_all(
-                &maps_by_key[&key],
+                &maps_by_dir[&map_dir],
                 &model,
                 &exact,
                 opts.poses,
@@ -454,14 +452,6 @@ fn write_recommended(campaign: &Campaign, dir: &Path, setting: usize) -> Result<
         model.circles().len()
     );
     draw::model(&out, "model", &title, &footprints, &model)
-}
-
-/// The parameters of a setting, by path (for tests and the CLI).
-pub fn parameters(campaign: &Campaign, setting: usize) -> BTreeMap<String, String> {
-    campaign.settings[setting]
-        .iter()
-        .map(|(k, v)| (k.clone(), v.to_string()))
-        .collect()
 }
 
 #[cfg(test)]

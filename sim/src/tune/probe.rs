@@ -158,30 +158,18 @@ pub fn probe_all(
     safety_m: f64,
 ) -> Result<Probe> {
     let mut total = Probe::default();
-    let mut n = 0usize;
     for (k, m) in maps.iter().enumerate() {
         let poses = poses_near_obstacles(m, model, per_map, seed.wrapping_add(k as u64));
         if poses.is_empty() {
             continue;
         }
         let p = probe(m, model, exact, &poses, safety_m)?;
-        let c = &mut total.comparison;
-        let d = &p.comparison;
-        c.poses += d.poses;
-        c.exact_collisions += d.exact_collisions;
-        c.circle_collisions += d.circle_collisions;
-        c.false_alarms += d.false_alarms;
-        c.misses += d.misses;
-        c.misses_beyond_lookup += d.misses_beyond_lookup;
-        c.max_excess_m = if n == 0 {
-            d.max_excess_m
-        } else {
-            c.max_excess_m.max(d.max_excess_m)
-        };
-        total.circle_ns += p.circle_ns * d.poses as f64;
-        total.exact_ns += p.exact_ns * d.poses as f64;
-        n += d.poses;
+        total.comparison.absorb(&p.comparison);
+        let w = p.comparison.poses as f64;
+        total.circle_ns += p.circle_ns * w;
+        total.exact_ns += p.exact_ns * w;
     }
+    let n = total.comparison.poses;
     if n > 0 {
         total.circle_ns /= n as f64;
         total.exact_ns /= n as f64;
