@@ -341,8 +341,8 @@ pub fn loop_figures(
     progress: &mut dyn FnMut(&str),
 ) -> crate::Result<Vec<Figure>> {
     let scenario = crate::scenario::Scenario::from_file(scenario)?;
-    let map_dir = &crate::mapping::default_map_dir(&scenario);
     let config = crate::config::RunConfig::default();
+    let map_dir = &crate::mapping::default_map_dir(&scenario, &config);
     if crate::mapping::fresh_manifest(&scenario, &config, map_dir)?.is_none() {
         progress("mapping drive");
         crate::mapping::map_drive(&scenario, &config, map_dir, &mut |_, _| {})?;

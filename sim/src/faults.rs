@@ -1,8 +1,9 @@
 //! Faults injected between the world and the stack under test: revolutions lost (singly or in
-//! bursts), beams that drop out (at random, or dead for the whole run), extra range noise,
-//! spurious returns (rain- or dust-like, near the sensor), and a pose estimate biased or drifting
-//! beyond its source's own error. Every draw is seeded by the run's
-//! seed and the revolution's index, so a run with faults is as reproducible as one without.
+//! bursts) or delivered late (latency and jitter), beams that drop out (at random, or dead for the
+//! whole run), extra range noise, spurious returns (rain- or dust-like, near the sensor), a pose
+//! estimate biased or drifting beyond its source's own error, and a stale offline map (the
+//! mapping drive made with static objects moved, missing or extra). Every draw is seeded by the
+//! run's seed and the revolution's index, so a run with faults is as reproducible as one without.
 
 use mapper::{Return, Scan};
 use nalgebra::{Point3, Vector3};
@@ -34,6 +35,39 @@ pub struct FaultsConfig {
     /// An across-track error growing with time (a localizer drifting off), metres per second.
     /// Default 0.
     pub pose_drift_m_per_s: f64,
+    /// Time from a revolution's end to its delivery to the stack, seconds. Default 0.
+    pub lidar_latency_s: f64,
+    /// Extra delay drawn uniformly in `[0, lidar_jitter_s]` for each revolution, seconds
+    /// (revolutions still arrive in order). Default 0.
+    pub lidar_jitter_s: f64,
+    /// How the world of the mapping drive differed from the run's. Default: not at all.
+    pub stale_map: StaleMap,
+}
+
+/// A stale offline map: the mapping drive was made in a world whose movable static objects
+/// (cones, containers, markers, parked cars, debris, vehicles; not buildings, lamp posts or
+/// plain boxes and cylinders, which scenarios use for structures) stood elsewhere, were missing, or had company that
+/// has since gone. Seeded by the scenario's seed (the map's own).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct StaleMap {
+    /// Each movable object stood this far from where it stands now, in a seeded direction,
+    /// metres. Default 0.
+    pub moved_m: f64,
+    /// The fraction of movable objects (seeded choice) that were not there yet: the map does not
+    /// know them. Default 0.
+    pub removed_fraction: f64,
+    /// Objects that stood near the route at the mapping drive and are gone now: ghosts in the
+    /// map. Each a copy of a movable object of the scenario (a cone if it has none), within 4 m
+    /// of the route's centre line. Default 0.
+    pub added_objects: u32,
+}
+
+impl StaleMap {
+    /// Whether the map is stale at all.
+    pub fn any(&self) -> bool {
+        *self != StaleMap::default()
+    }
 }
 
 impl Default for FaultsConfig {
@@ -48,6 +82,9 @@ impl Default for FaultsConfig {
             pose_bias_m: [0.0, 0.0],
             pose_bias_rad: 0.0,
             pose_drift_m_per_s: 0.0,
+            lidar_latency_s: 0.0,
+            lidar_jitter_s: 0.0,
+            stale_map: StaleMap::default(),
         }
     }
 }
@@ -63,6 +100,9 @@ pub struct FaultCounts {
     pub spurious_returns: u64,
     /// Times the stack's watchdog stopped the vehicle for want of a fresh revolution.
     pub watchdog_stops: u64,
+    /// Revolutions delivered late (latency or jitter above 0).
+    #[serde(default)]
+    pub delayed_revolutions: u64,
 }
 
 impl FaultsConfig {
@@ -91,12 +131,37 @@ impl FaultsConfig {
                 "faults.spurious_returns_per_revolution",
                 self.spurious_returns_per_revolution,
             ),
+            ("faults.lidar_latency_s", self.lidar_latency_s),
+            ("faults.lidar_jitter_s", self.lidar_jitter_s),
+            ("faults.stale_map.moved_m", self.stale_map.moved_m),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("{field} = {v}: must be a finite number >= 0"));
             }
         }
+        let removed = self.stale_map.removed_fraction;
+        if !(0.0..=1.0).contains(&removed) {
+            return Err(format!(
+                "faults.stale_map.removed_fraction = {removed}: must be a fraction in [0, 1]"
+            ));
+        }
+        if self.lidar_latency_s + self.lidar_jitter_s > 10.0 {
+            return Err(format!(
+                "faults.lidar_latency_s + faults.lidar_jitter_s = {} s: at most 10 s",
+                self.lidar_latency_s + self.lidar_jitter_s
+            ));
+        }
         Ok(())
+    }
+
+    /// How late revolution `index` reaches the stack, seconds (0 without latency or jitter).
+    pub fn delay_s(&self, seed: u64, index: u64) -> f64 {
+        let jitter = if self.lidar_jitter_s > 0.0 {
+            rng(seed, index, 3).random::<f64>() * self.lidar_jitter_s
+        } else {
+            0.0
+        };
+        self.lidar_latency_s + jitter
     }
 
     /// Whether any fault is on.
@@ -213,6 +278,82 @@ pub fn degrade(
     Scan::new(beams, scan.columns().to_vec(), returns)
 }
 
+/// The world of a stale map's mapping drive: `scene` (the run's static world) with its movable
+/// objects moved, some missing and ghosts added near `route`, as `stale` says, seeded by `seed`.
+/// The removed and moved objects keep their ids; ghosts are named `stale-ghost-<k>`.
+pub fn stale_scene(
+    scene: &crate::scene::Scene,
+    stale: &StaleMap,
+    seed: u64,
+    route: &autonomy::RoutePath,
+) -> crate::scene::Scene {
+    use crate::scene::{ObjectKind, SolidShape};
+    if !stale.any() {
+        return scene.clone();
+    }
+    let movable = |s: &crate::scene::Solid| {
+        !s.runtime
+            && matches!(
+                s.kind,
+                ObjectKind::Cone
+                    | ObjectKind::Container
+                    | ObjectKind::Marker
+                    | ObjectKind::ParkedCar
+                    | ObjectKind::Debris
+                    | ObjectKind::Vehicle
+            )
+    };
+    let mut r = rng(seed, 0, 4);
+    let mut out = scene.clone();
+    out.solids.clear();
+    for solid in &scene.solids {
+        if !movable(solid) {
+            out.solids.push(solid.clone());
+            continue;
+        }
+        // Drawn for every movable object whatever the settings, so one setting's draws do not
+        // shift another's.
+        let (missing, angle) = (
+            r.random::<f64>(),
+            r.random_range(0.0..std::f64::consts::TAU),
+        );
+        if missing < stale.removed_fraction {
+            continue;
+        }
+        let mut moved = solid.clone();
+        moved.x_m += stale.moved_m * angle.cos();
+        moved.y_m += stale.moved_m * angle.sin();
+        out.solids.push(moved);
+    }
+    let models: Vec<&crate::scene::Solid> = scene.solids.iter().filter(|s| movable(s)).collect();
+    for k in 0..stale.added_objects {
+        let (p, heading) = route.at(r.random_range(0.0..=route.length_m()));
+        let across = r.random_range(-4.0..=4.0);
+        let at = p + nalgebra::Vector2::new(-heading.sin(), heading.cos()) * across;
+        let mut ghost = match models.get(r.random_range(0..models.len().max(1))) {
+            Some(model) => (*model).clone(),
+            None => crate::scene::Solid {
+                id: String::new(),
+                kind: ObjectKind::Cone,
+                shape: SolidShape::Cone {
+                    radius_m: 0.2,
+                    height_m: 0.7,
+                },
+                x_m: 0.0,
+                y_m: 0.0,
+                z_min_m: 0.0,
+                yaw_rad: 0.0,
+                remission: 0.6,
+                runtime: false,
+            },
+        };
+        ghost.id = format!("stale-ghost-{k}");
+        (ghost.x_m, ghost.y_m) = (at.x, at.y);
+        out.solids.push(ghost);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -238,6 +379,113 @@ mod tests {
         }
         .bias_pose(0.0, &truth);
         assert!((turned.rotation.angle() - truth.rotation.angle() - 0.05).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_stale_scene_moves_drops_and_adds_only_movable_objects_the_same_way_each_time() {
+        use crate::scene::{ObjectKind, Scene, Solid, SolidShape};
+        use nalgebra::Point2;
+        let solid = |id: &str, kind, x_m| Solid {
+            id: id.into(),
+            kind,
+            shape: SolidShape::Box {
+                size_m: [1.0, 1.0, 1.0],
+            },
+            x_m,
+            y_m: 10.0,
+            z_min_m: 0.0,
+            yaw_rad: 0.0,
+            remission: 0.5,
+            runtime: false,
+        };
+        let mut solids: Vec<Solid> = (0..40)
+            .map(|k| solid(&format!("car{k}"), ObjectKind::ParkedCar, k as f64))
+            .collect();
+        solids.push(solid("hangar", ObjectKind::Building, 100.0));
+        let scene = Scene {
+            min_m: [-10.0, -10.0],
+            max_m: [200.0, 50.0],
+            solids,
+            ..Scene::default()
+        };
+        let route =
+            autonomy::RoutePath::new(&[Point2::new(0.0, 0.0), Point2::new(100.0, 0.0)], false);
+        assert_eq!(stale_scene(&scene, &StaleMap::default(), 1, &route), scene);
+        let moved = stale_scene(
+            &scene,
+            &StaleMap {
+                moved_m: 2.0,
+                ..StaleMap::default()
+            },
+            1,
+            &route,
+        );
+        for (a, b) in scene.solids.iter().zip(&moved.solids) {
+            let d = ((a.x_m - b.x_m).powi(2) + (a.y_m - b.y_m).powi(2)).sqrt();
+            let want = if a.kind == ObjectKind::Building {
+                0.0
+            } else {
+                2.0
+            };
+            assert!((d - want).abs() < 1e-9, "{} moved {d}", a.id);
+        }
+        let stale = StaleMap {
+            removed_fraction: 0.5,
+            added_objects: 6,
+            ..StaleMap::default()
+        };
+        let a = stale_scene(&scene, &stale, 1, &route);
+        assert_eq!(a, stale_scene(&scene, &stale, 1, &route));
+        assert_ne!(a, stale_scene(&scene, &stale, 2, &route));
+        assert!(a.solids.iter().any(|s| s.id == "hangar"));
+        let kept = a.solids.iter().filter(|s| s.id.starts_with("car")).count();
+        assert!(
+            (10..=30).contains(&kept),
+            "{kept} of 40 kept at a fraction 0.5 removed"
+        );
+        let ghosts: Vec<_> = a
+            .solids
+            .iter()
+            .filter(|s| s.id.starts_with("stale-ghost-"))
+            .collect();
+        assert_eq!(ghosts.len(), 6);
+        for g in ghosts {
+            assert_eq!(g.kind, ObjectKind::ParkedCar);
+            assert!(
+                (-1e-9..=100.0 + 1e-9).contains(&g.x_m) && g.y_m.abs() <= 4.0 + 1e-9,
+                "{g:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn latency_and_jitter_delay_every_revolution_within_their_bounds() {
+        let f = FaultsConfig {
+            lidar_latency_s: 0.1,
+            lidar_jitter_s: 0.05,
+            ..FaultsConfig::default()
+        };
+        let delays: Vec<f64> = (0..1000).map(|i| f.delay_s(3, i)).collect();
+        assert!(delays.iter().all(|d| (0.1..=0.15).contains(d)));
+        let mean = delays.iter().sum::<f64>() / 1000.0;
+        assert!((mean - 0.125).abs() < 0.003, "{mean}");
+        assert_eq!(
+            delays,
+            (0..1000).map(|i| f.delay_s(3, i)).collect::<Vec<_>>()
+        );
+        assert_eq!(FaultsConfig::default().delay_s(3, 5), 0.0);
+        let bad = FaultsConfig {
+            stale_map: StaleMap {
+                removed_fraction: 2.0,
+                ..StaleMap::default()
+            },
+            ..FaultsConfig::default()
+        };
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .contains("faults.stale_map.removed_fraction")
+        );
     }
 
     #[test]

@@ -47,7 +47,8 @@ pub fn map_config(config: &RunConfig) -> MapConfig {
 }
 
 /// Fingerprint of a scenario's offline map inputs: the scenario and vehicle files, the levels
-/// (heights and ceiling), the map and LiDAR settings of `config`, the format.
+/// (heights and ceiling), the map and LiDAR settings of `config`, a stale map's faults, the
+/// format.
 pub fn fingerprint(scenario: &Scenario, config: &RunConfig) -> Result<String> {
     let mut h = crc32fast::Hasher::new();
     h.update(&std::fs::read(&scenario.path).map_err(|source| Error::Io {
@@ -58,6 +59,9 @@ pub fn fingerprint(scenario: &Scenario, config: &RunConfig) -> Result<String> {
     h.update(format!("{:?}", scenario.vehicle.vehicle).as_bytes());
     h.update(format!("{:?}", levels_of(scenario, config)?).as_bytes());
     h.update(format!("{:?}{:?}{MAP_FORMAT}", map_config(config), config.lidar).as_bytes());
+    if config.faults.stale_map.any() {
+        h.update(format!("{:?}", config.faults.stale_map).as_bytes());
+    }
     Ok(format!("{:08x}", h.finalize()))
 }
 
@@ -187,7 +191,13 @@ pub fn map_drive(
     }
     let route = RoutePath::new(&scenario.route.waypoints_m, scenario.route.closed);
     let start = scenario.vehicle.world_from_start;
-    let mut world = World::new(&scenario.scene(false), false, vehicle, &start);
+    let scene = crate::faults::stale_scene(
+        &scenario.scene(false),
+        &config.faults.stale_map,
+        scenario.seed,
+        &route,
+    );
+    let mut world = World::new(&scene, false, vehicle, &start);
     let lidar = Lidar::new(config.lidar.clone(), vehicle.vehicle_from_lidar()).map_err(|e| {
         Error::Config {
             origin: "lidar".into(),
@@ -296,11 +306,21 @@ fn export_levels(
     Ok(occupied)
 }
 
-/// Where a scenario's offline map lives by default: `out/maps/<scenario file stem>`.
-pub fn default_map_dir(scenario: &Scenario) -> PathBuf {
+/// Where a scenario's offline map lives by default: `out/maps/<scenario file stem>`, or
+/// `out/maps/<stem>-stale-<digest>` for a stale map's faults (so the good map stays).
+pub fn default_map_dir(scenario: &Scenario, config: &RunConfig) -> PathBuf {
     let stem = scenario
         .path
         .file_stem()
         .map_or_else(|| "scenario".into(), |s| s.to_string_lossy().into_owned());
-    PathBuf::from("out").join("maps").join(stem)
+    let stale = &config.faults.stale_map;
+    let name = if stale.any() {
+        format!(
+            "{stem}-stale-{:08x}",
+            crc32fast::hash(format!("{stale:?}").as_bytes())
+        )
+    } else {
+        stem
+    };
+    PathBuf::from("out").join("maps").join(name)
 }

@@ -160,6 +160,8 @@ struct Rig<'a> {
     fault_counts: crate::faults::FaultCounts,
     /// Whether the watchdog held the vehicle at the last step.
     watchdog_holding: bool,
+    /// Revolutions taken and not yet delivered (LiDAR latency): when each is due, in order.
+    in_transit: std::collections::VecDeque<(f64, Captured)>,
     /// The live map's scratch directory, removed with the rig.
     _live: tempfile::TempDir,
 }
@@ -205,6 +207,7 @@ impl<'a> Rig<'a> {
             if self.step.is_multiple_of(self.steps_per_scan) {
                 self.revolution(tasks, &truth, observer)?;
             }
+            self.deliver_due(tasks, observer)?;
             let holding = self.driver.watchdog_tripped();
             if holding != self.watchdog_holding {
                 self.watchdog_holding = holding;
@@ -247,7 +250,8 @@ impl<'a> Rig<'a> {
         Ok(EndReason::Completed)
     }
 
-    /// A revolution: taken, mapped and planned from as the schedule says, shown to the observer.
+    /// A revolution: taken, then (at once, or when its latency has passed) mapped and planned
+    /// from as the schedule says, shown to the observer.
     fn revolution<'s>(
         &mut self,
         tasks: &rayon::Scope<'s>,
@@ -257,7 +261,6 @@ impl<'a> Rig<'a> {
         let Some(estimate) = self.driver.estimate().map(|e| e.world_from_vehicle) else {
             return Ok(());
         };
-        let (world, lidar) = (&self.world, &self.lidar);
         let (index, seed, t_s) = (self.step / self.steps_per_scan, self.seed, self.t_s);
         let faults = &self.config.faults;
         if faults.any() && self.lost.is_lost(faults, seed, index) {
@@ -265,35 +268,62 @@ impl<'a> Rig<'a> {
             self.fault_counts.lost_revolutions += 1;
             return Ok(());
         }
-        self.driver.on_revolution(t_s);
-        let (dropped, spurious) = (&self.dropped_returns, &self.spurious_returns);
-        let capture = || -> Result<Captured> {
-            let t0 = Instant::now();
-            let mut taken = lidar.scan(world, &SweepPoses::still(*truth), index, seed);
-            if faults.any() {
-                let mut counts = crate::faults::FaultCounts::default();
-                taken.scan = crate::faults::degrade(&taken.scan, faults, seed, index, &mut counts)?;
-                taken.owners.truncate(0);
-                dropped.fetch_add(counts.dropped_returns, Ordering::Relaxed);
-                spurious.fetch_add(counts.spurious_returns, Ordering::Relaxed);
-            }
-            let scan = if estimate == *truth {
-                taken.scan
-            } else {
-                reexpress(&taken.scan, truth, &estimate)?
-            };
-            Ok(Captured {
-                revolution: LidarRevolution {
-                    t_s,
-                    scan,
-                    world_from_vehicle_estimate: estimate,
-                },
-                owners: taken.owners,
-                truth: *truth,
-                lidar_s: t0.elapsed().as_secs_f64(),
-            })
+        let sensor = Sensor {
+            world: &self.world,
+            lidar: &self.lidar,
+            faults,
+            seed,
+            dropped: &self.dropped_returns,
+            spurious: &self.spurious_returns,
         };
+        let delay_s = faults.delay_s(seed, index);
+        if delay_s > 0.0 {
+            // Cast now, in the world as it is now; delivered later, in order.
+            let captured = sensor.capture(truth, &estimate, index, t_s)?;
+            let last = self.in_transit.back().map_or(0.0, |(at, _)| *at);
+            self.in_transit
+                .push_back(((t_s + delay_s).max(last), captured));
+            self.fault_counts.delayed_revolutions += 1;
+            return Ok(());
+        }
+        self.driver.on_revolution(t_s);
+        let capture = || sensor.capture(truth, &estimate, index, t_s);
         let (lidar_s, thought) = self.scheduler.revolution(capture, &mut self.driver)?;
+        self.planned(tasks, lidar_s, thought, observer)
+    }
+
+    /// Delivers the late revolutions whose time has come.
+    fn deliver_due<'s>(
+        &mut self,
+        tasks: &rayon::Scope<'s>,
+        observer: &mut (dyn Observer + Send),
+    ) -> Result<()> {
+        while self
+            .in_transit
+            .front()
+            .is_some_and(|(at, _)| *at <= self.t_s + 1e-9)
+        {
+            let Some((_, captured)) = self.in_transit.pop_front() else {
+                break;
+            };
+            // The watchdog counts a revolution's age from when it was taken.
+            self.driver.on_revolution(captured.revolution.t_s);
+            let (lidar_s, thought) = self
+                .scheduler
+                .revolution(move || Ok(captured), &mut self.driver)?;
+            self.planned(tasks, lidar_s, thought, observer)?;
+        }
+        Ok(())
+    }
+
+    /// After a revolution's plan: accounts, shows, and (overlapped) starts mapping the next.
+    fn planned<'s>(
+        &mut self,
+        tasks: &rayon::Scope<'s>,
+        lidar_s: f64,
+        thought: Option<Thought>,
+        observer: &mut (dyn Observer + Send),
+    ) -> Result<()> {
         self.split.lidar += lidar_s;
         if let Some(thought) = thought {
             self.show(&thought, observer)?;
@@ -360,6 +390,8 @@ impl<'a> Rig<'a> {
         self.judge.restart_lap();
         self.driver.restart();
         self.pose_source.reset();
+        // Revolutions of the last lap still in transit would carry its poses into this one.
+        self.in_transit.clear();
         self.world
             .set_vehicle_pose(&self.state.world_from_vehicle(), self.t_s);
     }
@@ -402,6 +434,59 @@ fn reexpress(
         })
         .collect();
     Ok(mapper::Scan::new(scan.beams(), columns, returns)?)
+}
+
+/// What a revolution is cast with: the world, the LiDAR, and the faults between them.
+struct Sensor<'r> {
+    world: &'r World,
+    lidar: &'r Lidar,
+    faults: &'r crate::faults::FaultsConfig,
+    seed: u64,
+    /// Fault counters (the casts may run on another thread).
+    dropped: &'r std::sync::atomic::AtomicU64,
+    spurious: &'r std::sync::atomic::AtomicU64,
+}
+
+impl Sensor<'_> {
+    /// Revolution `index`, taken at `t_s` from the true pose, degraded by the faults, its points
+    /// where a mapper at `estimate` would put them.
+    fn capture(
+        &self,
+        truth: &Isometry2<f64>,
+        estimate: &Isometry2<f64>,
+        index: u64,
+        t_s: f64,
+    ) -> Result<Captured> {
+        let t0 = Instant::now();
+        let mut taken = self
+            .lidar
+            .scan(self.world, &SweepPoses::still(*truth), index, self.seed);
+        if self.faults.any() {
+            let mut counts = crate::faults::FaultCounts::default();
+            taken.scan =
+                crate::faults::degrade(&taken.scan, self.faults, self.seed, index, &mut counts)?;
+            taken.owners.truncate(0);
+            self.dropped
+                .fetch_add(counts.dropped_returns, Ordering::Relaxed);
+            self.spurious
+                .fetch_add(counts.spurious_returns, Ordering::Relaxed);
+        }
+        let scan = if estimate == truth {
+            taken.scan
+        } else {
+            reexpress(&taken.scan, truth, estimate)?
+        };
+        Ok(Captured {
+            revolution: LidarRevolution {
+                t_s,
+                scan,
+                world_from_vehicle_estimate: *estimate,
+            },
+            owners: taken.owners,
+            truth: *truth,
+            lidar_s: t0.elapsed().as_secs_f64(),
+        })
+    }
 }
 
 impl<'a> Rig<'a> {
@@ -517,6 +602,7 @@ impl<'a> Rig<'a> {
             spurious_returns: Default::default(),
             fault_counts: crate::faults::FaultCounts::default(),
             watchdog_holding: false,
+            in_transit: std::collections::VecDeque::new(),
             config,
             _live: live,
         })

@@ -430,3 +430,82 @@ fn the_car_copes_with_dropout_dead_beams_noise_and_spurious_returns() {
     );
     assert!(r.contacts.is_empty() && r.expectations_met, "{r:#?}");
 }
+
+/// LiDAR latency: every revolution 0.2 s late (taken in the world as it was, mapped at the pose
+/// it was taken from). The car still passes over the cone under its wing and the jet still stops
+/// for the cone on its centreline and goes on once it is towed away; the watchdog, which ages a
+/// revolution from when it was taken, never holds (0.2 s + 0.1 s between revolutions is within
+/// its 0.3 s).
+#[test]
+fn the_stack_meets_its_expectations_with_revolutions_two_tenths_late() {
+    for name in ["straight_cone_under_wing", "cone_in_path_jet"] {
+        let dir = tempfile::tempdir().unwrap();
+        let r = run_scenario_with(name, dir.path(), |mut c| {
+            c.faults.lidar_latency_s = 0.2;
+            c
+        });
+        assert!(
+            r.contacts.is_empty() && r.expectations_met,
+            "{name}: {r:#?}"
+        );
+        // Every revolution (one at t = 0, then one every 0.1 s) but those still in transit at the
+        // end.
+        let taken = (r.sim_time_s * 10.0 + 1e-6).floor() as u64 + 1;
+        assert!(
+            (taken - 3..=taken).contains(&r.faults.delayed_revolutions),
+            "{name}: {} delayed of {taken}",
+            r.faults.delayed_revolutions
+        );
+        assert_eq!(r.faults.watchdog_stops, 0, "{name}");
+    }
+}
+
+/// Latency beyond the watchdog: 0.25 s plus up to 0.1 s of jitter makes most revolutions older
+/// than 0.3 s when they arrive. The watchdog holds the car again and again, it never gets far,
+/// and it touches nothing: it stops rather than drives on stale scans.
+#[test]
+fn revolutions_older_than_the_watchdog_allows_hold_the_car() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = run_scenario_with("straight_cone_under_wing", dir.path(), |mut c| {
+        c.faults.lidar_latency_s = 0.25;
+        c.faults.lidar_jitter_s = 0.1;
+        c
+    });
+    assert!(r.faults.watchdog_stops >= 100, "{:?}", r.faults);
+    assert!(r.contacts.is_empty(), "{r:#?}");
+    assert_eq!(r.end, EndReason::TimedOut);
+}
+
+/// A stale offline map: at the mapping drive half the parked cars of the parking lot were not
+/// there yet, the rest stood 2 m from where they stand now, and eight cars stood within 4 m of
+/// the route that have gone since. The map differs (fewer occupied cells), and the car still
+/// drives its lap meeting every expectation and touching nothing: what it sees overrules the
+/// map.
+#[test]
+fn the_car_drives_the_parking_lot_on_a_stale_map() {
+    let s = scenario("parking_lot");
+    let mut config = RunConfig::default();
+    config.faults.stale_map = sim::faults::StaleMap {
+        moved_m: 2.0,
+        removed_fraction: 0.5,
+        added_objects: 8,
+    };
+    let (good, stale) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let g =
+        sim::mapping::map_drive(&s, &RunConfig::default(), good.path(), &mut |_, _| {}).unwrap();
+    let m = sim::mapping::map_drive(&s, &config, stale.path(), &mut |_, _| {}).unwrap();
+    assert_ne!(g.fingerprint, m.fingerprint);
+    assert!(
+        m.occupied_cells[0] < g.occupied_cells[0],
+        "{:?} vs {:?}",
+        m.occupied_cells,
+        g.occupied_cells
+    );
+    let setup = RunSetup {
+        config,
+        laps: Some(1),
+        ..RunSetup::new(stale.path().to_path_buf())
+    };
+    let r = run(&s, &setup).unwrap();
+    assert!(r.contacts.is_empty() && r.expectations_met, "{r:#?}");
+}

@@ -243,10 +243,10 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
 }
 
 /// The static world's key: what the mapping drive depends on (world, static objects, patches,
-/// route, vehicle and start, seed, levels, map and LiDAR settings). Variants with the same key
-/// share one offline map.
+/// route, vehicle and start, seed, levels, map and LiDAR settings, a stale map's faults).
+/// Variants with the same key share one offline map.
 pub fn static_world_key(scenario: &Scenario, config: &RunConfig) -> Result<String> {
-    let text = format!(
+    let mut text = format!(
         "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}|{:?}|{:?}|{:?}",
         scenario.world,
         scenario.objects,
@@ -259,6 +259,9 @@ pub fn static_world_key(scenario: &Scenario, config: &RunConfig) -> Result<Strin
         crate::mapping::map_config(config),
         config.lidar,
     );
+    if config.faults.stale_map.any() {
+        text.push_str(&format!("|{:?}", config.faults.stale_map));
+    }
     Ok(format!(
         "{:08x}{:06x}",
         crc32fast::hash(text.as_bytes()),

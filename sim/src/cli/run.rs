@@ -117,11 +117,11 @@ fn build_map(
 /// Runs `taxi-sim map`.
 pub fn map(args: &MapArgs) -> anyhow::Result<()> {
     let scenario = Scenario::from_file(&args.scenario)?;
+    let config = RunConfig::for_scenario(&scenario, args.config.as_deref())?;
     let dir = args
         .out
         .clone()
-        .unwrap_or_else(|| default_map_dir(&scenario));
-    let config = RunConfig::for_scenario(&scenario, args.config.as_deref())?;
+        .unwrap_or_else(|| default_map_dir(&scenario, &config));
     let m = build_map(&scenario, &config, &dir)?;
     crate::emit(&format!(
         "{}: mapped {:.0} m with {} revolutions into {} blocks; occupied cells per level {:?} (levels at {:?} m)\nwrote {}\n",
@@ -148,7 +148,7 @@ pub fn run_cmd(args: &RunArgs) -> anyhow::Result<bool> {
     let dir = args
         .map_dir
         .clone()
-        .unwrap_or_else(|| default_map_dir(&scenario));
+        .unwrap_or_else(|| default_map_dir(&scenario, &config));
     if fresh_manifest(&scenario, &config, &dir)?.is_none() {
         eprintln!(
             "offline map {} is missing or stale: building it (mapping drive)",
@@ -282,8 +282,12 @@ pub fn table(r: &RunReport) -> String {
     if *f != sim::faults::FaultCounts::default() {
         let _ = writeln!(
             t,
-            "faults: {} revolutions lost, {} returns dropped, {} spurious returns; the watchdog held the vehicle {} times",
-            f.lost_revolutions, f.dropped_returns, f.spurious_returns, f.watchdog_stops
+            "faults: {} revolutions lost, {} delivered late, {} returns dropped, {} spurious returns; the watchdog held the vehicle {} times",
+            f.lost_revolutions,
+            f.delayed_revolutions,
+            f.dropped_returns,
+            f.spurious_returns,
+            f.watchdog_stops
         );
     }
     if let Some(w) = &r.waiting_for {
