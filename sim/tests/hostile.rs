@@ -283,6 +283,16 @@ const CASES: &[Case] = &[
         args: CONFIG,
         says: &[":1:", "unknown variant `whenever`"],
     },
+    Case {
+        file: "config_negative_latency.toml",
+        args: CONFIG,
+        says: &["faults.lidar_latency_s = -0.1", "finite number >= 0"],
+    },
+    Case {
+        file: "config_stale_fraction.toml",
+        args: CONFIG,
+        says: &["faults.stale_map.removed_fraction = 1.5", "fraction in [0, 1]"],
+    },
 ];
 
 fn corpus() -> PathBuf {
