@@ -422,6 +422,24 @@ fn bad_block_files_are_errors_that_name_the_file() {
     assert!(e.contains("block_0_0.tsmb"), "{e}");
     let e = open(b"");
     assert!(e.contains("block_0_0.tsmb") && e.contains("magic"), "{e}");
+    // A block of the uncompressed format 1 is refused with the remedy.
+    let mut v1 = good.clone();
+    v1[8..12].copy_from_slice(&1u32.to_le_bytes());
+    let e = open(&v1);
+    assert!(
+        e.contains("block_0_0.tsmb")
+            && e.contains("format version 1")
+            && e.contains("taxi-sim map"),
+        "{e}"
+    );
+    // The compressed body is smaller than the block it holds.
+    let side = map.block_spec().side;
+    let raw = (4 * 2 + 12) * side * side;
+    assert!(
+        good.len() * 4 < raw,
+        "{} bytes on disk for {raw}",
+        good.len()
+    );
     // A block of a map with other levels is refused by field name.
     std::fs::write(&path, &good).unwrap();
     let other = Levels::cumulative(vec![0.0, 0.5]).unwrap();
@@ -451,9 +469,6 @@ fn block_with_valid_checksum_and_non_finite_value_is_rejected() {
     map.save_live(&store).unwrap();
     let index = mapper::BlockIndex { x: 0, y: 0 };
     let path = store.path(index);
-    let good = std::fs::read(&path).unwrap();
-    let cells = spec.side * spec.side;
-    let header = 48 + 8 * levels.count();
     // A cell with remission samples (a ground return), so a zeroed count contradicts its sums.
     let original = map
         .live_blocks()
@@ -466,15 +481,11 @@ fn block_with_valid_checksum_and_non_finite_value_is_rejected() {
         .position(|r| r.count > 0 && r.sum != 0.0)
         .unwrap();
     let (row, column) = (cell / spec.side, cell % spec.side);
-    let log_odds_at = |k: usize| header + 4 * (k * cells + cell);
-    let remission_at = header + 4 * cells * levels.count() + 12 * cell;
-    // Writes `value` at byte `offset` with a recomputed (valid) checksum and loads the block.
-    let load = |offset: usize, value: [u8; 4]| {
-        let mut bytes = good.clone();
-        bytes[offset..offset + 4].copy_from_slice(&value);
-        let n = bytes.len();
-        let crc = crc32fast::hash(&bytes[..n - 4]);
-        bytes[n - 4..].copy_from_slice(&crc.to_le_bytes());
+    // Writes the block with one value edited (and so a valid checksum) and loads it.
+    let load = |edit: &dyn Fn(&mut mapper::Block)| {
+        let mut block = original.clone();
+        edit(&mut block);
+        let bytes = mapper::blocks::encode_block(&spec, &block).unwrap();
         std::fs::write(&path, &bytes).unwrap();
         store.load(index).map(|_| ()).map_err(|e| e.to_string())
     };
@@ -483,29 +494,29 @@ fn block_with_valid_checksum_and_non_finite_value_is_rejected() {
             && e.contains(field)
             && e.contains(&format!("cell {cell} (row {row}, column {column})"))
     };
-    let e = load(log_odds_at(1), f32::INFINITY.to_le_bytes()).unwrap_err();
+    let e = load(&|b| b.levels[1][cell] = f32::INFINITY).unwrap_err();
     assert!(
         names(&e, "`log_odds` of level 1") && e.contains("inf is infinite"),
         "{e}"
     );
-    let e = load(log_odds_at(0), f32::NEG_INFINITY.to_le_bytes()).unwrap_err();
+    let e = load(&|b| b.levels[0][cell] = f32::NEG_INFINITY).unwrap_err();
     assert!(names(&e, "`log_odds` of level 0"), "{e}");
-    let e = load(log_odds_at(0), 40.0f32.to_le_bytes()).unwrap_err();
+    let e = load(&|b| b.levels[0][cell] = 40.0).unwrap_err();
     assert!(
         names(&e, "`log_odds` of level 0") && e.contains("clamp") && e.contains("37"),
         "{e}"
     );
-    let e = load(remission_at, f32::NAN.to_le_bytes()).unwrap_err();
+    let e = load(&|b| b.remission[cell].sum = f32::NAN).unwrap_err();
     assert!(names(&e, "`remission.sum`"), "{e}");
-    let e = load(remission_at + 4, (-1.0f32).to_le_bytes()).unwrap_err();
+    let e = load(&|b| b.remission[cell].sum_sq = -1.0).unwrap_err();
     assert!(names(&e, "`remission.sum_sq`"), "{e}");
-    let e = load(remission_at + 8, 0u32.to_le_bytes()).unwrap_err();
+    let e = load(&|b| b.remission[cell].count = 0).unwrap_err();
     assert!(
         names(&e, "`remission.count`") && e.contains("0 samples"),
         "{e}"
     );
     // The map refuses to open over such a prior, naming the file too.
-    load(log_odds_at(1), f32::INFINITY.to_le_bytes()).unwrap_err();
+    load(&|b| b.levels[1][cell] = f32::INFINITY).unwrap_err();
     let err = MultiHeightMap::with_stores(
         MapConfig::default(),
         levels.clone(),
@@ -517,9 +528,9 @@ fn block_with_valid_checksum_and_non_finite_value_is_rejected() {
     .to_string();
     assert!(names(&err, "`log_odds` of level 1"), "{err}");
     // What a map can write still loads: unknown (NaN, any payload) and the clamp itself.
-    load(log_odds_at(1), f32::NAN.to_le_bytes()).unwrap();
-    load(log_odds_at(1), (-37.0f32).to_le_bytes()).unwrap();
-    load(log_odds_at(0), 37.0f32.to_le_bytes()).unwrap();
+    load(&|b| b.levels[1][cell] = f32::from_bits(0x7fc0_1234)).unwrap();
+    load(&|b| b.levels[1][cell] = -37.0).unwrap();
+    load(&|b| b.levels[0][cell] = 37.0).unwrap();
 }
 
 #[test]

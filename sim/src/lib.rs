@@ -20,6 +20,7 @@
 //! - [`error`]: the library's typed errors.
 
 pub mod bench;
+pub mod bench_blocks;
 pub mod campaign;
 pub mod config;
 pub mod demo;

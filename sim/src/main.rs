@@ -48,7 +48,7 @@ enum Command {
         /// Timed batches per figure (the median is reported).
         #[arg(long, default_value_t = 15)]
         samples: usize,
-        /// Scenario of `bench loop` (the 20x target is set on the parking lot).
+        /// Scenario of `bench loop` and `bench blocks` (the 20x target is set on the parking lot).
         #[arg(long, default_value = "scenarios/parking_lot.toml")]
         scenario: PathBuf,
         /// Laps of `bench loop` (default 1; 0: the scenario's own).
@@ -112,6 +112,9 @@ enum BenchTarget {
     /// A campaign's runs per hour against the same variants as separate `taxi-sim run`
     /// processes.
     Campaign,
+    /// The offline map of `--scenario` (built if missing): its blocks written and read in the
+    /// compressed format against the uncompressed one, and bytes per block.
+    Blocks,
 }
 
 /// Raised by [`emit`] when stdout's reader went away (`taxi-sim ... | head`): not an error.
@@ -275,6 +278,7 @@ fn bench(
         BenchTarget::Lidar => sim::bench::lidar_figures(samples, &mut report)?,
         BenchTarget::Loop => sim::bench::loop_figures(scenario, laps, &mut report)?,
         BenchTarget::Campaign => sim::campaign::bench::campaign_figures(campaign, &mut report)?,
+        BenchTarget::Blocks => sim::bench_blocks::figures_for(scenario, &mut report)?,
     };
     progress.finish_and_clear();
     let mut t = String::new();

@@ -19,8 +19,9 @@ use crate::lidar::{Lidar, SweepPoses};
 use crate::scenario::Scenario;
 use crate::world::World;
 
-/// Bumped when the mapping drive changes what it builds (2: the vehicle's ceiling).
-const MAP_FORMAT: u32 = 2;
+/// Bumped when the mapping drive changes what it builds (2: the vehicle's ceiling; 3: compressed
+/// blocks).
+const MAP_FORMAT: u32 = 3;
 
 /// What a mapping drive did.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]

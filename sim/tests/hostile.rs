@@ -291,7 +291,10 @@ const CASES: &[Case] = &[
     Case {
         file: "config_stale_fraction.toml",
         args: CONFIG,
-        says: &["faults.stale_map.removed_fraction = 1.5", "fraction in [0, 1]"],
+        says: &[
+            "faults.stale_map.removed_fraction = 1.5",
+            "fraction in [0, 1]",
+        ],
     },
 ];
 
@@ -408,14 +411,14 @@ fn corrupted_map_blocks_and_manifests_are_refused_naming_the_file() {
         blocks[0].clone()
     };
     type Corrupt = fn(&Path);
-    let cases: [(&str, Corrupt, &[&str]); 6] = [
+    let cases: [(&str, Corrupt, &[&str]); 7] = [
         (
             "truncated block",
             |p| {
                 let b = std::fs::read(p).unwrap();
-                std::fs::write(p, &b[..1000]).unwrap();
+                std::fs::write(p, &b[..b.len() - 100]).unwrap();
             },
-            &["truncated or padded: 1000 bytes"],
+            &["truncated or padded:", "its header says"],
         ),
         (
             "bad magic",
@@ -430,7 +433,8 @@ fn corrupted_map_blocks_and_manifests_are_refused_naming_the_file() {
             "flipped byte",
             |p| {
                 let mut b = std::fs::read(p).unwrap();
-                b[5000] ^= 0x40;
+                let middle = b.len() / 2;
+                b[middle] ^= 0x40;
                 std::fs::write(p, b).unwrap();
             },
             &["checksum mismatch"],
@@ -443,6 +447,15 @@ fn corrupted_map_blocks_and_manifests_are_refused_naming_the_file() {
                 std::fs::write(p, b).unwrap();
             },
             &["format version 0"],
+        ),
+        (
+            "block of the uncompressed format 1",
+            |p| {
+                let mut b = std::fs::read(p).unwrap();
+                b[8..12].copy_from_slice(&1u32.to_le_bytes());
+                std::fs::write(p, b).unwrap();
+            },
+            &["format version 1", "rebuild the map with `taxi-sim map`"],
         ),
         (
             "garbage manifest",
