@@ -14,26 +14,39 @@ fn insert(c: &mut Criterion) {
     });
 }
 
+/// The exact EDT on one thread and on every core, and the (single-threaded) chamfer: compare
+/// `exact/1_thread` with the chamfer, `exact/all_threads` with `exact/1_thread`.
 fn edt(c: &mut Criterion) {
     let mut group = c.benchmark_group("edt_1050x1050");
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap_or_else(|e| panic!("{e}"));
+    let all = rayon::ThreadPoolBuilder::new()
+        .build()
+        .unwrap_or_else(|e| panic!("{e}"));
     for (name, fraction) in [("sparse_0.1pct", 0.001), ("dense_2pct", 0.02)] {
         let mask = workloads::obstacle_mask(fraction, 1);
         let mut out = vec![0.0f32; 1050 * 1050];
         let mut scratch = EdtScratch::default();
-        group.bench_function(format!("exact/{name}"), |b| {
-            b.iter(|| {
-                exact_edt(
-                    1050,
-                    1050,
-                    0.2,
-                    30.0,
-                    |i| mask[i],
-                    &mut scratch,
-                    black_box(&mut out),
-                )
-            })
-        });
-        group.bench_function(format!("chamfer_3x3/{name}"), |b| {
+        for (threads, pool) in [("1_thread", &one), ("all_threads", &all)] {
+            group.bench_function(format!("exact/{threads}/{name}"), |b| {
+                b.iter(|| {
+                    pool.install(|| {
+                        exact_edt(
+                            1050,
+                            1050,
+                            0.2,
+                            30.0,
+                            |i| mask[i],
+                            &mut scratch,
+                            black_box(&mut out),
+                        )
+                    })
+                })
+            });
+        }
+        group.bench_function(format!("chamfer_3x3/1_thread/{name}"), |b| {
             b.iter(|| chamfer_3x3(1050, 1050, 0.2, 30.0, |i| mask[i], black_box(&mut out)))
         });
     }
@@ -50,6 +63,10 @@ fn check_pose(c: &mut Criterion) {
     });
     c.bench_function("check_pose/62_circles/far_from_obstacles", |b| {
         b.iter(|| black_box(checker.check_pose(black_box(&far), 0.2)))
+    });
+    // The same far pose without the early out.
+    c.bench_function("check_pose/62_circles/far_from_obstacles/full_check", |b| {
+        b.iter(|| black_box(checker.clearance(black_box(&far), 0.2)))
     });
 }
 

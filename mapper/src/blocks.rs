@@ -255,16 +255,61 @@ pub fn decode_block(spec: &BlockSpec, bytes: &[u8], path: &Path) -> Result<Block
             )));
         }
     }
-    let body = zstd::bulk::decompress(&bytes[header_len + 4..expected_len - 4], spec.body_len())
-        .map_err(|e| bad(format!("the compressed body does not decompress: {e}")))?;
-    if body.len() != spec.body_len() {
-        return Err(bad(format!(
-            "the body holds {} bytes once decompressed, a block of this map has {}",
-            body.len(),
-            spec.body_len()
-        )));
+    let block = decompress_body(spec, &bytes[header_len + 4..expected_len - 4], index)
+        .map_err(|e| bad(format!("the compressed body {e}")))?;
+    match bad_value(spec, &block) {
+        Some(why) => Err(bad(why)),
+        None => Ok(block),
     }
-    decode_body(spec, &body, index).map_err(bad)
+}
+
+/// Decompresses a body straight into the cell arrays of block `index` (no intermediate copy):
+/// exactly the body's size, never more (a hostile frame cannot make it allocate beyond a block).
+fn decompress_body(
+    spec: &BlockSpec,
+    packed: &[u8],
+    index: BlockIndex,
+) -> std::result::Result<Block, String> {
+    use std::io::Read as _;
+    let cells = spec.side * spec.side;
+    // Zeroed (calloc'd) arrays: every byte is overwritten below.
+    let mut block = Block {
+        index,
+        levels: (0..spec.levels.count())
+            .map(|_| bytemuck::zeroed_vec(cells))
+            .collect(),
+        remission: bytemuck::zeroed_vec(cells),
+    };
+    let mut decoder = zstd::stream::read::Decoder::with_buffer(packed)
+        .map_err(|e| format!("cannot be read: {e}"))?;
+    let short = |e: std::io::Error| format!("does not decompress to a block: {e}");
+    for level in &mut block.levels {
+        decoder
+            .read_exact(bytemuck::cast_slice_mut(&mut level[..]))
+            .map_err(short)?;
+    }
+    decoder
+        .read_exact(bytemuck::cast_slice_mut(&mut block.remission[..]))
+        .map_err(short)?;
+    let mut more = [0u8; 1];
+    if decoder.read(&mut more).map_err(short)? != 0 {
+        return Err(format!(
+            "decompresses to more than a block's {} bytes",
+            spec.body_len()
+        ));
+    }
+    // The file is little-endian; the arrays were filled with its bytes as they are.
+    if cfg!(target_endian = "big") {
+        for v in block.levels.iter_mut().flatten() {
+            *v = f32::from_bits(u32::from_le(v.to_bits()));
+        }
+        for r in &mut block.remission {
+            r.sum = f32::from_bits(u32::from_le(r.sum.to_bits()));
+            r.sum_sq = f32::from_bits(u32::from_le(r.sum_sq.to_bits()));
+            r.count = u32::from_le(r.count);
+        }
+    }
+    Ok(block)
 }
 
 /// Block `index` from its uncompressed body, checked value by value (the error says which);

@@ -3,8 +3,10 @@
 //! Sums merge by addition, so an offline layer and live data combine exactly. Mean and variance
 //! are what a remission-based localizer (CARMEN `localize_ackerman`) compares scans against.
 
-/// Intensity statistics of one cell.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// Intensity statistics of one cell. `repr(C)` and plain data: a block file's remission section
+/// (little-endian) is read straight into an array of these.
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 pub struct RemissionCell {
     /// Sum of intensities.
     pub sum: f32,

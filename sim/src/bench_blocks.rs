@@ -173,3 +173,35 @@ pub fn figures_for(
     };
     block_figures(&dir.join("blocks"), spec, 100, progress)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The benchmark reads back what it wrote both ways (it fails otherwise) and reports the
+    /// compressed blocks smaller than the raw ones.
+    #[test]
+    fn blocks_written_both_ways_read_back_and_format_2_is_smaller() {
+        let mut map = mapper::workloads::two_level_map();
+        let car = mapper::workloads::fake_wing_car();
+        map.insert_scan(&mapper::workloads::parking_lot_scan(), Some(&car))
+            .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let spec = map.block_spec().clone();
+        let store = BlockStore::open(dir.path(), spec.clone()).unwrap();
+        map.save_live(&store).unwrap();
+        let figures = block_figures(dir.path(), spec, 100, &mut |_| {}).unwrap();
+        let get = |name: &str| {
+            figures
+                .iter()
+                .find(|f| f.name == name)
+                .unwrap_or_else(|| panic!("{name} in {figures:?}"))
+        };
+        let (raw, packed) = (
+            get("blocks/bytes/format_1_raw_per_block"),
+            get("blocks/bytes_per_block"),
+        );
+        assert!(raw.median > 2.0 && packed.median * 4.0 < raw.median, "{figures:?}");
+        assert!(get("blocks/read").median > 0.0 && get("blocks/write").median > 0.0);
+    }
+}

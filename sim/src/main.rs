@@ -45,10 +45,11 @@ enum Command {
         /// One JSON object per figure on stdout instead of a table.
         #[arg(long)]
         json: bool,
-        /// Timed batches per figure (the median is reported).
-        #[arg(long, default_value_t = 15)]
-        samples: usize,
-        /// Scenario of `bench loop` and `bench blocks` (the 20x target is set on the parking lot).
+        /// Timed batches per figure, the median reported (default 15; `bench loop`: runs of each
+        /// schedule, in alternation, default 1 - it then says it ran once).
+        #[arg(long)]
+        samples: Option<usize>,
+        /// Scenario of `bench loop` and `bench blocks`.
         #[arg(long, default_value = "scenarios/parking_lot.toml")]
         scenario: PathBuf,
         /// Laps of `bench loop` (default 1; 0: the scenario's own).
@@ -267,16 +268,18 @@ fn demo(out: PathBuf, scans: usize, seed: u64) -> anyhow::Result<()> {
 fn bench(
     what: BenchTarget,
     json: bool,
-    samples: usize,
+    samples: Option<usize>,
     (scenario, laps): (&std::path::Path, u32),
     campaign: &sim::campaign::bench::CampaignBench<'_>,
 ) -> anyhow::Result<()> {
     let progress = ProgressBar::new_spinner();
     let mut report = |what: &str| progress.set_message(format!("measuring {what}"));
     let figures = match what {
-        BenchTarget::Mapper => sim::bench::mapper_figures(samples, &mut report),
-        BenchTarget::Lidar => sim::bench::lidar_figures(samples, &mut report)?,
-        BenchTarget::Loop => sim::bench::loop_figures(scenario, laps, &mut report)?,
+        BenchTarget::Mapper => sim::bench::mapper_figures(samples.unwrap_or(15), &mut report),
+        BenchTarget::Lidar => sim::bench::lidar_figures(samples.unwrap_or(15), &mut report)?,
+        BenchTarget::Loop => {
+            sim::bench::loop_figures(scenario, laps, samples.unwrap_or(1), &mut report)?
+        }
         BenchTarget::Campaign => sim::campaign::bench::campaign_figures(campaign, &mut report)?,
         BenchTarget::Blocks => sim::bench_blocks::figures_for(scenario, &mut report)?,
     };
