@@ -115,6 +115,16 @@ pub struct RosMapYaml {
     pub mode: Option<String>,
 }
 
+/// The image file of a ROS map (`map_server` reads both).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RosImage {
+    /// `<stem>.pgm`, binary graymap: what `map_saver` writes.
+    Pgm,
+    /// `<stem>.ros.png`, the same pixels losslessly compressed (a large, mostly unknown map is a
+    /// hundredth of the PGM).
+    Png,
+}
+
 /// Writes a level's probabilities (-1 = unknown) as a ROS map: `<stem>.yaml` naming `<stem>.pgm`.
 /// Returns the PGM's path.
 pub fn write_ros_map(
@@ -122,9 +132,22 @@ pub fn write_ros_map(
     yaml_path: &Path,
     thresholds: TrinaryThresholds,
 ) -> Result<PathBuf> {
+    write_ros_map_as(probabilities, yaml_path, thresholds, RosImage::Pgm)
+}
+
+/// [`write_ros_map`] with the image format chosen. Returns the image's path.
+pub fn write_ros_map_as(
+    probabilities: &Grid<f32>,
+    yaml_path: &Path,
+    thresholds: TrinaryThresholds,
+    format: RosImage,
+) -> Result<PathBuf> {
     let g = probabilities.geometry();
     let (w, h) = dims(g)?;
-    let pgm_path = yaml_path.with_extension("pgm");
+    let pgm_path = match format {
+        RosImage::Pgm => yaml_path.with_extension("pgm"),
+        RosImage::Png => yaml_path.with_extension("ros.png"),
+    };
     let image_name = pgm_path
         .file_name()
         .and_then(|n| n.to_str())
@@ -136,12 +159,17 @@ pub fn write_ros_map(
         })?
         .to_string();
     let pixels = image_rows(probabilities, |p| pixel(thresholds.classify(*p)));
-    let mut pgm = Vec::new();
-    PnmEncoder::new(&mut pgm)
-        .with_subtype(PnmSubtype::Graymap(SampleEncoding::Binary))
-        .write_image(&pixels, w, h, ExtendedColorType::L8)
-        .map_err(|e| MapError::bad_file(&pgm_path, e.to_string()))?;
-    write_atomically(&pgm_path, &pgm)?;
+    match format {
+        RosImage::Pgm => {
+            let mut pgm = Vec::new();
+            PnmEncoder::new(&mut pgm)
+                .with_subtype(PnmSubtype::Graymap(SampleEncoding::Binary))
+                .write_image(&pixels, w, h, ExtendedColorType::L8)
+                .map_err(|e| MapError::bad_file(&pgm_path, e.to_string()))?;
+            write_atomically(&pgm_path, &pgm)?;
+        }
+        RosImage::Png => write_png_l8(&pixels, g, &pgm_path)?,
+    }
     let yaml = RosMapYaml {
         image: image_name,
         resolution: g.resolution_m(),

@@ -40,6 +40,43 @@ fn mapped() -> MultiHeightMap {
     map
 }
 
+/// The PNG image (the mapping drive's) reads back to exactly what the PGM does, and is smaller.
+#[test]
+fn a_ros_map_with_a_png_image_reads_back_like_the_pgm() {
+    let map = mapped();
+    let dir = tempfile::tempdir().unwrap();
+    let thresholds = TrinaryThresholds::default();
+    let probabilities = map.probability_grid(0).unwrap();
+    let (pgm_yaml, png_yaml) = (dir.path().join("a.yaml"), dir.path().join("b.yaml"));
+    let pgm = write_ros_map(&probabilities, &pgm_yaml, thresholds).unwrap();
+    let png = mapper::export::write_ros_map_as(
+        &probabilities,
+        &png_yaml,
+        thresholds,
+        mapper::export::RosImage::Png,
+    )
+    .unwrap();
+    assert_eq!(png.file_name().unwrap(), "b.ros.png");
+    assert!(
+        std::fs::read_to_string(&png_yaml)
+            .unwrap()
+            .contains("image: b.ros.png")
+    );
+    let (a, b) = (
+        read_ros_map(&pgm_yaml).unwrap(),
+        read_ros_map(&png_yaml).unwrap(),
+    );
+    assert_eq!(a.geometry(), b.geometry());
+    assert_eq!(a.data(), b.data());
+    let size = |p: &std::path::Path| std::fs::metadata(p).unwrap().len();
+    assert!(
+        size(&png) * 3 < size(&pgm),
+        "{} vs {}",
+        size(&png),
+        size(&pgm)
+    );
+}
+
 #[test]
 fn ros_map_reads_back_to_the_same_cells_and_origin() {
     let map = mapped();

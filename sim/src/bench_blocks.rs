@@ -201,7 +201,10 @@ mod tests {
             get("blocks/bytes/format_1_raw_per_block"),
             get("blocks/bytes_per_block"),
         );
-        assert!(raw.median > 2.0 && packed.median * 4.0 < raw.median, "{figures:?}");
+        assert!(
+            raw.median > 2.0 && packed.median * 4.0 < raw.median,
+            "{figures:?}"
+        );
         assert!(get("blocks/read").median > 0.0 && get("blocks/write").median > 0.0);
     }
 }

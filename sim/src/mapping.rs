@@ -1,15 +1,16 @@
 //! The mapping drive: the route driven exactly (the thesis' manual drive) through the world
 //! without its run-time obstacles, building the offline multi-height map and remission map.
 //!
-//! Output directory: `blocks/` (the map blocks, the closed loop's prior), `level<k>.yaml/.pgm`
-//! (ROS map_server) and `level<k>.png` over the route's extent, and `manifest.json` whose
+//! Output directory: `blocks/` (the map blocks, the closed loop's prior), `level<k>.yaml` with
+//! `level<k>.ros.png` (ROS map_server, trinary; a PNG, which map_server reads like a PGM at a
+//! hundredth of the size) and `level<k>.png` over the route's extent, and `manifest.json` whose
 //! fingerprint (scenario and vehicle files, map and LiDAR settings, format) tells `taxi-sim run`
 //! whether the map is stale.
 
 use std::path::{Path, PathBuf};
 
 use autonomy::RoutePath;
-use mapper::export::{TrinaryThresholds, write_occupancy_png, write_ros_map};
+use mapper::export::{RosImage, TrinaryThresholds, write_occupancy_png, write_ros_map_as};
 use mapper::{BlockStore, Grid, GridGeometry, Levels, MapConfig, MultiHeightMap};
 use nalgebra::{Isometry2, Point2};
 
@@ -20,8 +21,8 @@ use crate::scenario::Scenario;
 use crate::world::World;
 
 /// Bumped when the mapping drive changes what it builds (2: the vehicle's ceiling; 3: compressed
-/// blocks).
-const MAP_FORMAT: u32 = 3;
+/// blocks; 4: the ROS image a PNG).
+const MAP_FORMAT: u32 = 4;
 
 /// What a mapping drive did.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
@@ -296,10 +297,11 @@ fn export_levels(
     }
     let mut occupied = Vec::new();
     for (k, grid) in grids.iter().enumerate() {
-        write_ros_map(
+        write_ros_map_as(
             grid,
             &out.join(format!("level{k}.yaml")),
             TrinaryThresholds::default(),
+            RosImage::Png,
         )?;
         write_occupancy_png(grid, &out.join(format!("level{k}.png")))?;
         occupied.push(grid.data().iter().filter(|&&p| p > 0.5).count());

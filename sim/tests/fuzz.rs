@@ -282,18 +282,48 @@ fn map_blocks_manifests_and_ros_maps() {
     let yaml = std::fs::read(map.join("level0.yaml")).unwrap();
     let ros = dir.path().join("ros");
     std::fs::create_dir_all(&ros).unwrap();
-    std::fs::copy(map.join("level0.pgm"), ros.join("level0.pgm")).unwrap();
-    fuzz("ROS map YAML", yaml, true, |b| {
+    std::fs::copy(map.join("level0.ros.png"), ros.join("level0.ros.png")).unwrap();
+    fuzz("ROS map YAML", yaml.clone(), true, |b| {
         std::fs::write(ros.join("level0.yaml"), b).unwrap();
         mapper::export::read_ros_map(&ros.join("level0.yaml"))
             .ok()
             .map(|g| format!("{:?}", g.geometry()))
     });
-    let pgm = std::fs::read(map.join("level0.pgm")).unwrap();
-    std::fs::copy(map.join("level0.yaml"), ros.join("level0.yaml")).unwrap();
-    fuzz("ROS map PGM", pgm, true, |b| {
-        std::fs::write(ros.join("level0.pgm"), b).unwrap();
+    std::fs::write(ros.join("level0.yaml"), &yaml).unwrap();
+    let png = std::fs::read(map.join("level0.ros.png")).unwrap();
+    fuzz("ROS map PNG", png, true, |b| {
+        std::fs::write(ros.join("level0.ros.png"), b).unwrap();
         mapper::export::read_ros_map(&ros.join("level0.yaml"))
+            .ok()
+            .map(|g| format!("{:?}", g.geometry()))
+    });
+    // The same level as map_saver writes it, a PGM.
+    use mapper::export::Trinary;
+    let level = mapper::export::read_ros_map(&map.join("level0.yaml")).unwrap();
+    let probabilities = mapper::Grid::from_vec(
+        *level.geometry(),
+        level
+            .data()
+            .iter()
+            .map(|t| match t {
+                Trinary::Occupied => 1.0f32,
+                Trinary::Free => 0.0,
+                Trinary::Unknown => -1.0,
+            })
+            .collect(),
+    )
+    .unwrap();
+    let pgm_yaml = ros.join("saved.yaml");
+    let pgm_path = mapper::export::write_ros_map(
+        &probabilities,
+        &pgm_yaml,
+        mapper::export::TrinaryThresholds::default(),
+    )
+    .unwrap();
+    let pgm = std::fs::read(&pgm_path).unwrap();
+    fuzz("ROS map PGM", pgm, true, |b| {
+        std::fs::write(&pgm_path, b).unwrap();
+        mapper::export::read_ros_map(&pgm_yaml)
             .ok()
             .map(|g| format!("{:?}", g.geometry()))
     });
