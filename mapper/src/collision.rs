@@ -172,7 +172,21 @@ impl CollisionModel {
                 .collect(),
             order,
             groups,
+            avx2: avx2_usable(maps.geometry()),
         })
+    }
+}
+
+/// Whether the AVX2 path can serve maps of geometry `g` on this CPU.
+fn avx2_usable(g: &crate::grid::GridGeometry) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        avx2::usable(g.width(), g.height())
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = g;
+        false
     }
 }
 
@@ -230,6 +244,8 @@ pub struct CollisionChecker<'a> {
     /// `order[k]` = index in the model of the k-th sorted circle.
     order: Vec<usize>,
     groups: Vec<CircleGroup<'a>>,
+    /// Whether [`CollisionChecker::clearance`] takes the AVX2 path.
+    avx2: bool,
 }
 
 /// Consecutive sorted circles of one level and the distances they read.
@@ -246,6 +262,164 @@ enum LevelData<'a> {
     One(&'a [f32]),
     /// Banded: every band from the part's level up.
     Bands(&'a [crate::odm::DistanceMap]),
+}
+
+/// A pose in the distance maps' cell units, and the maps' size.
+#[derive(Clone, Copy, Debug)]
+struct Frame {
+    /// cos and sin of the heading.
+    c: f32,
+    s: f32,
+    /// The pose's origin, cells from the maps' origin.
+    ox: f32,
+    oy: f32,
+    /// Width and height in cells, as floats and the width as an integer.
+    w: f32,
+    h: f32,
+    width: usize,
+}
+
+/// The smallest `d - r` over one group's circles (centres in cells, vehicle frame) and its index
+/// in the group (the first on ties), reading the distance of cell index `i` with `distance(i)`;
+/// a centre outside the maps reads 0.
+#[inline]
+fn group_min(
+    xs: &[f32],
+    ys: &[f32],
+    radii: &[f32],
+    f: &Frame,
+    distance: impl Fn(usize) -> f32,
+) -> (f32, usize) {
+    let mut best = (f32::INFINITY, 0usize);
+    for (k, ((&x, &y), &r)) in xs.iter().zip(ys).zip(radii).enumerate() {
+        let u = f.ox + f.c * x - f.s * y;
+        let v = f.oy + f.s * x + f.c * y;
+        // NaN fails every comparison and reads as outside, i.e. distance 0.
+        let d = if u >= 0.0 && v >= 0.0 && u < f.w && v < f.h {
+            distance(v as usize * f.width + u as usize)
+        } else {
+            0.0
+        };
+        let m = d - r;
+        if m < best.0 {
+            best = (m, k);
+        }
+    }
+    best
+}
+
+/// [`group_min`] over one distance map, eight circles at a time with AVX2 gathers. The project's
+/// only unsafe code: intrinsics behind a runtime feature check, and a gather whose every active
+/// lane is an index the bounds checks above it proved inside `data`.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod avx2 {
+    use super::Frame;
+    use std::arch::x86_64::*;
+
+    /// Whether this CPU runs [`group_min`] (AVX2), and `data` is a whole `w x h` map whose cell
+    /// indices fit an i32 and whose sides f32 holds exactly.
+    pub(super) fn usable(width: usize, height: usize) -> bool {
+        is_x86_feature_detected!("avx2")
+            && width < (1 << 24)
+            && height < (1 << 24)
+            && width
+                .checked_mul(height)
+                .is_some_and(|n| n < i32::MAX as usize)
+    }
+
+    /// As the scalar `group_min` over `data`, bit for bit.
+    pub(super) fn group_min(
+        xs: &[f32],
+        ys: &[f32],
+        radii: &[f32],
+        data: &[f32],
+        f: &Frame,
+    ) -> (f32, usize) {
+        if data.len() != f.width * (f.h as usize) || !is_x86_feature_detected!("avx2") {
+            return super::group_min(xs, ys, radii, f, |i| data.get(i).copied().unwrap_or(0.0));
+        }
+        let full = xs.len().min(ys.len()).min(radii.len()) / 8 * 8;
+        // SAFETY: AVX2 is present (checked just above); `eight` reads `full` elements of each
+        // slice, within their lengths, and gathers only lanes inside the w x h map of `data`.
+        let (m, k) = unsafe { eight(&xs[..full], &ys[..full], &radii[..full], data, f) };
+        let (rm, rk) = super::group_min(&xs[full..], &ys[full..], &radii[full..], f, |i| {
+            data.get(i).copied().unwrap_or(0.0)
+        });
+        if rm < m { (rm, full + rk) } else { (m, k) }
+    }
+
+    /// The first `xs.len()` (a multiple of 8) circles, 8 lanes at a time; the same arithmetic
+    /// in the same order as the scalar loop (no fused multiply-add), so the same cells.
+    #[target_feature(enable = "avx2")]
+    unsafe fn eight(
+        xs: &[f32],
+        ys: &[f32],
+        radii: &[f32],
+        data: &[f32],
+        f: &Frame,
+    ) -> (f32, usize) {
+        let (c, s) = (_mm256_set1_ps(f.c), _mm256_set1_ps(f.s));
+        let (ox, oy) = (_mm256_set1_ps(f.ox), _mm256_set1_ps(f.oy));
+        let (w, h, zero) = (
+            _mm256_set1_ps(f.w),
+            _mm256_set1_ps(f.h),
+            _mm256_setzero_ps(),
+        );
+        let width = _mm256_set1_epi32(f.width as i32);
+        let mut best_m = _mm256_set1_ps(f32::INFINITY);
+        let mut best_k = _mm256_setzero_si256();
+        let mut lane_k = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        for k in (0..xs.len()).step_by(8) {
+            // SAFETY: k + 8 <= len of each slice (the caller passes multiples of 8).
+            let (x, y, r) = unsafe {
+                (
+                    _mm256_loadu_ps(xs.as_ptr().add(k)),
+                    _mm256_loadu_ps(ys.as_ptr().add(k)),
+                    _mm256_loadu_ps(radii.as_ptr().add(k)),
+                )
+            };
+            let u = _mm256_sub_ps(_mm256_add_ps(ox, _mm256_mul_ps(c, x)), _mm256_mul_ps(s, y));
+            let v = _mm256_add_ps(_mm256_add_ps(oy, _mm256_mul_ps(s, x)), _mm256_mul_ps(c, y));
+            let inside = _mm256_and_ps(
+                _mm256_and_ps(
+                    _mm256_cmp_ps::<_CMP_GE_OQ>(u, zero),
+                    _mm256_cmp_ps::<_CMP_GE_OQ>(v, zero),
+                ),
+                _mm256_and_ps(
+                    _mm256_cmp_ps::<_CMP_LT_OQ>(u, w),
+                    _mm256_cmp_ps::<_CMP_LT_OQ>(v, h),
+                ),
+            );
+            let idx = _mm256_add_epi32(
+                _mm256_mullo_epi32(_mm256_cvttps_epi32(v), width),
+                _mm256_cvttps_epi32(u),
+            );
+            // SAFETY: an active lane has 0 <= u < w and 0 <= v < h, so its index is at most
+            // (h - 1) * width + w - 1 < data.len(); inactive lanes read nothing and give 0.
+            let d = unsafe { _mm256_mask_i32gather_ps::<4>(zero, data.as_ptr(), idx, inside) };
+            let m = _mm256_sub_ps(d, r);
+            let lower = _mm256_cmp_ps::<_CMP_LT_OQ>(m, best_m);
+            best_m = _mm256_blendv_ps(best_m, m, lower);
+            best_k = _mm256_blendv_epi8(best_k, lane_k, _mm256_castps_si256(lower));
+            lane_k = _mm256_add_epi32(lane_k, _mm256_set1_epi32(8));
+        }
+        let (mut m, mut k) = ([0f32; 8], [0i32; 8]);
+        // SAFETY: both arrays hold 8 lanes.
+        unsafe {
+            _mm256_storeu_ps(m.as_mut_ptr(), best_m);
+            _mm256_storeu_si256(k.as_mut_ptr().cast(), best_k);
+        }
+        // The smallest margin; on ties the first circle, as the scalar loop.
+        let mut best = (f32::INFINITY, 0usize);
+        for (&m, &k) in m.iter().zip(&k) {
+            let k = k as usize;
+            if m < best.0 || (m == best.0 && k < best.1) {
+                best = (m, k);
+            }
+        }
+        best
+    }
 }
 
 impl CollisionChecker<'_> {
@@ -288,77 +462,68 @@ impl CollisionChecker<'_> {
     }
 
     /// Checks one pose circle by circle (no early out): the exact smallest margin and its circle.
+    /// On a CPU with AVX2, eight circles at a time (the same numbers as
+    /// [`CollisionChecker::clearance_portable`], bit for bit: tested).
     pub fn clearance(&self, world_from_vehicle: &Isometry2<f64>, safety_m: f32) -> PoseCheck {
+        self.clearance_with(world_from_vehicle, safety_m, self.avx2)
+    }
+
+    /// Whether [`CollisionChecker::clearance`] checks eight circles at a time (AVX2) here.
+    pub fn vectorised(&self) -> bool {
+        self.avx2
+    }
+
+    /// [`CollisionChecker::clearance`] one circle at a time, on any CPU: the straightforward way,
+    /// for benchmarks and tests.
+    pub fn clearance_portable(
+        &self,
+        world_from_vehicle: &Isometry2<f64>,
+        safety_m: f32,
+    ) -> PoseCheck {
+        self.clearance_with(world_from_vehicle, safety_m, false)
+    }
+
+    fn clearance_with(
+        &self,
+        world_from_vehicle: &Isometry2<f64>,
+        safety_m: f32,
+        avx2: bool,
+    ) -> PoseCheck {
         let g = self.maps.geometry();
         let inv = 1.0 / g.resolution_m();
-        let (c, s) = (
-            world_from_vehicle.rotation.re as f32,
-            world_from_vehicle.rotation.im as f32,
-        );
         // The pose's origin in cell units; circle offsets are pre-scaled to cells. f32 is exact to
         // 1e-4 cells over a 1050-cell window.
-        let ox = ((world_from_vehicle.translation.x - g.origin_m().x) * inv) as f32;
-        let oy = ((world_from_vehicle.translation.y - g.origin_m().y) * inv) as f32;
-        let (w, h, width) = (g.width() as f32, g.height() as f32, g.width());
+        let frame = Frame {
+            c: world_from_vehicle.rotation.re as f32,
+            s: world_from_vehicle.rotation.im as f32,
+            ox: ((world_from_vehicle.translation.x - g.origin_m().x) * inv) as f32,
+            oy: ((world_from_vehicle.translation.y - g.origin_m().y) * inv) as f32,
+            w: g.width() as f32,
+            h: g.height() as f32,
+            width: g.width(),
+        };
         let mut best = (f32::INFINITY, 0usize);
-        // In chunks: first every cell index (branch-free arithmetic the compiler vectorises;
-        // f32 -> i32 is one instruction, f32 -> usize is not), then the lookups, then the minimum.
-        const CHUNK: usize = 16;
-        let mut idx = [0i32; CHUNK];
-        let mut margins = [0f32; CHUNK];
         for group in &self.groups {
-            let mut start = group.range.start;
-            while start < group.range.end {
-                let n = CHUNK.min(group.range.end - start);
-                let (xs, ys) = (&self.xs[start..start + n], &self.ys[start..start + n]);
-                for k in 0..n {
-                    let u = ox + c * xs[k] - s * ys[k];
-                    let v = oy + s * xs[k] + c * ys[k];
-                    // NaN fails every comparison and reads as outside, i.e. distance 0.
-                    let inside = u >= 0.0 && v >= 0.0 && u < w && v < h;
-                    idx[k] = if inside {
-                        v as i32 * width as i32 + u as i32
-                    } else {
-                        -1
-                    };
-                }
-                match group.data {
-                    LevelData::One(data) => {
-                        for k in 0..n {
-                            margins[k] = if idx[k] < 0 {
-                                0.0
-                            } else {
-                                data.get(idx[k] as usize).copied().unwrap_or(0.0)
-                            };
-                        }
-                    }
-                    LevelData::Bands(maps) => {
-                        for k in 0..n {
-                            margins[k] = if idx[k] < 0 {
-                                0.0
-                            } else {
-                                maps.iter()
-                                    .map(|m| m.grid().data()[idx[k] as usize])
-                                    .fold(f32::INFINITY, f32::min)
-                            };
-                        }
-                    }
-                }
-                for (m, r) in margins[..n].iter_mut().zip(&self.radii[start..start + n]) {
-                    *m -= r;
-                }
-                let (k, m) =
-                    margins[..n]
-                        .iter()
-                        .enumerate()
-                        .fold(
-                            (0, f32::INFINITY),
-                            |a, (k, &m)| if m < a.1 { (k, m) } else { a },
-                        );
-                if m < best.0 {
-                    best = (m, start + k);
-                }
-                start += n;
+            let range = group.range.clone();
+            let (xs, ys, radii) = (
+                &self.xs[range.clone()],
+                &self.ys[range.clone()],
+                &self.radii[range.clone()],
+            );
+            let (m, k) = match group.data {
+                #[cfg(target_arch = "x86_64")]
+                LevelData::One(data) if avx2 => avx2::group_min(xs, ys, radii, data, &frame),
+                LevelData::One(data) => group_min(xs, ys, radii, &frame, |i| {
+                    data.get(i).copied().unwrap_or(0.0)
+                }),
+                LevelData::Bands(maps) => group_min(xs, ys, radii, &frame, |i| {
+                    maps.iter()
+                        .map(|m| m.grid().data().get(i).copied().unwrap_or(0.0))
+                        .fold(f32::INFINITY, f32::min)
+                }),
+            };
+            if m < best.0 {
+                best = (m, range.start + k);
             }
         }
         let margin_m = best.0 - safety_m;

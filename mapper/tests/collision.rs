@@ -193,3 +193,67 @@ proptest! {
         prop_assert!(quick.margin_m <= exact.margin_m + 1e-6);
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+    /// The check eight circles at a time (AVX2, where the CPU has it) gives the portable check's
+    /// margin and nearest circle bit for bit: poses anywhere, half of them partly or wholly off
+    /// the map, models of 1-40 circles on both levels (groups that are not multiples of eight),
+    /// cumulative and banded maps.
+    #[test]
+    fn the_vectorised_check_equals_the_portable_one(
+        x in -45.0f64..45.0,
+        y in -45.0f64..45.0,
+        yaw in -3.2f64..3.2,
+        safety in 0.0f32..0.8,
+        circles in proptest::collection::vec((-6.0f64..6.0, -6.0f64..6.0, 0.1f64..1.5, 0usize..2), 1..40),
+        banded in any::<bool>(),
+    ) {
+        let maps = maps(if banded { LevelMode::Banded } else { LevelMode::Cumulative });
+        let model = CollisionModel::new(
+            circles
+                .iter()
+                .map(|&(x_m, y_m, radius_m, level)| Circle { x_m, y_m, radius_m, level })
+                .collect(),
+            vec![0.0, 0.7],
+        )
+        .unwrap();
+        let checker = model.checker(&maps).unwrap();
+        let pose = Isometry2::new(Vector2::new(x, y), yaw);
+        let (fast, portable) = (checker.clearance(&pose, safety), checker.clearance_portable(&pose, safety));
+        prop_assert_eq!(fast.margin_m.to_bits(), portable.margin_m.to_bits());
+        prop_assert_eq!(fast.nearest_circle, portable.nearest_circle);
+        prop_assert_eq!(fast.colliding, portable.colliding);
+    }
+}
+
+/// The jet's 62 circles on the benchmark's maps (obstacles all round the near pose), the two
+/// checks on a grid of poses across the obstacle ring: equal everywhere.
+#[test]
+fn the_vectorised_check_equals_the_portable_one_for_the_jet_at_the_obstacle_ring() {
+    let maps = mapper::workloads::distance_maps_for_checks();
+    let jet = mapper::workloads::jet_62_circles();
+    let checker = jet.checker(&maps).unwrap();
+    #[cfg(target_arch = "x86_64")]
+    assert_eq!(checker.vectorised(), is_x86_feature_detected!("avx2"));
+    let mut checked = 0;
+    for i in 0..60 {
+        for j in 0..60 {
+            let pose = Isometry2::new(
+                Vector2::new(-108.0 + 3.6 * i as f64, -108.0 + 3.6 * j as f64),
+                0.1 * (i + j) as f64,
+            );
+            let (fast, portable) = (
+                checker.clearance(&pose, 0.2),
+                checker.clearance_portable(&pose, 0.2),
+            );
+            assert_eq!(
+                (fast.margin_m.to_bits(), fast.nearest_circle),
+                (portable.margin_m.to_bits(), portable.nearest_circle),
+                "{pose}"
+            );
+            checked += usize::from(fast.colliding);
+        }
+    }
+    assert!(checked > 500, "{checked} colliding poses of 3600");
+}

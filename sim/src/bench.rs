@@ -156,6 +156,17 @@ fn check_figures(samples: usize) -> Vec<Figure> {
             black_box(checker.clearance(black_box(&far), 0.2));
         },
     );
+    // The full check near obstacles, eight circles at a time (AVX2) against one at a time.
+    let (full_t, portable_t) = alternating(
+        samples,
+        batch,
+        || {
+            black_box(checker.clearance(black_box(&near), 0.2));
+        },
+        || {
+            black_box(checker.clearance_portable(black_box(&near), 0.2));
+        },
+    );
     let near_f = figure(
         "check_pose/62_circles/near_obstacles",
         near_t,
@@ -175,10 +186,34 @@ fn check_figures(samples: usize) -> Vec<Figure> {
         Some("close to one lookup"),
     );
     let lookup = figure("distance_map/one_lookup", lookup_t, "ns", None);
+    let lanes = if checker.vectorised() {
+        "8_lanes_avx2"
+    } else {
+        "1_lane_no_avx2_here"
+    };
+    let full = figure(
+        &format!("check_pose/62_circles/near_obstacles/full_check/{lanes}"),
+        full_t,
+        "ns",
+        None,
+    );
+    let portable = figure(
+        "check_pose/62_circles/near_obstacles/full_check/1_lane",
+        portable_t,
+        "ns",
+        None,
+    );
     // The early out against the full check of the same pose; one lookup against the early out
     // (1.0 would be exactly one lookup).
     let lookup = against(lookup, &far_f);
-    vec![near_f, against(far_f, &far_full), far_full, lookup]
+    vec![
+        near_f,
+        against(full, &portable),
+        portable,
+        against(far_f, &far_full),
+        far_full,
+        lookup,
+    ]
 }
 
 /// Medians of `a` and `b` over `samples` rounds of `batch` calls each, timed in alternation (one

@@ -22,7 +22,7 @@ use crate::world::World;
 
 /// Bumped when the mapping drive changes what it builds (2: the vehicle's ceiling; 3: compressed
 /// blocks; 4: the ROS image a PNG).
-const MAP_FORMAT: u32 = 4;
+pub(crate) const MAP_FORMAT: u32 = 4;
 
 /// What a mapping drive did.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]

@@ -243,11 +243,12 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
 }
 
 /// The static world's key: what the mapping drive depends on (world, static objects, patches,
-/// route, vehicle and start, seed, levels, map and LiDAR settings, a stale map's faults).
+/// route, vehicle and start, seed, levels, map and LiDAR settings, a stale map's faults, the
+/// map format: a campaign directory of an older build gets new maps, not blocks it cannot read).
 /// Variants with the same key share one offline map.
 pub fn static_world_key(scenario: &Scenario, config: &RunConfig) -> Result<String> {
     let mut text = format!(
-        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}|{:?}|{:?}|{:?}",
+        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}|{:?}|{:?}|{:?}|{}",
         scenario.world,
         scenario.objects,
         scenario.patches,
@@ -258,6 +259,7 @@ pub fn static_world_key(scenario: &Scenario, config: &RunConfig) -> Result<Strin
         crate::mapping::levels_of(scenario, config)?,
         crate::mapping::map_config(config),
         config.lidar,
+        crate::mapping::MAP_FORMAT,
     );
     if config.faults.stale_map.any() {
         text.push_str(&format!("|{:?}", config.faults.stale_map));
