@@ -516,7 +516,7 @@ impl Lidar {
         let beams = self.config.channels;
         let self_hits = self.self_hits(world);
         let scene = world.scene();
-        let ground = scene.ground_texture();
+        let ground = world.ground_texture();
         // Every column writes its own slices of the preallocated outputs: no per-column vectors
         // to join afterwards.
         let n = self.config.columns * beams;
@@ -562,7 +562,7 @@ impl Lidar {
                         .zip(hits.iter())
                         .zip(dirs.iter())
                     {
-                        self.measure(scene, &ground, &mut rng, (origin, d), *hit, (ret, owner));
+                        self.measure(scene, ground, &mut rng, (origin, d), *hit, (ret, owner));
                     }
                     *column = mapper::ScanColumn {
                         world_from_sensor: sensor,

@@ -85,6 +85,9 @@ pub struct Contact {
 pub struct World {
     physics: PhysicsWorld,
     scene: Scene,
+    /// The ground's remission with the patches prepared and binned, built once (patches do not
+    /// move; the LiDAR reads it every revolution).
+    ground: crate::scene::GroundTexture,
     objects: Vec<ColliderHandle>,
     object_active: Vec<bool>,
     owners: HashMap<ColliderHandle, Owner>,
@@ -168,6 +171,7 @@ impl World {
         let n = objects.len();
         let mut world = World {
             physics,
+            ground: scene.ground_texture(),
             scene,
             objects,
             object_active: vec![true; n],
@@ -190,6 +194,10 @@ impl World {
     /// The scene the world was built from (run-time obstacles included only if asked).
     pub fn scene(&self) -> &Scene {
         &self.scene
+    }
+    /// The ground's remission texture of the scene (prepared once).
+    pub fn ground_texture(&self) -> &crate::scene::GroundTexture {
+        &self.ground
     }
     /// Simulation time of the last update, seconds.
     pub fn time_s(&self) -> f64 {
