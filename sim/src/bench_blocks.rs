@@ -2,7 +2,9 @@
 //! against the uncompressed format 1 it replaced, on the blocks of a real map.
 //!
 //! Both ways do the same work but the compression: the body encoded and written atomically
-//! (temporary file, fsync, rename), then read, checksummed and decoded with every value checked.
+//! (temporary file, fsync, rename), then read, checksummed and decoded with every value checked:
+//! once from the page cache (just written) and once from the disk (the file dropped from the
+//! cache first, as a map is read when a run starts).
 //! Each block is written and read both ways in alternation, so the machine's drift falls on both.
 
 use std::time::Instant;
@@ -12,6 +14,13 @@ use mapper::{Block, BlockStore, write_atomically};
 
 use crate::bench::Figure;
 use crate::error::{Error, Result};
+
+/// Drops `path` from the page cache (its pages are clean: written with fsync), so the next read
+/// comes from the disk. Best effort: an error leaves it cached, and the figure says "cached".
+fn evict(path: &std::path::Path) -> bool {
+    std::fs::File::open(path)
+        .is_ok_and(|f| rustix::fs::fadvise(&f, 0, None, rustix::fs::Advice::DontNeed).is_ok())
+}
 
 /// Median of `v` (sorted in place).
 fn median(v: &mut [f64]) -> f64 {
@@ -78,6 +87,7 @@ pub fn block_figures(
     let store = BlockStore::open(scratch.path().join("v2"), spec.clone())?;
     let v1_dir = scratch.path().join("v1");
     let (mut w1, mut w2, mut r1, mut r2) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut c1, mut c2, mut evicted) = (Vec::new(), Vec::new(), true);
     let (mut bytes1, mut bytes2) = (0usize, 0usize);
     for (k, block) in blocks.iter().enumerate() {
         progress(&format!("block {} of {}", k + 1, blocks.len()));
@@ -103,6 +113,15 @@ pub fn block_figures(
                 block.index
             )));
         }
+        // From the disk: each file dropped from the page cache first.
+        evicted &= evict(&p1);
+        let t = Instant::now();
+        read_v1(&spec, block, &p1)?;
+        c1.push(t.elapsed().as_secs_f64());
+        evicted &= evict(&store.path(block.index));
+        let t = Instant::now();
+        store.load(block.index)?;
+        c2.push(t.elapsed().as_secs_f64());
     }
     let n = blocks.len();
     let fig = |name: &str, mut v: Vec<f64>| Figure {
@@ -118,6 +137,15 @@ pub fn block_figures(
         fig("write", w2),
         fig("read/format_1_raw", r1),
         fig("read", r2),
+    );
+    let disk = if evicted {
+        "from_disk"
+    } else {
+        "cached_could_not_evict"
+    };
+    let (c1, c2) = (
+        fig(&format!("read/{disk}/format_1_raw"), c1),
+        fig(&format!("read/{disk}"), c2),
     );
     let with = |mut f: Figure, base: &Figure, target: &'static str| {
         f.baseline = Some(base.name.clone());
@@ -139,6 +167,8 @@ pub fn block_figures(
         w1,
         with(r2, &r1, ">= 1x format 1"),
         r1,
+        with(c2, &c1, ">= 1x format 1"),
+        c1,
         with(s2, &s1, "map <= 60 MB"),
         s1,
     ])
