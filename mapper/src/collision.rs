@@ -336,16 +336,15 @@ mod avx2 {
         data: &[f32],
         f: &Frame,
     ) -> (f32, usize) {
+        let read = |i: usize| data.get(i).copied().unwrap_or(0.0);
         if data.len() != f.width * (f.h as usize) || !is_x86_feature_detected!("avx2") {
-            return super::group_min(xs, ys, radii, f, |i| data.get(i).copied().unwrap_or(0.0));
+            return super::group_min(xs, ys, radii, f, read);
         }
         let full = xs.len().min(ys.len()).min(radii.len()) / 8 * 8;
         // SAFETY: AVX2 is present (checked just above); `eight` reads `full` elements of each
         // slice, within their lengths, and gathers only lanes inside the w x h map of `data`.
         let (m, k) = unsafe { eight(&xs[..full], &ys[..full], &radii[..full], data, f) };
-        let (rm, rk) = super::group_min(&xs[full..], &ys[full..], &radii[full..], f, |i| {
-            data.get(i).copied().unwrap_or(0.0)
-        });
+        let (rm, rk) = super::group_min(&xs[full..], &ys[full..], &radii[full..], f, read);
         if rm < m { (rm, full + rk) } else { (m, k) }
     }
 
