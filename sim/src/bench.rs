@@ -84,24 +84,15 @@ pub fn mapper_figures(samples: usize, progress: &mut dyn FnMut(&str)) -> Vec<Fig
         })
         .unwrap_or_else(|e| unreachable!("fixed config: {e}"))
     });
-    let mut times = [Vec::new(), Vec::new()];
-    for round in 0..=samples.max(1) {
-        for (map, times) in maps.iter_mut().zip(&mut times) {
-            let t = Instant::now();
-            black_box(
-                map.insert_scan(&scan, Some(&car))
-                    .map(|s| s.hits.len())
-                    .unwrap_or(0),
-            );
-            if round > 0 {
-                times.push(t.elapsed().as_secs_f64()); // round 0 warms up
-            }
-        }
-    }
-    let [every, coarse] = times.map(|mut t| {
-        t.sort_by(f64::total_cmp);
-        t[t.len() / 2]
-    });
+    let [every_map, coarse_map] = &mut maps;
+    let insert = |map: &mut mapper::MultiHeightMap| {
+        black_box(
+            map.insert_scan(&scan, Some(&car))
+                .map(|s| s.hits.len())
+                .unwrap_or(0),
+        );
+    };
+    let (every, coarse) = alternating(samples, 1, || insert(every_map), || insert(coarse_map));
     let every = figure(
         "insert_scan/hdl32e_69984_returns/2_levels/every_column_walks",
         every,
