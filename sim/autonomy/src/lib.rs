@@ -3,16 +3,18 @@
 //! gives commands; it keeps the online multi-height map, plans over its distance maps, avoids,
 //! behaves and follows.
 //!
-//! The crate depends on `mapper`, `aircraft`, nalgebra and rayon only: it cannot name Rapier, the
+//! The crate depends on `mapper`, `aircraft`, nalgebra, rayon and rand only: it cannot name Rapier, the
 //! simulated world or its ground truth, so "the autonomy never sees ground truth" is checked by
 //! the compiler (and by `cargo tree -p autonomy` in CI).
 //! - [`messages`]: what crosses the boundary: [`LidarRevolution`], [`PoseEstimate`],
 //!   [`Odometry`] in, [`Command`] out.
+//! - [`localizer`]: the particle filter over the offline map (remission, likelihood field).
 //! - [`online_map`]: the offline map merged with live LiDAR data around the estimate.
 //! - [`planner`]: candidates, the avoider, the behaviour, pure pursuit.
 //! - [`route`]: route geometry and Frenet projection.
 //! - [`stack`]: the [`Driver`], which ties them together and tracks its own route progress.
 
+pub mod localizer;
 pub mod messages;
 pub mod online_map;
 pub mod planner;

@@ -1,0 +1,716 @@
+//! Monte Carlo localization over the offline map, as CARMEN's `localize_ackerman` does it: a
+//! particle filter whose motion update is the odometry through the bicycle model (each particle
+//! with its own speed-scale and steering errors), whose measurement update compares each LiDAR
+//! revolution with the offline map's remission layer (mean and variance of intensity per cell)
+//! and/or its level-0 occupancy as a likelihood field (distance to the nearest obstacle cell),
+//! and which resamples with the low-variance sampler. The estimate is the particles' weighted
+//! mean and its covariance.
+//!
+//! The map is the offline prior only (no live data): a [`MultiHeightMap`] over the offline
+//! blocks, re-centred on the estimate like the online map, from which a [`LocalizationMap`]
+//! (per cell: the remission mean and weight, the likelihood field's log-likelihood) is built when
+//! the window moves. A pure function of the seed.
+
+use mapper::{CollisionModel, GridGeometry, MultiHeightMap, RemissionCell};
+use nalgebra::{Isometry2, Matrix3, Point2, Vector2};
+use rand::{RngExt, SeedableRng};
+use rand_distr::StandardNormal;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::messages::{LidarRevolution, Odometry};
+use crate::route::wrap_angle;
+
+/// What a revolution is compared with.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MeasurementModel {
+    /// The ground returns' intensities against the remission map (CARMEN on the aerodrome).
+    Remission,
+    /// The obstacle returns against the level-0 occupancy's likelihood field.
+    LikelihoodField,
+    /// Both, their log-likelihoods added. The default.
+    #[default]
+    Both,
+}
+
+/// The particle filter's parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LocalizerConfig {
+    /// Particles. Default 300 (CARMEN's).
+    pub particles: usize,
+    /// What a revolution is compared with. Default both.
+    pub measurement: MeasurementModel,
+    /// Ground returns (below `ground_height_m`) used per revolution, at most. Default 400.
+    pub remission_points: usize,
+    /// Obstacle returns (between `obstacle_min_height_m` and `obstacle_max_height_m`) used per
+    /// revolution, at most. Default 200.
+    pub field_points: usize,
+    /// Returns below this height are ground (remission), metres. Default 0.1.
+    pub ground_height_m: f64,
+    /// Obstacle returns for the likelihood field from this height up, metres. Default 0.3.
+    pub obstacle_min_height_m: f64,
+    /// ... up to this height, metres. Default 3.
+    pub obstacle_max_height_m: f64,
+    /// Ground returns farther than this are not used, metres. Default 40.
+    pub max_ground_range_m: f64,
+    /// Floor of a cell's intensity standard deviation. Default 0.05.
+    pub remission_sigma_floor: f64,
+    /// A ground return on a cell the map has no intensity for scores as this many standard
+    /// deviations off (near a match: the cells a mapping drive never sampled are no evidence). Default 0.5.
+    pub remission_unknown_sigmas: f64,
+    /// A return's log-likelihood is never below `-0.5 k^2` (outliers: things not in the map).
+    /// Default 3.
+    pub outlier_sigmas: f64,
+    /// Standard deviation of an obstacle return's distance to the map's obstacles, metres.
+    /// Default 0.25.
+    pub field_sigma_m: f64,
+    /// Each return's log-likelihood is multiplied by this (the returns of one revolution are not
+    /// independent; CARMEN's particles weight factor). Default 0.05.
+    pub likelihood_weight: f64,
+    /// Spread of each particle's odometry speed-scale error (drawn at the start). Default 0.02.
+    pub speed_scale_sigma: f64,
+    /// Spread of each particle's steering error, radians. Default 0.01.
+    pub steering_sigma_rad: f64,
+    /// Random walk of those errors per measurement update (fraction of their spread). Default
+    /// 0.2.
+    pub bias_walk: f64,
+    /// Position diffusion per measurement update: this plus `diffusion_per_m` per metre driven,
+    /// metres. Default 0.01.
+    pub diffusion_m: f64,
+    /// Position diffusion per metre driven. Default 0.02.
+    pub diffusion_per_m: f64,
+    /// Heading diffusion per measurement update, radians (plus 0.01 rad per metre). Default
+    /// 0.002.
+    pub diffusion_rad: f64,
+    /// A revolution updates the particles only once the vehicle has moved this far since the last
+    /// update, metres (standing still, the same view would collapse them). Default 0.05.
+    pub min_travel_m: f64,
+    /// Resample when the effective sample size falls below this fraction of the particles.
+    /// Default 0.5.
+    pub resample_ess_fraction: f64,
+    /// Standard deviation of the GNSS-like fix the filter starts from, metres. Default 0.5.
+    pub fix_sigma_m: f64,
+    /// ... in heading, radians. Default 0.05.
+    pub fix_sigma_rad: f64,
+    /// Estimates published per second. Default 20.
+    pub rate_hz: f64,
+}
+
+impl Default for LocalizerConfig {
+    fn default() -> Self {
+        LocalizerConfig {
+            particles: 300,
+            measurement: MeasurementModel::Both,
+            remission_points: 400,
+            field_points: 200,
+            ground_height_m: 0.1,
+            obstacle_min_height_m: 0.3,
+            obstacle_max_height_m: 3.0,
+            max_ground_range_m: 40.0,
+            remission_sigma_floor: 0.05,
+            remission_unknown_sigmas: 0.5,
+            outlier_sigmas: 3.0,
+            field_sigma_m: 0.25,
+            likelihood_weight: 0.05,
+            speed_scale_sigma: 0.02,
+            steering_sigma_rad: 0.01,
+            bias_walk: 0.2,
+            diffusion_m: 0.01,
+            diffusion_per_m: 0.02,
+            diffusion_rad: 0.002,
+            min_travel_m: 0.05,
+            resample_ess_fraction: 0.5,
+            fix_sigma_m: 0.5,
+            fix_sigma_rad: 0.05,
+            rate_hz: 20.0,
+        }
+    }
+}
+
+impl LocalizerConfig {
+    /// Checks every field, naming the first wrong one.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.particles == 0 || self.particles > 100_000 {
+            return Err(format!(
+                "particles = {}: between 1 and 100000",
+                self.particles
+            ));
+        }
+        let non_negative = [
+            ("remission_sigma_floor", self.remission_sigma_floor),
+            ("remission_unknown_sigmas", self.remission_unknown_sigmas),
+            ("outlier_sigmas", self.outlier_sigmas),
+            ("likelihood_weight", self.likelihood_weight),
+            ("speed_scale_sigma", self.speed_scale_sigma),
+            ("steering_sigma_rad", self.steering_sigma_rad),
+            ("bias_walk", self.bias_walk),
+            ("diffusion_m", self.diffusion_m),
+            ("diffusion_per_m", self.diffusion_per_m),
+            ("diffusion_rad", self.diffusion_rad),
+            ("min_travel_m", self.min_travel_m),
+            ("fix_sigma_m", self.fix_sigma_m),
+            ("fix_sigma_rad", self.fix_sigma_rad),
+            ("max_ground_range_m", self.max_ground_range_m),
+        ];
+        for (name, v) in non_negative {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("{name} = {v}: must be finite and >= 0"));
+            }
+        }
+        let positive = [
+            ("field_sigma_m", self.field_sigma_m),
+            ("rate_hz", self.rate_hz),
+            ("remission_sigma_floor", self.remission_sigma_floor),
+        ];
+        for (name, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{name} = {v}: must be finite and > 0"));
+            }
+        }
+        if !(0.0..=1.0).contains(&self.resample_ess_fraction) {
+            return Err(format!(
+                "resample_ess_fraction = {}: between 0 and 1",
+                self.resample_ess_fraction
+            ));
+        }
+        if !(self.obstacle_min_height_m < self.obstacle_max_height_m) {
+            return Err(format!(
+                "obstacle_min_height_m = {} must be below obstacle_max_height_m = {}",
+                self.obstacle_min_height_m, self.obstacle_max_height_m
+            ));
+        }
+        Ok(())
+    }
+
+    /// The lowest log-likelihood one return can score.
+    fn floor(&self) -> f32 {
+        (-0.5 * self.outlier_sigmas * self.outlier_sigmas) as f32
+    }
+}
+
+/// The map as the measurement update reads it, one window: per cell the remission mean and the
+/// weight `-0.5 / (variance + floor^2)` (NaN mean: no sample), and the likelihood field's
+/// log-likelihood of an obstacle return there.
+#[derive(Clone, Debug)]
+pub struct LocalizationMap {
+    geometry: GridGeometry,
+    /// Mean, weight per cell.
+    remission: Vec<[f32; 2]>,
+    field: Vec<f32>,
+}
+
+impl LocalizationMap {
+    /// Built from `map`'s window (its remission layer and its level-0 distance map, which the
+    /// caller has brought up to date).
+    pub fn from_map(map: &MultiHeightMap, config: &LocalizerConfig) -> Self {
+        let floor2 = (config.remission_sigma_floor * config.remission_sigma_floor) as f32;
+        let remission = map
+            .remission_grid()
+            .data()
+            .iter()
+            .map(|c| remission_entry(c, floor2))
+            .collect();
+        let sigma = config.field_sigma_m as f32;
+        let floor = config.floor();
+        let field = match map.distance_maps().level(0) {
+            Some(d) => d
+                .grid()
+                .data()
+                .iter()
+                .map(|d| (-0.5 * (d / sigma) * (d / sigma)).max(floor))
+                .collect(),
+            None => vec![floor; map.geometry().len()],
+        };
+        LocalizationMap {
+            geometry: *map.geometry(),
+            remission,
+            field,
+        }
+    }
+
+    /// The window's geometry.
+    pub fn geometry(&self) -> &GridGeometry {
+        &self.geometry
+    }
+}
+
+#[inline]
+fn remission_entry(c: &RemissionCell, floor2: f32) -> [f32; 2] {
+    match (c.mean(), c.variance()) {
+        (Some(mean), Some(var)) => [mean, -0.5 / (var + floor2)],
+        _ => [f32::NAN, 0.0],
+    }
+}
+
+/// One revolution as the filter uses it, in the vehicle frame: ground returns (x, y, intensity)
+/// and obstacle returns (x, y), decimated to the configured counts.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Observation {
+    /// Ground returns: x, y (metres, vehicle frame), intensity.
+    pub ground: Vec<[f64; 3]>,
+    /// Obstacle returns: x, y (metres, vehicle frame).
+    pub obstacles: Vec<[f64; 2]>,
+}
+
+impl Observation {
+    /// The returns of `revolution` in the vehicle frame (each column's points taken back through
+    /// the pose the column was placed at), the vehicle's own body left out (`self_filter`, with
+    /// `self_margin_m`), spread evenly over the revolution down to the configured counts.
+    pub fn from_revolution(
+        revolution: &LidarRevolution,
+        config: &LocalizerConfig,
+        self_filter: Option<&CollisionModel>,
+        self_margin_m: f64,
+    ) -> Self {
+        let scan = &revolution.scan;
+        let beams = scan.beams();
+        let (mut ground, mut obstacles) = (Vec::new(), Vec::new());
+        let max_r2 = config.max_ground_range_m * config.max_ground_range_m;
+        for (column, returns) in scan.columns().iter().zip(scan.returns().chunks(beams)) {
+            let vehicle_from_world = column.world_from_vehicle.inverse();
+            for r in returns.iter().flatten() {
+                let p = r.point_in_world;
+                let v = vehicle_from_world * Point2::new(p.x, p.y);
+                let z = p.z;
+                if z < config.ground_height_m {
+                    if v.coords.norm_squared() <= max_r2 {
+                        ground.push([v.x, v.y, f64::from(r.intensity)]);
+                    }
+                } else if (config.obstacle_min_height_m..config.obstacle_max_height_m).contains(&z)
+                    && !self_filter.is_some_and(|m| m.is_self_hit(&v, z, self_margin_m))
+                {
+                    obstacles.push([v.x, v.y]);
+                }
+            }
+        }
+        Observation {
+            ground: decimate(ground, config.remission_points),
+            obstacles: decimate(obstacles, config.field_points),
+        }
+    }
+}
+
+/// At most `n` of `v`, evenly spaced.
+fn decimate<T: Copy>(v: Vec<T>, n: usize) -> Vec<T> {
+    if v.len() <= n {
+        return v;
+    }
+    (0..n).map(|k| v[k * v.len() / n]).collect()
+}
+
+/// A particle's pose and its own odometry errors.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Particle {
+    /// Position, metres.
+    pub x: f64,
+    /// Position, metres.
+    pub y: f64,
+    /// Heading, radians.
+    pub theta: f64,
+    /// Its odometry speed is multiplied by `1 + speed_scale`.
+    pub speed_scale: f64,
+    /// Its steering angle is the odometry's plus this, radians.
+    pub steering_rad: f64,
+}
+
+/// The filter's estimate: the weighted mean pose and the covariance of (x, y, heading).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimate {
+    /// The mean pose.
+    pub world_from_vehicle: Isometry2<f64>,
+    /// Covariance of x, y (metres) and heading (radians), world frame.
+    pub covariance: Matrix3<f64>,
+}
+
+impl Estimate {
+    /// Standard deviation across the vehicle's heading, metres.
+    pub fn cross_track_sigma_m(&self) -> f64 {
+        let left = self.world_from_vehicle.rotation * Vector2::y();
+        let c = self.covariance.fixed_view::<2, 2>(0, 0);
+        (left.transpose() * c * left)[(0, 0)].max(0.0).sqrt()
+    }
+    /// Standard deviation of the heading, radians.
+    pub fn heading_sigma_rad(&self) -> f64 {
+        self.covariance[(2, 2)].max(0.0).sqrt()
+    }
+}
+
+/// What one measurement update did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct UpdateStats {
+    /// Whether the particles were weighed (false: the vehicle had not moved enough).
+    pub weighed: bool,
+    /// Whether they were resampled.
+    pub resampled: bool,
+    /// Effective sample size after weighing.
+    pub effective_particles: f64,
+    /// Ground and obstacle returns used.
+    pub points: (usize, usize),
+}
+
+/// The particle filter.
+pub struct ParticleFilter {
+    config: LocalizerConfig,
+    wheelbase_m: f64,
+    rng: rand::rngs::Xoshiro256PlusPlus,
+    particles: Vec<Particle>,
+    log_w: Vec<f64>,
+    last_odometry: Option<Odometry>,
+    travelled_m: f64,
+    map: MultiHeightMap,
+    lmap: Option<LocalizationMap>,
+}
+
+impl ParticleFilter {
+    /// A filter with `config` for a vehicle of wheelbase `wheelbase_m`, over `map` (the offline
+    /// prior; its distance maps' cap should be a few `field_sigma_m`), seeded with `seed`. It
+    /// has no particles until [`Self::initialise`].
+    pub fn new(config: LocalizerConfig, wheelbase_m: f64, map: MultiHeightMap, seed: u64) -> Self {
+        ParticleFilter {
+            wheelbase_m,
+            rng: rand::rngs::Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x10CA_112E),
+            particles: Vec::new(),
+            log_w: Vec::new(),
+            last_odometry: None,
+            travelled_m: 0.0,
+            map,
+            lmap: None,
+            config,
+        }
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &LocalizerConfig {
+        &self.config
+    }
+
+    /// Particles drawn around `fix` (a GNSS-like fix) with the configured fix spread; the
+    /// window re-centred there.
+    pub fn initialise(&mut self, fix: &Isometry2<f64>) -> Result<(), mapper::MapError> {
+        let c = &self.config;
+        let (sm, sr) = (c.fix_sigma_m, c.fix_sigma_rad);
+        let (ss, sst) = (c.speed_scale_sigma, c.steering_sigma_rad);
+        let rng = &mut self.rng;
+        self.particles = (0..c.particles)
+            .map(|_| Particle {
+                x: fix.translation.x + sm * normal(rng),
+                y: fix.translation.y + sm * normal(rng),
+                theta: wrap_angle(fix.rotation.angle() + sr * normal(rng)),
+                speed_scale: ss * normal(rng),
+                steering_rad: sst * normal(rng),
+            })
+            .collect();
+        self.log_w = vec![0.0; c.particles];
+        self.last_odometry = None;
+        self.travelled_m = 0.0;
+        self.follow(Point2::new(fix.translation.x, fix.translation.y))
+    }
+
+    /// The localization map of the current window (built at [`Self::initialise`]).
+    pub fn localization_map(&self) -> Option<&LocalizationMap> {
+        self.lmap.as_ref()
+    }
+
+    /// The offline map the filter reads.
+    pub fn map(&self) -> &MultiHeightMap {
+        &self.map
+    }
+
+    /// Whether the filter has particles.
+    pub fn initialised(&self) -> bool {
+        !self.particles.is_empty()
+    }
+
+    /// The particles.
+    pub fn particles(&self) -> &[Particle] {
+        &self.particles
+    }
+
+    /// Motion update: every particle moves along the arc its own reading of `odometry` (since
+    /// the last) describes.
+    pub fn on_odometry(&mut self, odometry: &Odometry) {
+        if let Some(last) = self.last_odometry {
+            let dt = odometry.t_s - last.t_s;
+            if dt > 0.0 {
+                let (v, delta, l) = (last.speed_m_s, last.steering_rad, self.wheelbase_m);
+                for p in &mut self.particles {
+                    let ds = v * (1.0 + p.speed_scale) * dt;
+                    let dtheta = ds * (delta + p.steering_rad).tan() / l;
+                    let mid = p.theta + 0.5 * dtheta;
+                    p.x += ds * mid.cos();
+                    p.y += ds * mid.sin();
+                    p.theta = wrap_angle(p.theta + dtheta);
+                }
+                self.travelled_m += (v * dt).abs();
+            }
+        }
+        self.last_odometry = Some(*odometry);
+    }
+
+    /// Measurement update from a revolution already reduced to an [`Observation`]: (once the
+    /// vehicle has moved `min_travel_m`) diffuse, weigh against the map, resample when the
+    /// effective sample size is low.
+    pub fn on_observation(
+        &mut self,
+        observation: &Observation,
+    ) -> Result<UpdateStats, mapper::MapError> {
+        let mut stats = UpdateStats {
+            points: (observation.ground.len(), observation.obstacles.len()),
+            ..Default::default()
+        };
+        if !self.initialised() || self.travelled_m < self.config.min_travel_m {
+            return Ok(stats);
+        }
+        let here = self.estimate().world_from_vehicle.translation.vector;
+        self.follow(Point2::from(here))?;
+        self.diffuse();
+        let Some(lmap) = &self.lmap else {
+            return Ok(stats);
+        };
+        let ll = weigh(&self.particles, observation, lmap, &self.config);
+        for (w, l) in self.log_w.iter_mut().zip(&ll) {
+            *w += l;
+        }
+        normalise(&mut self.log_w);
+        let ess = effective_size(&self.log_w);
+        stats.weighed = true;
+        stats.effective_particles = ess;
+        if ess < self.config.resample_ess_fraction * self.particles.len() as f64 {
+            self.resample();
+            stats.resampled = true;
+        }
+        self.travelled_m = 0.0;
+        Ok(stats)
+    }
+
+    /// [`Self::on_observation`] of a revolution.
+    pub fn on_revolution(
+        &mut self,
+        revolution: &LidarRevolution,
+        self_filter: Option<&CollisionModel>,
+        self_margin_m: f64,
+    ) -> Result<UpdateStats, mapper::MapError> {
+        let obs =
+            Observation::from_revolution(revolution, &self.config, self_filter, self_margin_m);
+        self.on_observation(&obs)
+    }
+
+    /// The weighted mean pose (circular mean of the heading) and covariance.
+    pub fn estimate(&self) -> Estimate {
+        estimate_of(&self.particles, &self.log_w)
+    }
+
+    /// Re-centres the map window on `here`; the localization map is rebuilt when it moved.
+    fn follow(&mut self, here: Point2<f64>) -> Result<(), mapper::MapError> {
+        let moved = self.map.recenter(here)?;
+        if moved || self.lmap.is_none() {
+            self.map.update_distance_maps();
+            self.lmap = Some(LocalizationMap::from_map(&self.map, &self.config));
+        }
+        Ok(())
+    }
+
+    /// The per-update diffusion and the random walk of each particle's odometry errors.
+    fn diffuse(&mut self) {
+        let c = &self.config;
+        let d = self.travelled_m;
+        let sp = c.diffusion_m + c.diffusion_per_m * d;
+        let sh = c.diffusion_rad + 0.01 * d;
+        let (ss, sst) = (
+            c.speed_scale_sigma * c.bias_walk,
+            c.steering_sigma_rad * c.bias_walk,
+        );
+        let rng = &mut self.rng;
+        for p in &mut self.particles {
+            p.x += sp * normal(rng);
+            p.y += sp * normal(rng);
+            p.theta = wrap_angle(p.theta + sh * normal(rng));
+            p.speed_scale += ss * normal(rng);
+            p.steering_rad += sst * normal(rng);
+        }
+    }
+
+    /// Low-variance (systematic) resampling: one uniform draw, particles taken at equal steps
+    /// of the cumulative weight; the weights start equal again.
+    fn resample(&mut self) {
+        let n = self.particles.len();
+        let w: Vec<f64> = self.log_w.iter().map(|l| l.exp()).collect();
+        let step = w.iter().sum::<f64>() / n as f64;
+        let mut u = self.rng.random::<f64>() * step;
+        let (mut i, mut cumulative) = (0, w[0]);
+        let mut next = Vec::with_capacity(n);
+        for _ in 0..n {
+            while u > cumulative && i + 1 < n {
+                i += 1;
+                cumulative += w[i];
+            }
+            next.push(self.particles[i]);
+            u += step;
+        }
+        self.particles = next;
+        self.log_w.iter_mut().for_each(|l| *l = 0.0);
+    }
+}
+
+fn normal(rng: &mut rand::rngs::Xoshiro256PlusPlus) -> f64 {
+    rng.sample(StandardNormal)
+}
+
+/// Log-weights shifted so the largest is 0.
+fn normalise(log_w: &mut [f64]) {
+    let max = log_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if max.is_finite() {
+        log_w.iter_mut().for_each(|l| *l -= max);
+    }
+}
+
+/// Effective sample size of log-weights: `(sum w)^2 / sum w^2`.
+pub fn effective_size(log_w: &[f64]) -> f64 {
+    let max = log_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let (s, s2) = log_w.iter().fold((0.0, 0.0), |(s, s2), l| {
+        let w = (l - max).exp();
+        (s + w, s2 + w * w)
+    });
+    if s2 > 0.0 { s * s / s2 } else { 0.0 }
+}
+
+/// The weighted mean and covariance of particles with log-weights `log_w`.
+pub fn estimate_of(particles: &[Particle], log_w: &[f64]) -> Estimate {
+    let max = log_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let w: Vec<f64> = log_w.iter().map(|l| (l - max).exp()).collect();
+    let total: f64 = w.iter().sum();
+    if particles.is_empty() || !(total > 0.0) {
+        return Estimate {
+            world_from_vehicle: Isometry2::identity(),
+            covariance: Matrix3::from_diagonal_element(f64::INFINITY),
+        };
+    }
+    let (mut mx, mut my, mut sc, mut ss) = (0.0, 0.0, 0.0, 0.0);
+    for (p, w) in particles.iter().zip(&w) {
+        mx += w * p.x;
+        my += w * p.y;
+        sc += w * p.theta.cos();
+        ss += w * p.theta.sin();
+    }
+    let (mx, my, mt) = (mx / total, my / total, ss.atan2(sc));
+    let mut cov = Matrix3::zeros();
+    for (p, w) in particles.iter().zip(&w) {
+        let e = nalgebra::Vector3::new(p.x - mx, p.y - my, wrap_angle(p.theta - mt));
+        cov += (w / total) * e * e.transpose();
+    }
+    Estimate {
+        world_from_vehicle: Isometry2::new(Vector2::new(mx, my), mt),
+        covariance: cov,
+    }
+}
+
+/// Each particle's log-likelihood of `obs` over `lmap`: per particle, every return placed from
+/// its pose, looked up in the window's tables; the particles in parallel.
+pub fn weigh(
+    particles: &[Particle],
+    obs: &Observation,
+    lmap: &LocalizationMap,
+    config: &LocalizerConfig,
+) -> Vec<f64> {
+    particles
+        .par_iter()
+        .with_min_len(16)
+        .map(|p| particle_log_likelihood(p, obs, lmap, config))
+        .collect()
+}
+
+/// One particle's log-likelihood of `obs` (the tables' kernel).
+#[inline]
+pub fn particle_log_likelihood(
+    p: &Particle,
+    obs: &Observation,
+    lmap: &LocalizationMap,
+    config: &LocalizerConfig,
+) -> f64 {
+    let g = &lmap.geometry;
+    let (w, h) = (g.width() as i64, g.height() as i64);
+    let (s, c) = p.theta.sin_cos();
+    let floor = config.floor();
+    let unknown = (-0.5 * config.remission_unknown_sigmas * config.remission_unknown_sigmas) as f32;
+    let index = |px: f64, py: f64| -> Option<usize> {
+        let world = Point2::new(c * px - s * py + p.x, s * px + c * py + p.y);
+        let (cx, cy) = g.cell_coords(&world);
+        (cx >= 0 && cy >= 0 && cx < w && cy < h).then(|| (cy * w + cx) as usize)
+    };
+    let mut sum = 0.0f32;
+    if config.measurement != MeasurementModel::LikelihoodField {
+        for &[px, py, intensity] in &obs.ground {
+            sum += match index(px, py) {
+                Some(i) => {
+                    let [mean, weight] = lmap.remission[i];
+                    if mean.is_nan() {
+                        unknown
+                    } else {
+                        let d = intensity as f32 - mean;
+                        (weight * d * d).max(floor)
+                    }
+                }
+                None => unknown,
+            };
+        }
+    }
+    if config.measurement != MeasurementModel::Remission {
+        for &[px, py] in &obs.obstacles {
+            sum += index(px, py).map_or(floor, |i| lmap.field[i]);
+        }
+    }
+    f64::from(sum) * config.likelihood_weight
+}
+
+/// The straightforward measurement update, for comparison: one particle at a time, each return
+/// through the particle's `Isometry2`, the map's `Option` lookups, the cell's mean and variance
+/// computed from its sums and the likelihood field's Gaussian evaluated at each lookup.
+pub fn weigh_straightforward(
+    particles: &[Particle],
+    obs: &Observation,
+    map: &MultiHeightMap,
+    remission: &mapper::Grid<RemissionCell>,
+    config: &LocalizerConfig,
+) -> Vec<f64> {
+    let floor = f64::from(config.floor());
+    let unknown = -0.5 * config.remission_unknown_sigmas * config.remission_unknown_sigmas;
+    let floor2 = config.remission_sigma_floor * config.remission_sigma_floor;
+    let field = map.distance_maps().level(0);
+    particles
+        .iter()
+        .map(|p| {
+            let pose = Isometry2::new(Vector2::new(p.x, p.y), p.theta);
+            let mut sum = 0.0;
+            if config.measurement != MeasurementModel::LikelihoodField {
+                for &[px, py, intensity] in &obs.ground {
+                    let at = pose * Point2::new(px, py);
+                    sum += match remission
+                        .at(&at)
+                        .and_then(|c| Some((c.mean()?, c.variance()?)))
+                    {
+                        Some((mean, var)) => {
+                            let d = intensity - f64::from(mean);
+                            (-0.5 * d * d / (f64::from(var) + floor2)).max(floor)
+                        }
+                        None => unknown,
+                    };
+                }
+            }
+            if config.measurement != MeasurementModel::Remission {
+                for &[px, py] in &obs.obstacles {
+                    let at = pose * Point2::new(px, py);
+                    sum += match (field, map.geometry().contains(&at)) {
+                        (Some(f), true) => {
+                            let d = f64::from(f.distance_at(&at)) / config.field_sigma_m;
+                            (-0.5 * d * d).max(floor)
+                        }
+                        _ => floor,
+                    };
+                }
+            }
+            sum * config.likelihood_weight
+        })
+        .collect()
+}
