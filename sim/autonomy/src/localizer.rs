@@ -175,7 +175,11 @@ impl LocalizerConfig {
                 self.resample_ess_fraction
             ));
         }
-        if !(self.obstacle_min_height_m < self.obstacle_max_height_m) {
+        if self
+            .obstacle_min_height_m
+            .partial_cmp(&self.obstacle_max_height_m)
+            != Some(std::cmp::Ordering::Less)
+        {
             return Err(format!(
                 "obstacle_min_height_m = {} must be below obstacle_max_height_m = {}",
                 self.obstacle_min_height_m, self.obstacle_max_height_m
@@ -581,7 +585,7 @@ pub fn estimate_of(particles: &[Particle], log_w: &[f64]) -> Estimate {
     let max = log_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let w: Vec<f64> = log_w.iter().map(|l| (l - max).exp()).collect();
     let total: f64 = w.iter().sum();
-    if particles.is_empty() || !(total > 0.0) {
+    if particles.is_empty() || total.is_nan() || total <= 0.0 {
         return Estimate {
             world_from_vehicle: Isometry2::identity(),
             covariance: Matrix3::from_diagonal_element(f64::INFINITY),
