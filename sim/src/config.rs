@@ -31,6 +31,8 @@ pub struct RunConfig {
     pub pose_source: PoseSourceConfig,
     /// The vehicle's circle model the stack checks. Default: the vehicle's own fit.
     pub collision_model: CollisionModelConfig,
+    /// The odometry's noise and bias (`crate::odometry`).
+    pub odometry: crate::odometry::OdometryConfig,
     /// Faults injected between the world and the stack (`crate::faults`): lost revolutions,
     /// beam dropout, dead beams, range noise, spurious returns, pose bias and drift. None by
     /// default.
@@ -48,6 +50,7 @@ impl Default for RunConfig {
             autonomy: AutonomyConfig::default(),
             pose_source: PoseSourceConfig::Truth,
             collision_model: CollisionModelConfig::Vehicle,
+            odometry: crate::odometry::OdometryConfig::default(),
             faults: FaultsConfig::default(),
         }
     }
@@ -131,6 +134,9 @@ pub enum PoseSourceConfig {
     /// Gauss-Markov drift (the slowly wandering error of a localizer) plus white noise (its
     /// jitter), both in the vehicle frame (along track, across track, heading).
     NoisyTruth(NoisyTruthConfig),
+    /// The particle filter over the offline map (`autonomy::localizer`): odometry, the remission
+    /// map and/or the likelihood field; the estimate's covariance widens the margins.
+    ParticleFilter(autonomy::localizer::LocalizerConfig),
 }
 
 /// The noisy-truth pose source's error model.
@@ -314,6 +320,20 @@ impl RunConfig {
         positive("autonomy.pilot_call_after_s", a.pilot_call_after_s)?;
         if let Some(r) = a.detection_range_m {
             positive("autonomy.detection_range_m", r)?;
+        }
+        non_negative("autonomy.uncertainty_sigmas", a.uncertainty_sigmas)?;
+        non_negative("autonomy.uncertainty_slow_m", a.uncertainty_slow_m)?;
+        if a.uncertainty_stop_m.partial_cmp(&a.uncertainty_slow_m)
+            != Some(std::cmp::Ordering::Greater)
+        {
+            return Err(format!(
+                "autonomy.uncertainty_stop_m = {} must be above autonomy.uncertainty_slow_m = {}",
+                a.uncertainty_stop_m, a.uncertainty_slow_m
+            ));
+        }
+        self.odometry.validate()?;
+        if let PoseSourceConfig::ParticleFilter(l) = &self.pose_source {
+            l.validate().map_err(|e| format!("pose_source.{e}"))?;
         }
         if let PoseSourceConfig::NoisyTruth(n) = &self.pose_source {
             positive("pose_source.rate_hz", n.rate_hz)?;

@@ -1,8 +1,11 @@
 //! Pose sources: what stands between the world's true pose and the stack's pose estimate. The
 //! truth; the truth with a seeded localizer-like error (Gauss-Markov drift plus white noise,
-//! published at a localizer's rate); a particle filter will be a third.
+//! published at a localizer's rate); the particle filter over the offline map
+//! (`autonomy::localizer`), started from a GNSS-like fix and fed the odometry and every
+//! revolution.
 
-use autonomy::PoseEstimate;
+use autonomy::localizer::{LocalizerConfig, Particle, ParticleFilter};
+use autonomy::{LidarRevolution, Odometry, PoseEstimate};
 use nalgebra::{Isometry2, Vector2};
 use rand::{RngExt, SeedableRng};
 use rand_distr::StandardNormal;
@@ -14,16 +17,146 @@ use crate::config::{NoisyTruthConfig, PoseSourceConfig};
 pub trait PoseSource: Send {
     /// The estimate published at `t_s`, if any.
     fn publish(&mut self, t_s: f64, truth: &Isometry2<f64>) -> Option<PoseEstimate>;
-    /// The vehicle was moved by the simulator (a new lap of an open route): publish at the next
-    /// step.
-    fn reset(&mut self) {}
+    /// The vehicle was moved by the simulator to `truth` (a new lap of an open route): publish
+    /// at the next step.
+    fn reset(&mut self, _truth: &Isometry2<f64>) -> crate::error::Result<()> {
+        Ok(())
+    }
+    /// The odometry of this physics step.
+    fn on_odometry(&mut self, _odometry: &Odometry) {}
+    /// Whether it reads the LiDAR ([`Self::on_revolution`]).
+    fn wants_revolutions(&self) -> bool {
+        false
+    }
+    /// A revolution as the stack receives it.
+    fn on_revolution(&mut self, _revolution: &LidarRevolution) -> crate::error::Result<()> {
+        Ok(())
+    }
+    /// The particles, when it has any (for the replay).
+    fn particles(&self) -> Option<&[Particle]> {
+        None
+    }
+}
+
+/// What a particle filter is built from besides its configuration.
+pub struct LocalizationContext<'a> {
+    /// The offline map's block directory.
+    pub blocks_dir: &'a std::path::Path,
+    /// The offline map's configuration and levels.
+    pub map: mapper::MapConfig,
+    /// The levels.
+    pub levels: mapper::Levels,
+    /// The vehicle's wheelbase, metres.
+    pub wheelbase_m: f64,
+    /// The vehicle's self-hit filter model and margin.
+    pub self_filter: mapper::CollisionModel,
+    /// See `self_filter`.
+    pub self_margin_m: f64,
+    /// Where the vehicle starts.
+    pub start: Isometry2<f64>,
 }
 
 /// The pose source a configuration asks for, seeded from the run's seed.
-pub fn from_config(config: &PoseSourceConfig, seed: u64) -> Box<dyn PoseSource> {
-    match config {
+pub fn from_config(
+    config: &PoseSourceConfig,
+    seed: u64,
+    context: LocalizationContext<'_>,
+) -> crate::error::Result<Box<dyn PoseSource>> {
+    Ok(match config {
         PoseSourceConfig::Truth => Box::new(Truth),
         PoseSourceConfig::NoisyTruth(c) => Box::new(NoisyTruth::new(c.clone(), seed)),
+        PoseSourceConfig::ParticleFilter(c) => Box::new(Localizer::new(c.clone(), seed, context)?),
+    })
+}
+
+/// The particle filter as a pose source: started from a fix (the truth plus the fix's seeded
+/// error) at the start and after every move by the simulator; publishes its mean and covariance
+/// at its rate.
+pub struct Localizer {
+    filter: ParticleFilter,
+    rng: rand::rngs::Xoshiro256PlusPlus,
+    self_filter: mapper::CollisionModel,
+    self_margin_m: f64,
+    last_t_s: Option<f64>,
+}
+
+impl Localizer {
+    /// A filter over the offline map of `context`, initialised at a fix near its start.
+    pub fn new(
+        config: LocalizerConfig,
+        seed: u64,
+        context: LocalizationContext<'_>,
+    ) -> crate::error::Result<Self> {
+        let map_config = mapper::MapConfig {
+            max_distance_m: (3.0 * config.field_sigma_m).max(context.map.resolution_m) as f32,
+            ..context.map
+        };
+        let start = context.start.translation.vector;
+        let map = mapper::MultiHeightMap::with_stores(
+            map_config,
+            context.levels,
+            start.into(),
+            Some(context.blocks_dir),
+            None,
+        )?;
+        let filter = ParticleFilter::new(config, context.wheelbase_m, map, seed);
+        let mut localizer = Localizer {
+            filter,
+            rng: rand::rngs::Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x6E55_F1C5),
+            self_filter: context.self_filter,
+            self_margin_m: context.self_margin_m,
+            last_t_s: None,
+        };
+        localizer.reset(&context.start)?;
+        Ok(localizer)
+    }
+
+    /// The filter.
+    pub fn filter(&self) -> &ParticleFilter {
+        &self.filter
+    }
+}
+
+impl PoseSource for Localizer {
+    fn publish(&mut self, t_s: f64, _truth: &Isometry2<f64>) -> Option<PoseEstimate> {
+        let period = 1.0 / self.filter.config().rate_hz;
+        if self.last_t_s.is_some_and(|last| t_s - last < period - 5e-7) {
+            return None;
+        }
+        self.last_t_s = Some(t_s);
+        Some(self.filter.estimate().at(t_s))
+    }
+
+    fn reset(&mut self, truth: &Isometry2<f64>) -> crate::error::Result<()> {
+        let c = self.filter.config();
+        let (sm, sr) = (c.fix_sigma_m, c.fix_sigma_rad);
+        let mut normal = || -> f64 { self.rng.sample(StandardNormal) };
+        let fix = Isometry2::new(
+            truth.translation.vector + Vector2::new(sm * normal(), sm * normal()),
+            truth.rotation.angle() + sr * normal(),
+        );
+        self.filter.clear();
+        self.filter.initialise(&fix)?;
+        self.last_t_s = None;
+        Ok(())
+    }
+
+    fn on_odometry(&mut self, odometry: &Odometry) {
+        self.filter.on_odometry(odometry);
+    }
+
+    fn wants_revolutions(&self) -> bool {
+        true
+    }
+
+    fn on_revolution(&mut self, revolution: &LidarRevolution) -> crate::error::Result<()> {
+        self.filter
+            .on_revolution(revolution, Some(&self.self_filter), self.self_margin_m)?;
+        Ok(())
+    }
+
+    fn particles(&self) -> Option<&[Particle]> {
+        Some(self.filter.particles())
     }
 }
 
@@ -32,10 +165,7 @@ pub struct Truth;
 
 impl PoseSource for Truth {
     fn publish(&mut self, t_s: f64, truth: &Isometry2<f64>) -> Option<PoseEstimate> {
-        Some(PoseEstimate {
-            t_s,
-            world_from_vehicle: *truth,
-        })
+        Some(PoseEstimate::exact(t_s, *truth))
     }
 }
 
@@ -114,17 +244,18 @@ impl PoseSource for NoisyTruth {
             self.drift[2] + white[2],
         ];
         let offset = truth.rotation * Vector2::new(e[0], e[1]);
-        Some(PoseEstimate {
+        Some(PoseEstimate::exact(
             t_s,
-            world_from_vehicle: Isometry2::new(
+            Isometry2::new(
                 truth.translation.vector + offset,
                 truth.rotation.angle() + e[2],
             ),
-        })
+        ))
     }
 
-    fn reset(&mut self) {
+    fn reset(&mut self, _truth: &Isometry2<f64>) -> crate::error::Result<()> {
         self.last_t_s = None;
+        Ok(())
     }
 }
 

@@ -51,6 +51,8 @@ pub struct RunReport {
     /// What the faults did: lost revolutions, dropped and spurious returns, watchdog stops.
     #[serde(default)]
     pub faults: crate::faults::FaultCounts,
+    /// The pose estimate against the truth (`None` when the pose source is the truth).
+    pub localization: Option<crate::localization::LocalizationReport>,
 }
 
 /// The obstacle a vehicle waits for without seeing it.
@@ -79,6 +81,8 @@ pub struct TimeSplit {
     pub planning: f64,
     /// Motion, ground truth, obstacles.
     pub physics: f64,
+    /// The pose source (the particle filter's motion and measurement updates).
+    pub localization: f64,
 }
 
 /// Progress of a run, for a progress bar.

@@ -11,8 +11,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use autonomy::{
-    AutonomyConfig, Behaviour, Driver, DriverStatus, LidarRevolution, Odometry, OnlineMap,
-    RoutePath, VehicleModel,
+    AutonomyConfig, Behaviour, Driver, DriverStatus, LidarRevolution, OnlineMap, RoutePath,
+    VehicleModel,
 };
 use mapper::{CollisionModel, MultiHeightMap};
 use nalgebra::{Isometry2, Point2};
@@ -142,6 +142,10 @@ struct Rig<'a> {
     part_levels: Vec<usize>,
     route: RoutePath,
     pose_source: Box<dyn PoseSource>,
+    /// The odometry sensor (noise and bias).
+    odometry: crate::odometry::OdometrySensor,
+    /// The pose estimates' errors (not kept when the pose source is the truth).
+    localization_errors: Option<crate::localization::ErrorLog>,
     driver: Driver,
     scheduler: Scheduler,
     judge: Judge,
@@ -192,18 +196,7 @@ impl<'a> Rig<'a> {
             self.move_obstacles();
             self.split.physics += physics.elapsed().as_secs_f64();
             let truth = self.state.world_from_vehicle();
-            self.driver.on_odometry(Odometry {
-                t_s: self.t_s,
-                speed_m_s: self.state.speed_m_s,
-                steering_rad: self.state.steering_rad,
-            });
-            if let Some(mut estimate) = self.pose_source.publish(self.t_s, &truth) {
-                estimate.world_from_vehicle = self
-                    .config
-                    .faults
-                    .bias_pose(self.t_s, &estimate.world_from_vehicle);
-                self.driver.on_pose(estimate);
-            }
+            self.sense_pose(&truth);
             if self.step.is_multiple_of(self.steps_per_scan) {
                 self.revolution(tasks, &truth, observer)?;
             }
@@ -237,7 +230,7 @@ impl<'a> Rig<'a> {
                 world: &self.world,
             })?;
             if verdict.lap_ended && !self.route.closed() && !self.judge.done() {
-                self.restart_open_route();
+                self.restart_open_route()?;
             }
             if self.step.is_multiple_of(100) {
                 progress(Progress {
@@ -248,6 +241,37 @@ impl<'a> Rig<'a> {
             }
         }
         Ok(EndReason::Completed)
+    }
+
+    /// The odometry of this step to the stack and the pose source; the pose source's estimate
+    /// (through the pose faults) to the stack, its error logged.
+    fn sense_pose(&mut self, truth: &Isometry2<f64>) {
+        let odometry =
+            self.odometry
+                .measure(self.t_s, self.state.speed_m_s, self.state.steering_rad);
+        self.driver.on_odometry(odometry);
+        let t0 = Instant::now();
+        self.pose_source.on_odometry(&odometry);
+        let published = self.pose_source.publish(self.t_s, truth);
+        self.split.localization += t0.elapsed().as_secs_f64();
+        if let Some(mut estimate) = published {
+            estimate.world_from_vehicle = self
+                .config
+                .faults
+                .bias_pose(self.t_s, &estimate.world_from_vehicle);
+            if let Some(log) = &mut self.localization_errors {
+                log.record(self.judge.laps_completed() + 1, truth, &estimate);
+            }
+            self.driver.on_pose(estimate);
+        }
+    }
+
+    /// The pose source reads a revolution as the stack receives it.
+    fn localize(&mut self, captured: &Captured) -> Result<()> {
+        let t0 = Instant::now();
+        self.pose_source.on_revolution(&captured.revolution)?;
+        self.split.localization += t0.elapsed().as_secs_f64();
+        Ok(())
     }
 
     /// A revolution: taken, then (at once, or when its latency has passed) mapped and planned
@@ -287,6 +311,15 @@ impl<'a> Rig<'a> {
             return Ok(());
         }
         self.driver.on_revolution(t_s);
+        if self.pose_source.wants_revolutions() {
+            // The localizer reads it first, here; the stack maps what was captured.
+            let captured = sensor.capture(truth, &estimate, index, t_s)?;
+            self.localize(&captured)?;
+            let (lidar_s, thought) = self
+                .scheduler
+                .revolution(move || Ok(captured), &mut self.driver)?;
+            return self.planned(tasks, lidar_s, thought, observer);
+        }
         let capture = || sensor.capture(truth, &estimate, index, t_s);
         let (lidar_s, thought) = self.scheduler.revolution(capture, &mut self.driver)?;
         self.planned(tasks, lidar_s, thought, observer)
@@ -308,6 +341,7 @@ impl<'a> Rig<'a> {
             };
             // The watchdog counts a revolution's age from when it was taken.
             self.driver.on_revolution(captured.revolution.t_s);
+            self.localize(&captured)?;
             let (lidar_s, thought) = self
                 .scheduler
                 .revolution(move || Ok(captured), &mut self.driver)?;
@@ -385,15 +419,17 @@ impl<'a> Rig<'a> {
     }
 
     /// An open route starts its next lap from its start pose.
-    fn restart_open_route(&mut self) {
+    fn restart_open_route(&mut self) -> Result<()> {
         self.state = start_state(&self.scenario.vehicle.world_from_start);
         self.judge.restart_lap();
         self.driver.restart();
-        self.pose_source.reset();
+        self.pose_source
+            .reset(&self.scenario.vehicle.world_from_start)?;
         // Revolutions of the last lap still in transit would carry its poses into this one.
         self.in_transit.clear();
         self.world
             .set_vehicle_pose(&self.state.world_from_vehicle(), self.t_s);
+        Ok(())
     }
 }
 
@@ -574,6 +610,19 @@ impl<'a> Rig<'a> {
         );
         let state = start_state(&start);
         world.set_vehicle_pose(&state.world_from_vehicle(), 0.0);
+        let pose_source = crate::pose_source::from_config(
+            &config.pose_source,
+            seed,
+            crate::pose_source::LocalizationContext {
+                blocks_dir: &setup.map_dir.join("blocks"),
+                map: config.mapping.map,
+                levels: crate::mapping::levels_of(scenario, &config)?,
+                wheelbase_m: vehicle.spec.motion.wheelbase_m,
+                self_filter: crate::mapping::self_filter_model(vehicle)?,
+                self_margin_m: config.mapping.map.self_hit_margin_m,
+                start,
+            },
+        )?;
         let total_m = route.length_m() * laps as f64;
         Ok(Rig {
             scenario,
@@ -586,7 +635,10 @@ impl<'a> Rig<'a> {
             model,
             part_levels,
             route,
-            pose_source: crate::pose_source::from_config(&config.pose_source, seed),
+            pose_source,
+            odometry: crate::odometry::OdometrySensor::new(config.odometry.clone(), seed),
+            localization_errors: (config.pose_source != crate::config::PoseSourceConfig::Truth)
+                .then(crate::localization::ErrorLog::default),
             driver,
             scheduler: Scheduler::new(config.schedule, online),
             judge,
@@ -676,6 +728,7 @@ impl<'a> Rig<'a> {
                 spurious_returns: self.spurious_returns.load(Ordering::Relaxed),
                 ..self.fault_counts
             },
+            localization: self.localization_errors.as_ref().map(|l| l.report()),
             config: self.config,
         }
     }

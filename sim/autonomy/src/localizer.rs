@@ -85,8 +85,11 @@ pub struct LocalizerConfig {
     /// 0.002.
     pub diffusion_rad: f64,
     /// A revolution updates the particles only once the vehicle has moved this far since the last
-    /// update, metres (standing still, the same view would collapse them). Default 0.05.
+    /// update, metres (standing still, the same view would collapse them) - or while the
+    /// estimate's cross-track standard deviation is above `settled_sigma_m`. Default 0.05.
     pub min_travel_m: f64,
+    /// See `min_travel_m`, metres. Default 0.1.
+    pub settled_sigma_m: f64,
     /// Resample when the effective sample size falls below this fraction of the particles.
     /// Default 0.5.
     pub resample_ess_fraction: f64,
@@ -121,6 +124,7 @@ impl Default for LocalizerConfig {
             diffusion_per_m: 0.02,
             diffusion_rad: 0.002,
             min_travel_m: 0.05,
+            settled_sigma_m: 0.1,
             resample_ess_fraction: 0.5,
             fix_sigma_m: 0.5,
             fix_sigma_rad: 0.05,
@@ -150,6 +154,7 @@ impl LocalizerConfig {
             ("diffusion_per_m", self.diffusion_per_m),
             ("diffusion_rad", self.diffusion_rad),
             ("min_travel_m", self.min_travel_m),
+            ("settled_sigma_m", self.settled_sigma_m),
             ("fix_sigma_m", self.fix_sigma_m),
             ("fix_sigma_rad", self.fix_sigma_rad),
             ("max_ground_range_m", self.max_ground_range_m),
@@ -329,15 +334,17 @@ pub struct Estimate {
 }
 
 impl Estimate {
+    /// As the stack's message, holding at `t_s`.
+    pub fn at(&self, t_s: f64) -> crate::PoseEstimate {
+        crate::PoseEstimate {
+            t_s,
+            world_from_vehicle: self.world_from_vehicle,
+            covariance: self.covariance,
+        }
+    }
     /// Standard deviation across the vehicle's heading, metres.
     pub fn cross_track_sigma_m(&self) -> f64 {
-        let left = self.world_from_vehicle.rotation * Vector2::y();
-        let c = self.covariance.fixed_view::<2, 2>(0, 0);
-        (left.transpose() * c * left)[(0, 0)].max(0.0).sqrt()
-    }
-    /// Standard deviation of the heading, radians.
-    pub fn heading_sigma_rad(&self) -> f64 {
-        self.covariance[(2, 2)].max(0.0).sqrt()
+        self.at(0.0).cross_track_sigma_m()
     }
 }
 
@@ -422,6 +429,13 @@ impl ParticleFilter {
         &self.map
     }
 
+    /// Drops the particles (the vehicle was moved: [`Self::initialise`] again).
+    pub fn clear(&mut self) {
+        self.particles.clear();
+        self.log_w.clear();
+        self.last_odometry = None;
+    }
+
     /// Whether the filter has particles.
     pub fn initialised(&self) -> bool {
         !self.particles.is_empty()
@@ -464,7 +478,13 @@ impl ParticleFilter {
             points: (observation.ground.len(), observation.obstacles.len()),
             ..Default::default()
         };
-        if !self.initialised() || self.travelled_m < self.config.min_travel_m {
+        if !self.initialised() {
+            return Ok(stats);
+        }
+        // Standing still, the same view again would collapse the particles onto one reading of
+        // it - unless they have not settled yet (at the start, from the fix).
+        let settled = self.estimate().cross_track_sigma_m() < self.config.settled_sigma_m;
+        if self.travelled_m < self.config.min_travel_m && settled {
             return Ok(stats);
         }
         let here = self.estimate().world_from_vehicle.translation.vector;

@@ -1,7 +1,7 @@
 //! What crosses the boundary between the simulated vehicle and the stack under test: sensor
 //! messages in (a LiDAR revolution, a pose estimate, odometry), a command out.
 
-use nalgebra::Isometry2;
+use nalgebra::{Isometry2, Matrix3, Vector2};
 
 /// One LiDAR revolution as the stack receives it: the returns placed in the world frame from the
 /// pose estimate the revolution was taken at (where the vehicle believes it was), never from the
@@ -23,6 +23,38 @@ pub struct PoseEstimate {
     pub t_s: f64,
     /// The estimated pose of the vehicle (rear axle centre) in the world frame.
     pub world_from_vehicle: Isometry2<f64>,
+    /// Covariance of x, y (metres) and heading (radians), world frame; zero for an exact pose.
+    pub covariance: Matrix3<f64>,
+}
+
+impl PoseEstimate {
+    /// An estimate that claims to be exact (zero covariance).
+    pub fn exact(t_s: f64, world_from_vehicle: Isometry2<f64>) -> Self {
+        PoseEstimate {
+            t_s,
+            world_from_vehicle,
+            covariance: Matrix3::zeros(),
+        }
+    }
+
+    /// Standard deviation across the vehicle's heading, metres.
+    pub fn cross_track_sigma_m(&self) -> f64 {
+        let left = self.world_from_vehicle.rotation * Vector2::y();
+        let c = self.covariance.fixed_view::<2, 2>(0, 0);
+        (left.transpose() * c * left)[(0, 0)].max(0.0).sqrt()
+    }
+
+    /// Standard deviation of the heading, radians.
+    pub fn heading_sigma_rad(&self) -> f64 {
+        self.covariance[(2, 2)].max(0.0).sqrt()
+    }
+
+    /// How far a point `reach_m` from the vehicle's origin may be from where the estimate puts
+    /// it, one standard deviation across track: `sqrt(sigma_y^2 + (reach sigma_theta)^2)`.
+    pub fn lateral_sigma_at_m(&self, reach_m: f64) -> f64 {
+        self.cross_track_sigma_m()
+            .hypot(reach_m * self.heading_sigma_rad())
+    }
 }
 
 /// What the vehicle's own sensors report of its motion.

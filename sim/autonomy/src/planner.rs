@@ -83,6 +83,32 @@ pub struct AutonomyConfig {
     /// stop (it would be planning blind), and drives on when revolutions return, seconds.
     /// Default 0.3 (three revolutions at 10 Hz).
     pub watchdog_s: f64,
+    /// The safety distances (planner's and avoider's) are widened by this many standard
+    /// deviations of the estimate's lateral uncertainty at the vehicle's farthest point
+    /// (`PoseEstimate::lateral_sigma_at_m`). Default 2.
+    pub uncertainty_sigmas: f64,
+    /// Above this lateral standard deviation the wanted speed falls linearly ... Default 0.15 m.
+    pub uncertainty_slow_m: f64,
+    /// ... to a stop at this one, metres. Default 0.5.
+    pub uncertainty_stop_m: f64,
+}
+
+impl AutonomyConfig {
+    /// The configuration for an estimate whose lateral standard deviation at the vehicle's
+    /// farthest point is `sigma_m`: the safety distances widened by `uncertainty_sigmas` of it,
+    /// and the factor the wanted speed is multiplied by (1 up to `uncertainty_slow_m`, 0 from
+    /// `uncertainty_stop_m`).
+    pub fn under_uncertainty(&self, sigma_m: f64) -> (AutonomyConfig, f64) {
+        let extra = (self.uncertainty_sigmas * sigma_m) as f32;
+        let span = (self.uncertainty_stop_m - self.uncertainty_slow_m).max(1e-9);
+        let factor = (1.0 - (sigma_m - self.uncertainty_slow_m) / span).clamp(0.0, 1.0);
+        let widened = AutonomyConfig {
+            planner_safety_m: self.planner_safety_m + extra,
+            avoider_safety_m: self.avoider_safety_m + extra,
+            ..self.clone()
+        };
+        (widened, if sigma_m.is_finite() { factor } else { 0.0 })
+    }
 }
 
 impl Default for AutonomyConfig {
@@ -106,6 +132,9 @@ impl Default for AutonomyConfig {
             pilot_call_after_s: 10.0,
             detection_range_m: None,
             watchdog_s: 0.3,
+            uncertainty_sigmas: 2.0,
+            uncertainty_slow_m: 0.15,
+            uncertainty_stop_m: 0.5,
         }
     }
 }

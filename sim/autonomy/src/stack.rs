@@ -80,6 +80,9 @@ pub struct Driver {
     status: DriverStatus,
     /// When the last revolution arrived, seconds (the watchdog's clock).
     last_revolution_s: Option<f64>,
+    /// The farthest any circle of the collision model reaches from the vehicle's origin, metres
+    /// (where a heading error moves the vehicle most).
+    reach_m: f64,
 }
 
 impl Driver {
@@ -92,7 +95,14 @@ impl Driver {
         wanted_speed_m_s: f64,
         distance_map_half_size_m: f64,
     ) -> Self {
+        let reach_m = vehicle
+            .collision
+            .circles()
+            .iter()
+            .map(|c| c.x_m.hypot(c.y_m) + c.radius_m)
+            .fold(0.0, f64::max);
         Driver {
+            reach_m,
             route,
             vehicle,
             config,
@@ -177,6 +187,9 @@ impl Driver {
         self.route_s_m = Some(s);
         let checker = self.vehicle.collision.checker(map.map().distance_maps())?;
         let previous = self.plan.as_ref().map_or(0.0, |p| p.chosen().offset_m);
+        // A less certain estimate: wider margins, a lower speed.
+        let sigma_m = estimate.lateral_sigma_at_m(self.reach_m);
+        let (config, speed_factor) = self.config.under_uncertainty(sigma_m);
         let p = plan(
             &checker,
             &self.route,
@@ -184,13 +197,13 @@ impl Driver {
             d,
             previous,
             self.vehicle.behaviour,
-            &self.config,
+            &config,
         );
         let (v, _) = avoid(
             p.chosen(),
-            self.wanted_speed_m_s,
+            self.wanted_speed_m_s * speed_factor,
             self.vehicle.deceleration_m_s2,
-            &self.config,
+            &config,
         );
         self.speed_command_m_s = v;
         self.status = if v > 0.0 {
@@ -363,6 +376,7 @@ mod tests {
 
     fn at(t_s: f64, x: f64, y: f64, yaw: f64) -> PoseEstimate {
         PoseEstimate {
+            covariance: nalgebra::Matrix3::zeros(),
             t_s,
             world_from_vehicle: Isometry2::new(Vector2::new(x, y), yaw),
         }

@@ -28,6 +28,15 @@ pub struct MapArgs {
     pub config: Option<PathBuf>,
 }
 
+/// The pose sources `--pose-source` can pick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PoseSourceKind {
+    /// The true pose.
+    Truth,
+    /// The particle filter over the offline map.
+    ParticleFilter,
+}
+
 /// Arguments of `taxi-sim run`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct RunArgs {
@@ -48,6 +57,10 @@ pub struct RunArgs {
     /// The offline map (default: out/maps/<scenario file name>; built there when missing or stale).
     #[arg(long)]
     pub map_dir: Option<PathBuf>,
+    /// Where the stack's pose comes from: `truth`, or `particle-filter` (the configuration's
+    /// settings, or the defaults). Default: the configuration's.
+    #[arg(long, value_enum)]
+    pub pose_source: Option<PoseSourceKind>,
     /// Pose source `noisy_truth` with this white noise in position, metres (standard deviation,
     /// each axis, at the source's rate); the configuration's other noisy-truth settings are kept.
     #[arg(long)]
@@ -225,10 +238,21 @@ fn run_config(args: &RunArgs, scenario: &Scenario) -> anyhow::Result<RunConfig> 
     if args.sequential_sensing {
         config.schedule = Schedule::Sequential;
     }
+    match args.pose_source {
+        Some(PoseSourceKind::Truth) => config.pose_source = PoseSourceConfig::Truth,
+        Some(PoseSourceKind::ParticleFilter)
+            if !matches!(config.pose_source, PoseSourceConfig::ParticleFilter(_)) =>
+        {
+            config.pose_source = PoseSourceConfig::ParticleFilter(Default::default());
+        }
+        _ => {}
+    }
     if args.pose_noise_m.is_some() || args.pose_noise_rad.is_some() {
         let mut noisy = match &config.pose_source {
             PoseSourceConfig::NoisyTruth(n) => n.clone(),
-            PoseSourceConfig::Truth => NoisyTruthConfig::default(),
+            PoseSourceConfig::Truth | PoseSourceConfig::ParticleFilter(_) => {
+                NoisyTruthConfig::default()
+            }
         };
         if let Some(m) = args.pose_noise_m {
             noisy.white_sigma_m = m;
@@ -289,6 +313,22 @@ pub fn table(r: &RunReport) -> String {
             f.spurious_returns,
             f.watchdog_stops
         );
+    }
+    if let Some(l) = &r.localization {
+        for e in std::iter::once(&l.run).chain(&l.laps) {
+            let _ = writeln!(
+                t,
+                "localization {}: cross-track RMSE {:.3} m (p95 {:.3}, max {:.3}), along {:.3} m, heading {:.4} rad; its sigma {:.3} m mean, {:.3} max",
+                e.lap.map_or("(run)".to_string(), |k| format!("lap {k}")),
+                e.cross_m.rmse,
+                e.cross_m.p95,
+                e.cross_m.max,
+                e.along_m.rmse,
+                e.heading_rad.rmse,
+                e.mean_sigma_cross_m,
+                e.max_sigma_cross_m
+            );
+        }
     }
     if let Some(w) = &r.waiting_for {
         let _ = writeln!(
@@ -352,7 +392,7 @@ pub fn table(r: &RunReport) -> String {
     let s = &r.time_split_s;
     let _ = writeln!(
         t,
-        "sim {:.1} s in {:.1} s wall: {:.1}x real time (lidar {:.1} s, mapping {:.1} s, distance maps {:.1} s, planning {:.1} s, physics {:.1} s)",
+        "sim {:.1} s in {:.1} s wall: {:.1}x real time (lidar {:.1} s, mapping {:.1} s, distance maps {:.1} s, planning {:.1} s, physics {:.1} s, localization {:.1} s)",
         r.sim_time_s,
         r.wall_time_s,
         r.real_time_factor,
@@ -360,7 +400,8 @@ pub fn table(r: &RunReport) -> String {
         s.mapping,
         s.distance_maps,
         s.planning,
-        s.physics
+        s.physics,
+        s.localization
     );
     t
 }
