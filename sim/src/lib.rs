@@ -21,6 +21,7 @@
 
 pub mod bench;
 pub mod bench_blocks;
+pub mod bench_localization;
 pub mod campaign;
 pub mod config;
 pub mod demo;

@@ -116,6 +116,9 @@ enum BenchTarget {
     /// The offline map of `--scenario` (built if missing): its blocks written and read in the
     /// compressed format against the uncompressed one, and bytes per block.
     Blocks,
+    /// The particle filter on `--scenario`'s offline map (built if missing): one revolution's
+    /// update, the weighing's tables against the straightforward way (one thread each).
+    Localization,
 }
 
 /// Raised by [`emit`] when stdout's reader went away (`taxi-sim ... | head`): not an error.
@@ -282,6 +285,9 @@ fn bench(
         }
         BenchTarget::Campaign => sim::campaign::bench::campaign_figures(campaign, &mut report)?,
         BenchTarget::Blocks => sim::bench_blocks::figures_for(scenario, &mut report)?,
+        BenchTarget::Localization => {
+            sim::bench_localization::figures_for(scenario, samples.unwrap_or(15), &mut report)?
+        }
     };
     progress.finish_and_clear();
     let mut t = String::new();

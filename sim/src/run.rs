@@ -311,15 +311,6 @@ impl<'a> Rig<'a> {
             return Ok(());
         }
         self.driver.on_revolution(t_s);
-        if self.pose_source.wants_revolutions() {
-            // The localizer reads it first, here; the stack maps what was captured.
-            let captured = sensor.capture(truth, &estimate, index, t_s)?;
-            self.localize(&captured)?;
-            let (lidar_s, thought) = self
-                .scheduler
-                .revolution(move || Ok(captured), &mut self.driver)?;
-            return self.planned(tasks, lidar_s, thought, observer);
-        }
         let capture = || sensor.capture(truth, &estimate, index, t_s);
         let (lidar_s, thought) = self.scheduler.revolution(capture, &mut self.driver)?;
         self.planned(tasks, lidar_s, thought, observer)
@@ -341,7 +332,6 @@ impl<'a> Rig<'a> {
             };
             // The watchdog counts a revolution's age from when it was taken.
             self.driver.on_revolution(captured.revolution.t_s);
-            self.localize(&captured)?;
             let (lidar_s, thought) = self
                 .scheduler
                 .revolution(move || Ok(captured), &mut self.driver)?;
@@ -359,10 +349,16 @@ impl<'a> Rig<'a> {
         observer: &mut (dyn Observer + Send),
     ) -> Result<()> {
         self.split.lidar += lidar_s;
-        if let Some(thought) = thought {
-            self.show(&thought, observer)?;
+        if let Some(thought) = &thought {
+            self.show(thought, observer)?;
         }
         self.scheduler.dispatch(tasks);
+        if let Some(thought) = &thought {
+            // The localizer reads the revolution once the stack has it (overlapped: the one
+            // taken a revolution ago, brought forward to now on odometry), beside the mapping
+            // of the next.
+            self.localize(&thought.captured)?;
+        }
         Ok(())
     }
 
