@@ -47,6 +47,11 @@ pub struct ObstacleTestParams {
     pub unsafe_height_above_ground_m: Option<f64>,
     /// Height of the (flat) ground in the world frame, metres. Default 0.
     pub ground_height_m: f64,
+    /// A hit lower than this above the ground is never an obstacle, whatever the test says
+    /// (CARMEN's `safe_height_from_ground`), metres. Default 0 (off). Near the sensor the beams
+    /// fall a few centimetres apart on the ground, and range noise alone tilts a pair of ground
+    /// hits enough for the test: the simulator sets 0.05 m (its range noise is 0.02 m).
+    pub safe_height_from_ground_m: f64,
     /// Returns farther than this (horizontal distance) are not mapped, metres. Default 70 (CARMEN).
     pub max_range_m: f64,
 }
@@ -57,6 +62,7 @@ impl Default for ObstacleTestParams {
             sigma: 0.45,
             unsafe_height_above_ground_m: Some(1.0),
             ground_height_m: 0.0,
+            safe_height_from_ground_m: 0.0,
             max_range_m: 70.0,
         }
     }
@@ -107,6 +113,9 @@ fn evidence(
         .is_some_and(|h| upper.z - params.ground_height_m >= h)
     {
         return Evidence::Certain;
+    }
+    if upper.z - params.ground_height_m < params.safe_height_from_ground_m {
+        return Evidence::Nothing;
     }
     let drop_upper = sensor.z - upper.z; // how far below the sensor the upper hit is
     if drop_upper <= 1e-6 {

@@ -104,6 +104,13 @@ pub struct MappingConfig {
 /// car's body clears 0.2 m, its wheels nothing).
 pub const OBSTACLE_HEIGHT_M: f64 = 0.1;
 
+/// Below this height above the ground no hit is an obstacle in the simulator's maps (CARMEN's
+/// `safe_height_from_ground`): about 4.5 standard deviations of a ground return's height error
+/// (0.011 m, above). Without it, ground hits a
+/// few metres ahead of the jet's nose-mounted sensor, 0.15 m apart, read as obstacles often
+/// enough to stop a jet whose margins the localizer's uncertainty had widened.
+pub const SAFE_HEIGHT_FROM_GROUND_M: f64 = 0.05;
+
 impl Default for MappingConfig {
     fn default() -> Self {
         let map = MapConfig::default();
@@ -112,6 +119,7 @@ impl Default for MappingConfig {
                 self_hit_margin_m: 1.5,
                 obstacle_test: mapper::ObstacleTestParams {
                     unsafe_height_above_ground_m: Some(OBSTACLE_HEIGHT_M),
+                    safe_height_from_ground_m: SAFE_HEIGHT_FROM_GROUND_M,
                     ..map.obstacle_test
                 },
                 ..map

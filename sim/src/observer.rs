@@ -89,6 +89,10 @@ pub struct ScanFrame<'a> {
     pub speed_scale: f64,
     /// The world (ground truth: object poses, which ones are active).
     pub world: &'a World,
+    /// The pose source's particles, when it has any (the particle filter).
+    pub particles: Option<&'a [autonomy::localizer::Particle]>,
+    /// The stack's current pose estimate with its covariance.
+    pub pose_estimate: Option<autonomy::PoseEstimate>,
 }
 
 /// One physics step, given to [`Observer::step`].

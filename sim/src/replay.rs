@@ -983,6 +983,58 @@ impl Replay {
         Ok(())
     }
 
+    /// The estimate's error against the truth of the same revolution and its own standard
+    /// deviation (plots); with `particles`, a hundred of the particles and the 2-sigma ellipse
+    /// of the estimate's position.
+    fn log_localization(&mut self, frame: &ScanFrame<'_>, particles: bool) -> Result<()> {
+        let Some(estimate) = frame.pose_estimate else {
+            return Ok(());
+        };
+        let d = frame.estimate.translation.vector - frame.truth.translation.vector;
+        let left = frame.truth.rotation * nalgebra::Vector2::y();
+        self.rec.log(
+            "plots/localization/cross_track_error_m",
+            &rerun::Scalars::single(d.dot(&left)),
+        )?;
+        self.rec.log(
+            "plots/localization/cross_track_sigma_m",
+            &rerun::Scalars::single(estimate.cross_track_sigma_m()),
+        )?;
+        let Some(ps) = frame.particles.filter(|_| particles) else {
+            return Ok(());
+        };
+        let every = ps.len().div_ceil(100).max(1);
+        self.rec.log(
+            "world/localization/particles",
+            &rerun::Points3D::new(
+                ps.iter()
+                    .step_by(every)
+                    .map(|p| [p.x as f32, p.y as f32, 0.08]),
+            )
+            .with_radii([0.05])
+            .with_colors([Rgba32::from_rgb(255, 120, 0)]),
+        )?;
+        let c = estimate.covariance.fixed_view::<2, 2>(0, 0).into_owned();
+        let eig = c.symmetric_eigen();
+        let centre = estimate.world_from_vehicle.translation.vector;
+        let ellipse: Vec<[f32; 3]> = (0..=32)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / 32.0;
+                let u = nalgebra::Vector2::new(
+                    2.0 * eig.eigenvalues[0].max(0.0).sqrt() * a.cos(),
+                    2.0 * eig.eigenvalues[1].max(0.0).sqrt() * a.sin(),
+                );
+                let p = centre + eig.eigenvectors * u;
+                [p.x as f32, p.y as f32, 0.08]
+            })
+            .collect();
+        self.rec.log(
+            "world/localization/covariance_2sigma",
+            &rerun::LineStrips3D::new([ellipse]).with_colors([Rgba32::from_rgb(255, 120, 0)]),
+        )?;
+        Ok(())
+    }
+
     fn log_plan(&mut self, frame: &ScanFrame<'_>, candidates: bool) -> Result<()> {
         let strip = |poses: &[Isometry2<f64>], every: usize| -> Vec<[f32; 3]> {
             let mut out: Vec<[f32; 3]> = poses
@@ -1201,6 +1253,7 @@ impl Observer for Replay {
             self.log_lidar(frame)?;
             self.summary.scans_logged += 1;
         }
+        self.log_localization(frame, full)?;
         self.log_plan(frame, full)?;
         self.rec.log(
             "plots/speed_scale",

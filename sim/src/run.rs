@@ -391,6 +391,8 @@ impl<'a> Rig<'a> {
             speed_cmd_m_s: v,
             speed_scale: if wanted > 0.0 { v / wanted } else { 0.0 },
             world: &self.world,
+            particles: self.pose_source.particles(),
+            pose_estimate: self.driver.estimate().copied(),
         })
     }
 

@@ -69,13 +69,15 @@ pub struct LocalizerConfig {
     /// Each return's log-likelihood is multiplied by this (the returns of one revolution are not
     /// independent; CARMEN's particles weight factor). Default 0.05.
     pub likelihood_weight: f64,
-    /// Spread of each particle's odometry speed-scale error (drawn at the start). Default 0.02.
+    /// Spread of each particle's odometry speed-scale error, drawn afresh at every measurement
+    /// update (white, not a per-particle bias: along a straight line with nothing to see
+    /// along it, resampling would otherwise let the particles' shared bias wander - 8 % in a
+    /// kilometre of taxiway). CARMEN's velocity noise, 0.15, by default: along a taxiway whose
+    /// lines say nothing of the along-track position, the particles must spread far enough
+    /// for the next marker or turn to find the odometry's error.
     pub speed_scale_sigma: f64,
-    /// Spread of each particle's steering error, radians. Default 0.01.
+    /// Spread of each particle's steering error, radians, drawn the same way. Default 0.01.
     pub steering_sigma_rad: f64,
-    /// Random walk of those errors per measurement update (fraction of their spread). Default
-    /// 0.2.
-    pub bias_walk: f64,
     /// Position diffusion per measurement update: this plus `diffusion_per_m` per metre driven,
     /// metres. Default 0.01.
     pub diffusion_m: f64,
@@ -117,9 +119,8 @@ impl Default for LocalizerConfig {
             outlier_sigmas: 3.0,
             field_sigma_m: 0.25,
             likelihood_weight: 0.05,
-            speed_scale_sigma: 0.02,
+            speed_scale_sigma: 0.15,
             steering_sigma_rad: 0.01,
-            bias_walk: 0.2,
             diffusion_m: 0.01,
             diffusion_per_m: 0.02,
             diffusion_rad: 0.002,
@@ -149,7 +150,6 @@ impl LocalizerConfig {
             ("likelihood_weight", self.likelihood_weight),
             ("speed_scale_sigma", self.speed_scale_sigma),
             ("steering_sigma_rad", self.steering_sigma_rad),
-            ("bias_walk", self.bias_walk),
             ("diffusion_m", self.diffusion_m),
             ("diffusion_per_m", self.diffusion_per_m),
             ("diffusion_rad", self.diffusion_rad),
@@ -627,23 +627,20 @@ impl ParticleFilter {
         Ok(())
     }
 
-    /// The per-update diffusion and the random walk of each particle's odometry errors.
+    /// The per-update diffusion, and each particle's odometry errors until the next update.
     fn diffuse(&mut self) {
         let c = &self.config;
         let d = self.travelled_m;
         let sp = c.diffusion_m + c.diffusion_per_m * d;
         let sh = c.diffusion_rad + 0.01 * d;
-        let (ss, sst) = (
-            c.speed_scale_sigma * c.bias_walk,
-            c.steering_sigma_rad * c.bias_walk,
-        );
+        let (ss, sst) = (c.speed_scale_sigma, c.steering_sigma_rad);
         let rng = &mut self.rng;
         for p in &mut self.particles {
             p.x += sp * normal(rng);
             p.y += sp * normal(rng);
             p.theta = wrap_angle(p.theta + sh * normal(rng));
-            p.speed_scale += ss * normal(rng);
-            p.steering_rad += sst * normal(rng);
+            p.speed_scale = ss * normal(rng);
+            p.steering_rad = sst * normal(rng);
         }
     }
 

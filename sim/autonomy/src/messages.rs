@@ -41,12 +41,12 @@ impl PoseEstimate {
     pub fn cross_track_sigma_m(&self) -> f64 {
         let left = self.world_from_vehicle.rotation * Vector2::y();
         let c = self.covariance.fixed_view::<2, 2>(0, 0);
-        (left.transpose() * c * left)[(0, 0)].max(0.0).sqrt()
+        non_negative_sqrt((left.transpose() * c * left)[(0, 0)])
     }
 
     /// Standard deviation of the heading, radians.
     pub fn heading_sigma_rad(&self) -> f64 {
-        self.covariance[(2, 2)].max(0.0).sqrt()
+        non_negative_sqrt(self.covariance[(2, 2)])
     }
 
     /// How far a point `reach_m` from the vehicle's origin may be from where the estimate puts
@@ -55,6 +55,12 @@ impl PoseEstimate {
         self.cross_track_sigma_m()
             .hypot(reach_m * self.heading_sigma_rad())
     }
+}
+
+/// The square root of a variance, rounding's small negatives taken as 0 - and NaN kept (an
+/// estimate that knows nothing must not read as exact).
+fn non_negative_sqrt(v: f64) -> f64 {
+    if v < 0.0 { 0.0 } else { v.sqrt() }
 }
 
 /// What the vehicle's own sensors report of its motion.

@@ -99,6 +99,10 @@ impl AutonomyConfig {
     /// and the factor the wanted speed is multiplied by (1 up to `uncertainty_slow_m`, 0 from
     /// `uncertainty_stop_m`).
     pub fn under_uncertainty(&self, sigma_m: f64) -> (AutonomyConfig, f64) {
+        if !sigma_m.is_finite() {
+            // Nothing known of the pose: hold the vehicle.
+            return (self.clone(), 0.0);
+        }
         let extra = (self.uncertainty_sigmas * sigma_m) as f32;
         let span = (self.uncertainty_stop_m - self.uncertainty_slow_m).max(1e-9);
         let factor = (1.0 - (sigma_m - self.uncertainty_slow_m) / span).clamp(0.0, 1.0);
@@ -107,7 +111,7 @@ impl AutonomyConfig {
             avoider_safety_m: self.avoider_safety_m + extra,
             ..self.clone()
         };
-        (widened, if sigma_m.is_finite() { factor } else { 0.0 })
+        (widened, factor)
     }
 }
 

@@ -421,6 +421,48 @@ mod tests {
         assert!(c.speed_m_s == 5.0 && c.steering_rad < 0.0, "{c:?}");
     }
 
+    /// An estimate with a lateral standard deviation `sigma_m` (position only).
+    fn uncertain(sigma_m: f64) -> PoseEstimate {
+        PoseEstimate {
+            covariance: nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(
+                sigma_m * sigma_m,
+                sigma_m * sigma_m,
+                0.0,
+            )),
+            ..at(0.0, 10.0, 0.0, 0.0)
+        }
+    }
+
+    /// A less certain estimate means a slower vehicle, then a stopped one: full speed up to
+    /// 0.15 m, falling linearly to 0 at 0.5 m (the defaults).
+    #[test]
+    fn an_uncertain_estimate_slows_then_stops_the_vehicle() {
+        let speed = |sigma_m| {
+            let mut d = driver();
+            let mut map = empty_map();
+            d.on_pose(uncertain(sigma_m));
+            d.plan(&mut map).unwrap();
+            d.speed_command_m_s()
+        };
+        assert_eq!(speed(0.0), 5.0);
+        assert_eq!(speed(0.1), 5.0);
+        assert!((speed(0.325) - 2.5).abs() < 1e-9, "{}", speed(0.325));
+        assert_eq!(speed(0.5), 0.0);
+        assert_eq!(speed(f64::NAN), 0.0, "an estimate that knows nothing holds the vehicle");
+    }
+
+    /// The margins widen by two standard deviations: an obstacle the certain estimate passes
+    /// 0.3 m from (beyond the avoider's 0.2 m) is inside the uncertain estimate's 0.2 + 2 x 0.1.
+    #[test]
+    fn an_uncertain_estimate_widens_the_safety_distances() {
+        let c = AutonomyConfig::default();
+        let (w, factor) = c.under_uncertainty(0.1);
+        assert!((w.avoider_safety_m - 0.4).abs() < 1e-6 && (w.planner_safety_m - 0.8).abs() < 1e-6);
+        assert_eq!(factor, 1.0);
+        let (w0, _) = c.under_uncertainty(0.0);
+        assert_eq!(w0, c);
+    }
+
     /// Between estimates the driver carries its estimate forward on odometry (a localizer slower
     /// than the control loop); a new estimate replaces it.
     #[test]
