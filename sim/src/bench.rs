@@ -396,6 +396,7 @@ pub fn lidar_scene() -> crate::scene::Scene {
         min_m: [-100.0, -100.0],
         max_m: [100.0, 100.0],
         ground_remission: 0.2,
+        pavement_texture: 0.0,
         solids,
         patches: Vec::new(),
     }

@@ -58,10 +58,7 @@ pub fn figures_for(
         world_from_vehicle_estimate: start,
     };
     let config = LocalizerConfig::default();
-    let map_config = mapper::MapConfig {
-        max_distance_m: (3.0 * config.field_sigma_m) as f32,
-        ..run.mapping.map
-    };
+    let map_config = run.mapping.map;
     let map = mapper::MultiHeightMap::with_stores(
         map_config,
         crate::mapping::levels_of(&scenario, &run)?,
@@ -100,6 +97,7 @@ fn figures(
         .ok_or_else(|| crate::error::Error::Invalid("no localization map".into()))?
         .clone();
     let remission = pf.map().remission_grid();
+    let field = autonomy::localizer::level0_distance(pf.map(), &config);
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -116,8 +114,8 @@ fn figures(
                 std::hint::black_box(weigh_straightforward(
                     &particles,
                     obs,
-                    pf.map(),
                     &remission,
+                    field.as_ref(),
                     &config,
                 ));
             },

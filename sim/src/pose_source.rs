@@ -87,10 +87,7 @@ impl Localizer {
         seed: u64,
         context: LocalizationContext<'_>,
     ) -> crate::error::Result<Self> {
-        let map_config = mapper::MapConfig {
-            max_distance_m: (3.0 * config.field_sigma_m).max(context.map.resolution_m) as f32,
-            ..context.map
-        };
+        let map_config = context.map;
         let start = context.start.translation.vector;
         let map = mapper::MultiHeightMap::with_stores(
             map_config,

@@ -286,7 +286,7 @@ impl TryFrom<f64> for NonNegative {
 }
 
 /// A LiDAR remission (reflectivity) in [0, 1].
-#[derive(Clone, Copy, Debug, PartialEq, PartialOrd, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, PartialOrd, Deserialize)]
 #[serde(try_from = "f64")]
 pub struct Remission(pub f32);
 
@@ -421,6 +421,11 @@ pub struct WorldSpec {
     /// Remission of bare ground, in [0, 1]. Default 0.2 (asphalt, concrete).
     #[serde(default = "default_ground_remission")]
     pub ground_remission: Remission,
+    /// Texture of the pavement: each 0.5 m square's remission (bare ground or a patch) is off by
+    /// up to this much, in [0, 1] (what a remission map of real asphalt or concrete shows).
+    /// Default 0: uniform.
+    #[serde(default)]
+    pub pavement_texture: Remission,
 }
 
 /// `[vehicle]`: which vehicle, and where it starts.
@@ -670,6 +675,8 @@ pub struct World {
     pub max_m: [f64; 2],
     /// Remission of bare ground in [0, 1].
     pub ground_remission: f32,
+    /// Amplitude of the pavement's texture (`[world] pavement_texture`).
+    pub pavement_texture: f32,
 }
 
 /// The vehicle of a scenario.
@@ -838,6 +845,7 @@ impl Scenario {
             min_m: self.world.min_m,
             max_m: self.world.max_m,
             ground_remission: self.world.ground_remission,
+            pavement_texture: self.world.pavement_texture,
             solids,
             patches: self.patches.clone(),
         }
@@ -1106,6 +1114,7 @@ impl Resolver<'_> {
             min_m,
             max_m,
             ground_remission: w.ground_remission.0,
+            pavement_texture: w.pavement_texture.0,
         })
     }
 

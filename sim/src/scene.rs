@@ -132,6 +132,10 @@ pub struct Scene {
     pub max_m: [f64; 2],
     /// Remission of bare ground.
     pub ground_remission: f32,
+    /// Amplitude of the ground's texture: each 0.5 m square is off its remission (bare ground or
+    /// a patch) by up to this much, the same every time it is seen (aggregate, wear, stains).
+    /// 0: a perfectly uniform ground.
+    pub pavement_texture: f32,
     /// Solid objects (static and run-time).
     pub solids: Vec<Solid>,
     /// Painted markings (later ones paint over earlier ones).
@@ -141,11 +145,13 @@ pub struct Scene {
 impl Scene {
     /// Remission of the ground at (x, y): the last patch holding the point, else bare ground.
     pub fn ground_remission_at(&self, x: f64, y: f64) -> f32 {
-        self.patches
+        let base = self
+            .patches
             .iter()
             .rev()
             .find(|p| p.contains(x, y))
-            .map_or(self.ground_remission, |p| p.remission)
+            .map_or(self.ground_remission, |p| p.remission);
+        pavement(base, self.pavement_texture, x, y)
     }
 
     /// The ground's remission prepared for many lookups (the LiDAR's ground returns): the same
@@ -175,10 +181,28 @@ impl Scene {
         let bins = PatchBins::new(&patches);
         GroundTexture {
             ground_remission: self.ground_remission,
+            pavement_texture: self.pavement_texture,
             patches,
             bins,
         }
     }
+}
+
+/// The ground's remission at (x, y) where it is `base` untextured: off by up to `amplitude`, a hash of the 0.5 m
+/// square holding the point (uniform in [-1, 1]), clamped to [0, 1].
+#[inline]
+pub fn pavement(base: f32, amplitude: f32, x: f64, y: f64) -> f32 {
+    if amplitude == 0.0 {
+        return base;
+    }
+    let (i, j) = ((x * 2.0).floor() as i64, (y * 2.0).floor() as i64);
+    // SplitMix64 of the square's coordinates.
+    let mut z = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (j as u64).wrapping_add(0x632B_E59B_D9B4_E019);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    let u = (z >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0;
+    (base + amplitude * u).clamp(0.0, 1.0)
 }
 
 /// [`Scene::ground_remission_at`] with each patch's rotation computed once, and the patches
@@ -186,6 +210,7 @@ impl Scene {
 #[derive(Clone, Debug)]
 pub struct GroundTexture {
     ground_remission: f32,
+    pavement_texture: f32,
     /// Last painted first.
     patches: Vec<PreparedPatch>,
     bins: PatchBins,
@@ -307,25 +332,43 @@ impl GroundTexture {
         for &i in self.bins.at(x, y) {
             let p = &self.patches[i as usize];
             if p.contains(x, y) {
-                return p.remission;
+                return pavement(p.remission, self.pavement_texture, x, y);
             }
         }
-        self.ground_remission
+        pavement(self.ground_remission, self.pavement_texture, x, y)
     }
 
     /// [`Self::remission_at`] trying every patch, the straightforward way (for tests).
     #[cfg(test)]
     fn remission_at_every_patch(&self, x: f64, y: f64) -> f32 {
-        self.patches
+        let base = self
+            .patches
             .iter()
             .find(|p| p.contains(x, y))
-            .map_or(self.ground_remission, |p| p.remission)
+            .map_or(self.ground_remission, |p| p.remission);
+        pavement(base, self.pavement_texture, x, y)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The pavement's texture: the same value anywhere in a 0.5 m square and every time,
+    /// within the amplitude of the base, spread over it (mean near the base, both signs).
+    #[test]
+    fn the_pavement_texture_is_fixed_per_square_and_within_its_amplitude() {
+        assert_eq!(pavement(0.3, 0.0, 1.7, 2.2), 0.3);
+        assert_eq!(pavement(0.3, 0.05, 1.51, 2.01), pavement(0.3, 0.05, 1.99, 2.49));
+        let values: Vec<f32> = (0..10_000)
+            .map(|k| pavement(0.3, 0.05, (k % 100) as f64 * 0.5, (k / 100) as f64 * 0.5 - 20.0))
+            .collect();
+        assert!(values.iter().all(|v| (v - 0.3).abs() <= 0.05 + 1e-6));
+        let mean = values.iter().sum::<f32>() / values.len() as f32;
+        assert!((mean - 0.3).abs() < 0.002, "mean {mean}");
+        let spread = values.iter().filter(|v| (*v - 0.3).abs() > 0.04).count();
+        assert!(spread > 1_000, "{spread} squares beyond 0.04 of the base");
+    }
 
     #[test]
     fn the_prepared_ground_texture_answers_as_the_scene_does() {
@@ -342,6 +385,7 @@ mod tests {
             min_m: [-20.0, -20.0],
             max_m: [20.0, 20.0],
             ground_remission: 0.2,
+            pavement_texture: 0.05,
             solids: Vec::new(),
             patches: vec![
                 patch("lane", 0.0, 0.0, 0.0, 30.0, 0.3, 0.8),
@@ -363,7 +407,7 @@ mod tests {
                     want,
                     "at ({x}, {y})"
                 );
-                painted += usize::from(want != 0.2);
+                painted += usize::from(scene.patches.iter().any(|p| p.contains(x, y)));
             }
         }
         assert!(

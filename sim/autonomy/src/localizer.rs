@@ -88,7 +88,8 @@ pub struct LocalizerConfig {
     pub diffusion_rad: f64,
     /// A revolution updates the particles only once the vehicle has moved this far since the last
     /// update, metres (standing still, the same view would collapse them) - or while the
-    /// estimate's cross-track standard deviation is above `settled_sigma_m`. Default 0.05.
+    /// estimate's cross-track standard deviation has not yet been below `settled_sigma_m` since
+    /// the fix. Default 0.05.
     pub min_travel_m: f64,
     /// See `min_travel_m`, metres. Default 0.1.
     pub settled_sigma_m: f64,
@@ -211,8 +212,9 @@ pub struct LocalizationMap {
 }
 
 impl LocalizationMap {
-    /// Built from `map`'s window (its remission layer and its level-0 distance map, which the
-    /// caller has brought up to date).
+    /// Built from `map`'s window: its remission layer, and the distance to the nearest level-0
+    /// obstacle cell of its offline (prior) occupancy, capped at `outlier_sigmas` field sigmas
+    /// (an exact EDT of level 0 only; the map's own distance maps would cover every level).
     pub fn from_map(map: &MultiHeightMap, config: &LocalizerConfig) -> Self {
         let floor2 = (config.remission_sigma_floor * config.remission_sigma_floor) as f32;
         let remission = map
@@ -223,8 +225,8 @@ impl LocalizationMap {
             .collect();
         let sigma = config.field_sigma_m as f32;
         let floor = config.floor();
-        let field = match map.distance_maps().level(0) {
-            Some(d) => d
+        let field = match level0_distance(map, config) {
+            Some(distance) => distance
                 .grid()
                 .data()
                 .iter()
@@ -243,6 +245,26 @@ impl LocalizationMap {
     pub fn geometry(&self) -> &GridGeometry {
         &self.geometry
     }
+}
+
+/// The distance from each cell of `map`'s window to the nearest level-0 obstacle cell (the
+/// filter's map holds the offline occupancy only), capped at `outlier_sigmas` field sigmas: an exact EDT of level 0
+/// only (the map's own distance maps would cover every level). `None` without levels.
+pub fn level0_distance(
+    map: &MultiHeightMap,
+    config: &LocalizerConfig,
+) -> Option<mapper::DistanceMap> {
+    let (prior, live) = (map.prior_log_odds(0)?.data(), map.live_log_odds(0)?.data());
+    let t = map.config().obstacle_threshold;
+    let l_obstacle = (t / (1.0 - t)).ln();
+    let cap = (config.outlier_sigmas * config.field_sigma_m) as f32;
+    let merge = map.config().merge;
+    Some(mapper::DistanceMap::compute(
+        *map.geometry(),
+        cap.max(map.config().resolution_m as f32),
+        |i| mapper::map::merge_log_odds(live[i], prior[i], merge).is_some_and(|l| l > l_obstacle),
+        &mut mapper::edt::EdtScratch::default(),
+    ))
 }
 
 #[inline]
@@ -412,13 +434,16 @@ pub struct ParticleFilter {
     /// revolution is taken to where the vehicle is now through it).
     odometry_pose: Isometry2<f64>,
     trail: std::collections::VecDeque<(f64, Isometry2<f64>)>,
+    /// Whether the particles have settled since the fix (standing still, they are updated only
+    /// until then).
+    settled: bool,
     map: MultiHeightMap,
     lmap: Option<LocalizationMap>,
 }
 
 impl ParticleFilter {
     /// A filter with `config` for a vehicle of wheelbase `wheelbase_m`, over `map` (the offline
-    /// prior; its distance maps' cap should be a few `field_sigma_m`), seeded with `seed`. It
+    /// prior; the filter computes its own level-0 distance field), seeded with `seed`. It
     /// has no particles until [`Self::initialise`].
     pub fn new(config: LocalizerConfig, wheelbase_m: f64, map: MultiHeightMap, seed: u64) -> Self {
         ParticleFilter {
@@ -430,6 +455,7 @@ impl ParticleFilter {
             travelled_m: 0.0,
             odometry_pose: Isometry2::identity(),
             trail: std::collections::VecDeque::new(),
+            settled: false,
             map,
             lmap: None,
             config,
@@ -461,6 +487,7 @@ impl ParticleFilter {
         self.last_odometry = None;
         self.travelled_m = 0.0;
         self.trail.clear();
+        self.settled = false;
         self.follow(Point2::new(fix.translation.x, fix.translation.y))
     }
 
@@ -560,9 +587,10 @@ impl ParticleFilter {
             return Ok(stats);
         }
         // Standing still, the same view again would collapse the particles onto one reading of
-        // it - unless they have not settled yet (at the start, from the fix).
-        let settled = self.estimate().cross_track_sigma_m() < self.config.settled_sigma_m;
-        if self.travelled_m < self.config.min_travel_m && settled {
+        // it, and each update's diffusion would walk them - except at the start, from the fix,
+        // until they have settled once.
+        self.settled |= self.estimate().cross_track_sigma_m() < self.config.settled_sigma_m;
+        if self.travelled_m < self.config.min_travel_m && self.settled {
             return Ok(stats);
         }
         let here = self.estimate().world_from_vehicle.translation.vector;
@@ -621,7 +649,6 @@ impl ParticleFilter {
     fn follow(&mut self, here: Point2<f64>) -> Result<(), mapper::MapError> {
         let moved = self.map.recenter(here)?;
         if moved || self.lmap.is_none() {
-            self.map.update_distance_maps();
             self.lmap = Some(LocalizationMap::from_map(&self.map, &self.config));
         }
         Ok(())
@@ -824,14 +851,14 @@ fn weigh_block(
 pub fn weigh_straightforward(
     particles: &[Particle],
     obs: &Observation,
-    map: &MultiHeightMap,
     remission: &mapper::Grid<RemissionCell>,
+    field: Option<&mapper::DistanceMap>,
     config: &LocalizerConfig,
 ) -> Vec<f64> {
     let floor = f64::from(config.floor());
     let unknown = -0.5 * config.remission_unknown_sigmas * config.remission_unknown_sigmas;
     let floor2 = config.remission_sigma_floor * config.remission_sigma_floor;
-    let field = map.distance_maps().level(0);
+
     particles
         .iter()
         .map(|p| {
@@ -855,7 +882,7 @@ pub fn weigh_straightforward(
             if config.measurement != MeasurementModel::Remission {
                 for &[px, py] in &obs.obstacles {
                     let at = pose * Point2::new(px, py);
-                    sum += match (field, map.geometry().contains(&at)) {
+                    sum += match (field, remission.geometry().contains(&at)) {
                         (Some(f), true) => {
                             let d = f64::from(f.distance_at(&at)) / config.field_sigma_m;
                             (-0.5 * d * d).max(floor)

@@ -230,11 +230,12 @@ fn the_tables_weigh_like_the_straightforward_way() {
         let particles: Vec<Particle> = pf.particles().to_vec();
         let lmap = pf.localization_map().expect("map built at initialise");
         let fast = weigh(&particles, &obs, lmap, &config);
+        let field = autonomy::localizer::level0_distance(pf.map(), &config);
         let slow = weigh_straightforward(
             &particles,
             &obs,
-            pf.map(),
             &pf.map().remission_grid(),
+            field.as_ref(),
             &config,
         );
         for (f, s) in fast.iter().zip(&slow) {
