@@ -197,7 +197,8 @@ pub fn pavement(base: f32, amplitude: f32, x: f64, y: f64) -> f32 {
     }
     let (i, j) = ((x * 2.0).floor() as i64, (y * 2.0).floor() as i64);
     // SplitMix64 of the square's coordinates.
-    let mut z = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (j as u64).wrapping_add(0x632B_E59B_D9B4_E019);
+    let mut z = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ (j as u64).wrapping_add(0x632B_E59B_D9B4_E019);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^= z >> 31;
@@ -359,9 +360,19 @@ mod tests {
     #[test]
     fn the_pavement_texture_is_fixed_per_square_and_within_its_amplitude() {
         assert_eq!(pavement(0.3, 0.0, 1.7, 2.2), 0.3);
-        assert_eq!(pavement(0.3, 0.05, 1.51, 2.01), pavement(0.3, 0.05, 1.99, 2.49));
+        assert_eq!(
+            pavement(0.3, 0.05, 1.51, 2.01),
+            pavement(0.3, 0.05, 1.99, 2.49)
+        );
         let values: Vec<f32> = (0..10_000)
-            .map(|k| pavement(0.3, 0.05, (k % 100) as f64 * 0.5, (k / 100) as f64 * 0.5 - 20.0))
+            .map(|k| {
+                pavement(
+                    0.3,
+                    0.05,
+                    (k % 100) as f64 * 0.5,
+                    (k / 100) as f64 * 0.5 - 20.0,
+                )
+            })
             .collect();
         assert!(values.iter().all(|v| (v - 0.3).abs() <= 0.05 + 1e-6));
         let mean = values.iter().sum::<f32>() / values.len() as f32;

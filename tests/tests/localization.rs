@@ -40,8 +40,16 @@ fn the_parking_lot_is_localized_within_a_decimetre_and_every_expectation_holds()
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     assert!(r.expectations_met, "{:?}", r.obstacles);
     let l = &localization(&r).run;
-    assert!(l.cross_m.rmse <= 0.10, "cross-track RMSE {}", l.cross_m.rmse);
-    assert!(l.heading_rad.rmse <= 0.01, "heading RMSE {}", l.heading_rad.rmse);
+    assert!(
+        l.cross_m.rmse <= 0.10,
+        "cross-track RMSE {}",
+        l.cross_m.rmse
+    );
+    assert!(
+        l.heading_rad.rmse <= 0.01,
+        "heading RMSE {}",
+        l.heading_rad.rmse
+    );
     // The estimate is no more sure of itself than it should be: its own sigma covers the error.
     assert!(l.mean_sigma_cross_m >= 0.5 * l.cross_m.rmse, "{l:?}");
 }
@@ -94,5 +102,9 @@ fn with_the_odometry_bias_doubled_nothing_is_touched() {
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     assert!(r.expectations_met, "{:?}", r.obstacles);
     let l = &localization(&r).run;
-    assert!(l.cross_m.rmse <= 0.10, "cross-track RMSE {}", l.cross_m.rmse);
+    assert!(
+        l.cross_m.rmse <= 0.10,
+        "cross-track RMSE {}",
+        l.cross_m.rmse
+    );
 }

@@ -434,6 +434,9 @@ pub struct ParticleFilter {
     /// revolution is taken to where the vehicle is now through it).
     odometry_pose: Isometry2<f64>,
     trail: std::collections::VecDeque<(f64, Isometry2<f64>)>,
+    /// The odometry's pose when the particles were last moved, and their estimate then.
+    propagated_at: Isometry2<f64>,
+    at_propagation: Estimate,
     /// Whether the particles have settled since the fix (standing still, they are updated only
     /// until then).
     settled: bool,
@@ -455,6 +458,8 @@ impl ParticleFilter {
             travelled_m: 0.0,
             odometry_pose: Isometry2::identity(),
             trail: std::collections::VecDeque::new(),
+            propagated_at: Isometry2::identity(),
+            at_propagation: estimate_of(&[], &[]),
             settled: false,
             map,
             lmap: None,
@@ -487,6 +492,8 @@ impl ParticleFilter {
         self.last_odometry = None;
         self.travelled_m = 0.0;
         self.trail.clear();
+        self.propagated_at = self.odometry_pose;
+        self.refresh();
         self.settled = false;
         self.follow(Point2::new(fix.translation.x, fix.translation.y))
     }
@@ -507,6 +514,7 @@ impl ParticleFilter {
         self.log_w.clear();
         self.last_odometry = None;
         self.trail.clear();
+        self.refresh();
     }
 
     /// Whether the filter has particles.
@@ -514,26 +522,19 @@ impl ParticleFilter {
         !self.particles.is_empty()
     }
 
-    /// The particles.
+    /// The particles, as of the last update.
     pub fn particles(&self) -> &[Particle] {
         &self.particles
     }
 
-    /// Motion update: every particle moves along the arc its own reading of `odometry` (since
-    /// the last) describes.
+    /// The odometry's reading since the last: the nominal pose is integrated along its arc (the
+    /// particles follow it at the next update or estimate - a hundred readings a second, ten
+    /// updates).
     pub fn on_odometry(&mut self, odometry: &Odometry) {
         if let Some(last) = self.last_odometry {
             let dt = odometry.t_s - last.t_s;
             if dt > 0.0 {
                 let (v, delta, l) = (last.speed_m_s, last.steering_rad, self.wheelbase_m);
-                for p in &mut self.particles {
-                    let ds = v * (1.0 + p.speed_scale) * dt;
-                    let dtheta = ds * (delta + p.steering_rad).tan() / l;
-                    let mid = p.theta + 0.5 * dtheta;
-                    p.x += ds * mid.cos();
-                    p.y += ds * mid.sin();
-                    p.theta = wrap_angle(p.theta + dtheta);
-                }
                 self.travelled_m += (v * dt).abs();
                 let ds = v * dt;
                 let dtheta = ds * delta.tan() / l;
@@ -553,6 +554,33 @@ impl ParticleFilter {
         {
             self.trail.pop_front();
         }
+    }
+
+    /// Motion update: every particle moves by the odometry's displacement since the last
+    /// propagation, read with its own errors - its distance times `1 + speed_scale`, its turn
+    /// plus the distance times `tan(steering error) / wheelbase`.
+    fn propagate(&mut self) {
+        let delta = self.propagated_at.inverse() * self.odometry_pose;
+        if delta == Isometry2::identity() {
+            return;
+        }
+        let (t, turn) = (delta.translation.vector, delta.rotation.angle());
+        let d = t.norm().copysign(t.x);
+        for p in &mut self.particles {
+            let (s, c) = p.theta.sin_cos();
+            let k = 1.0 + p.speed_scale;
+            let (dx, dy) = (k * t.x, k * t.y);
+            p.x += c * dx - s * dy;
+            p.y += s * dx + c * dy;
+            p.theta = wrap_angle(p.theta + turn + d * p.steering_rad.tan() / self.wheelbase_m);
+        }
+        self.propagated_at = self.odometry_pose;
+        self.refresh();
+    }
+
+    /// The estimate of the particles as they stand, kept for the estimates between updates.
+    fn refresh(&mut self) {
+        self.at_propagation = estimate_of(&self.particles, &self.log_w);
     }
 
     /// Where the vehicle was at `t_s` in its frame now, by the odometry (`None`: before the
@@ -586,6 +614,7 @@ impl ParticleFilter {
         if !self.initialised() {
             return Ok(stats);
         }
+        self.propagate();
         // Standing still, the same view again would collapse the particles onto one reading of
         // it, and each update's diffusion would walk them - except at the start, from the fix,
         // until they have settled once.
@@ -619,6 +648,7 @@ impl ParticleFilter {
             self.resample();
             stats.resampled = true;
         }
+        self.refresh();
     }
 
     /// [`Self::on_observation`] of a revolution.
@@ -641,8 +671,14 @@ impl ParticleFilter {
     }
 
     /// The weighted mean pose (circular mean of the heading) and covariance.
+    /// Between updates, the particles' estimate at the last update carried forward on the
+    /// odometry.
     pub fn estimate(&self) -> Estimate {
-        estimate_of(&self.particles, &self.log_w)
+        Estimate {
+            world_from_vehicle: self.at_propagation.world_from_vehicle
+                * (self.propagated_at.inverse() * self.odometry_pose),
+            covariance: self.at_propagation.covariance,
+        }
     }
 
     /// Re-centres the map window on `here`; the localization map is rebuilt when it moved.

@@ -448,7 +448,11 @@ mod tests {
         assert_eq!(speed(0.1), 5.0);
         assert!((speed(0.325) - 2.5).abs() < 1e-9, "{}", speed(0.325));
         assert_eq!(speed(0.5), 0.0);
-        assert_eq!(speed(f64::NAN), 0.0, "an estimate that knows nothing holds the vehicle");
+        assert_eq!(
+            speed(f64::NAN),
+            0.0,
+            "an estimate that knows nothing holds the vehicle"
+        );
     }
 
     /// The margins widen by two standard deviations: an obstacle the certain estimate passes
