@@ -118,6 +118,36 @@ impl Scan {
         })
     }
 
+    /// The scan moved rigidly by `correction` (points and sensor poses), each column's vehicle
+    /// pose replaced by `world_from_vehicle`: in place, without a copy or a new check (a rigid
+    /// motion of finite values is finite, and ranges do not change). `world_from_vehicle` must
+    /// be finite.
+    pub fn moved(
+        mut self,
+        correction: &nalgebra::Isometry3<f64>,
+        world_from_vehicle: &Isometry2<f64>,
+    ) -> Result<Self> {
+        let t = world_from_vehicle.translation.vector;
+        if !(t.iter().all(|x| x.is_finite()) && world_from_vehicle.rotation.angle().is_finite()) {
+            return Err(MapError::invalid(
+                "scan column pose",
+                "the new vehicle pose is not finite",
+            ));
+        }
+        for c in &mut self.columns {
+            c.world_from_sensor = correction * c.world_from_sensor;
+            c.world_from_vehicle = *world_from_vehicle;
+        }
+        self.returns
+            .par_chunks_mut(self.beams * 64)
+            .for_each(|chunk| {
+                for r in chunk.iter_mut().flatten() {
+                    r.point_in_world = correction * r.point_in_world;
+                }
+            });
+        Ok(self)
+    }
+
     /// Beams per column.
     pub fn beams(&self) -> usize {
         self.beams
@@ -138,5 +168,44 @@ impl Scan {
     pub fn column(&self, c: usize) -> Option<(&ScanColumn, &[Option<Return>])> {
         let col = self.columns.get(c)?;
         Some((col, &self.returns[c * self.beams..(c + 1) * self.beams]))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+
+    /// Moving a scan in place gives what building it from the moved points and poses gives.
+    #[test]
+    fn a_scan_moved_in_place_equals_one_built_from_moved_values() {
+        let scan = crate::workloads::parking_lot_scan();
+        let correction = Isometry3::from_parts(
+            Translation3::new(0.4, -0.3, 0.0),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 0.02),
+        );
+        let vehicle = Isometry2::new(nalgebra::Vector2::new(1.0, 2.0), 0.3);
+        let columns = scan
+            .columns()
+            .iter()
+            .map(|c| ScanColumn {
+                world_from_sensor: correction * c.world_from_sensor,
+                world_from_vehicle: vehicle,
+            })
+            .collect();
+        let returns = scan
+            .returns()
+            .iter()
+            .map(|r| {
+                r.map(|r| Return {
+                    point_in_world: correction * r.point_in_world,
+                    ..r
+                })
+            })
+            .collect();
+        let want = Scan::new(scan.beams(), columns, returns).unwrap();
+        assert_eq!(scan.clone().moved(&correction, &vehicle).unwrap(), want);
+        let nan = Isometry2::new(nalgebra::Vector2::new(f64::NAN, 0.0), 0.0);
+        assert!(scan.moved(&correction, &nan).is_err());
     }
 }

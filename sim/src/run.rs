@@ -461,31 +461,13 @@ fn start_state(start: &Isometry2<f64>) -> VehicleState {
 /// A scan's points moved from the true pose to the estimated one: where a mapper with a wrong
 /// pose would put them.
 fn reexpress(
-    scan: &mapper::Scan,
+    scan: mapper::Scan,
     truth: &Isometry2<f64>,
     estimate: &Isometry2<f64>,
 ) -> Result<mapper::Scan> {
     let lift = crate::world::planar_to_3d;
     let correction = lift(estimate) * lift(truth).inverse();
-    let columns = scan
-        .columns()
-        .iter()
-        .map(|c| mapper::ScanColumn {
-            world_from_sensor: correction * c.world_from_sensor,
-            world_from_vehicle: *estimate,
-        })
-        .collect();
-    let returns = scan
-        .returns()
-        .iter()
-        .map(|r| {
-            r.map(|r| mapper::Return {
-                point_in_world: correction * r.point_in_world,
-                ..r
-            })
-        })
-        .collect();
-    Ok(mapper::Scan::new(scan.beams(), columns, returns)?)
+    Ok(scan.moved(&correction, estimate)?)
 }
 
 /// What a revolution is cast with: the world, the LiDAR, and the faults between them.
@@ -526,7 +508,7 @@ impl Sensor<'_> {
         let scan = if estimate == truth {
             taken.scan
         } else {
-            reexpress(&taken.scan, truth, estimate)?
+            reexpress(taken.scan, truth, estimate)?
         };
         Ok(Captured {
             revolution: LidarRevolution {
