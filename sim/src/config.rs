@@ -27,7 +27,7 @@ pub struct RunConfig {
     pub mapping: MappingConfig,
     /// Planner, avoider and follower.
     pub autonomy: AutonomyConfig,
-    /// Where the stack's pose estimate comes from. Default `truth`.
+    /// Where the stack's pose estimate comes from. Default the particle filter.
     pub pose_source: PoseSourceConfig,
     /// The vehicle's circle model the stack checks. Default: the vehicle's own fit.
     pub collision_model: CollisionModelConfig,
@@ -48,7 +48,7 @@ impl Default for RunConfig {
             lidar: LidarConfig::default(),
             mapping: MappingConfig::default(),
             autonomy: AutonomyConfig::default(),
-            pose_source: PoseSourceConfig::Truth,
+            pose_source: PoseSourceConfig::default(),
             collision_model: CollisionModelConfig::Vehicle,
             odometry: crate::odometry::OdometryConfig::default(),
             faults: FaultsConfig::default(),
@@ -132,19 +132,25 @@ impl Default for MappingConfig {
 }
 
 /// Where the stack's pose estimate comes from.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum PoseSourceConfig {
     /// The true pose at every physics step.
-    #[default]
     Truth,
     /// The true pose with a seeded error, published at a localizer's rate: a first-order
     /// Gauss-Markov drift (the slowly wandering error of a localizer) plus white noise (its
     /// jitter), both in the vehicle frame (along track, across track, heading).
     NoisyTruth(NoisyTruthConfig),
     /// The particle filter over the offline map (`autonomy::localizer`): odometry, the remission
-    /// map and/or the likelihood field; the estimate's covariance widens the margins.
+    /// map and/or the likelihood field; the estimate's covariance widens the margins. The
+    /// default.
     ParticleFilter(autonomy::localizer::LocalizerConfig),
+}
+
+impl Default for PoseSourceConfig {
+    fn default() -> Self {
+        PoseSourceConfig::ParticleFilter(Default::default())
+    }
 }
 
 /// The noisy-truth pose source's error model.
