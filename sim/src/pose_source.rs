@@ -24,10 +24,6 @@ pub trait PoseSource: Send {
     }
     /// The odometry of this physics step.
     fn on_odometry(&mut self, _odometry: &Odometry) {}
-    /// Whether it reads the LiDAR ([`Self::on_revolution`]).
-    fn wants_revolutions(&self) -> bool {
-        false
-    }
     /// A revolution as the stack receives it.
     fn on_revolution(&mut self, _revolution: &LidarRevolution) -> crate::error::Result<()> {
         Ok(())
@@ -140,10 +136,6 @@ impl PoseSource for Localizer {
 
     fn on_odometry(&mut self, odometry: &Odometry) {
         self.filter.on_odometry(odometry);
-    }
-
-    fn wants_revolutions(&self) -> bool {
-        true
     }
 
     fn on_revolution(&mut self, revolution: &LidarRevolution) -> crate::error::Result<()> {

@@ -262,24 +262,6 @@ impl<'a> Rig<'a> {
             if let Some(log) = &mut self.localization_errors {
                 log.record(self.judge.laps_completed() + 1, truth, &estimate);
             }
-            if std::env::var_os("TAXI_SIM_DEBUG_LOC").is_some()
-                && (self.t_s * 100.0).round() as u64 % 500 == 0
-            {
-                let e = estimate.world_from_vehicle;
-                eprintln!(
-                    "DEBUG t {:.1} truth {:.2} {:.2} {:.3} est {:.2} {:.2} {:.3} sigma {:.3} v {:.2} cov {:?}",
-                    self.t_s,
-                    truth.translation.x,
-                    truth.translation.y,
-                    truth.rotation.angle(),
-                    e.translation.x,
-                    e.translation.y,
-                    e.rotation.angle(),
-                    estimate.cross_track_sigma_m(),
-                    self.state.speed_m_s,
-                    estimate.covariance.diagonal().as_slice()
-                );
-            }
             self.driver.on_pose(estimate);
         }
     }
