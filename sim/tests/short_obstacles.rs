@@ -17,6 +17,7 @@ fn debris_at(x_m: f64) -> Scene {
         min_m: [-50.0, -50.0],
         max_m: [100.0, 50.0],
         ground_remission: 0.2,
+        pavement_texture: 0.0,
         solids: vec![Solid {
             id: "debris".into(),
             kind: ObjectKind::Debris,

@@ -26,6 +26,7 @@ fn scene(solids: Vec<Solid>) -> Scene {
         min_m: [-150.0, -150.0],
         max_m: [150.0, 150.0],
         ground_remission: 0.2,
+        pavement_texture: 0.0,
         solids,
         patches: vec![],
     }
