@@ -49,7 +49,12 @@ pub fn median_seconds(samples: usize, batch: usize, mut f: impl FnMut()) -> f64 
     times[times.len() / 2]
 }
 
-fn figure(name: &str, seconds: f64, unit: &'static str, target: Option<&'static str>) -> Figure {
+pub(crate) fn figure(
+    name: &str,
+    seconds: f64,
+    unit: &'static str,
+    target: Option<&'static str>,
+) -> Figure {
     let scale = if unit == "ms" { 1e3 } else { 1e9 };
     Figure {
         name: name.into(),
@@ -61,7 +66,7 @@ fn figure(name: &str, seconds: f64, unit: &'static str, target: Option<&'static 
     }
 }
 
-fn against(mut f: Figure, baseline: &Figure) -> Figure {
+pub(crate) fn against(mut f: Figure, baseline: &Figure) -> Figure {
     f.baseline = Some(baseline.name.clone());
     f.ratio = Some(baseline.median / f.median);
     f

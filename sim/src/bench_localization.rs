@@ -10,24 +10,11 @@ use autonomy::localizer::{
     weigh_straightforward,
 };
 
-use crate::bench::{Figure, alternating, median_seconds};
+use crate::bench::{Figure, against, alternating, median_seconds};
 use crate::error::Result;
 
 fn ms(name: &str, seconds: f64, target: Option<&'static str>) -> Figure {
-    Figure {
-        name: name.into(),
-        median: seconds * 1e3,
-        unit: "ms",
-        baseline: None,
-        ratio: None,
-        target,
-    }
-}
-
-fn against(mut f: Figure, baseline: &Figure) -> Figure {
-    f.baseline = Some(baseline.name.clone());
-    f.ratio = Some(baseline.median / f.median);
-    f
+    crate::bench::figure(name, seconds, "ms", target)
 }
 
 /// The figures on `scenario`'s offline map (built if missing), `samples` rounds each.
