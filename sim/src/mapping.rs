@@ -58,6 +58,9 @@ pub fn fingerprint(scenario: &Scenario, config: &RunConfig) -> Result<String> {
         path: scenario.path.clone(),
         source,
     })?);
+    // The world as resolved (a default the code changes, like the pavement's texture, is not in
+    // the file).
+    h.update(format!("{:?}{:?}", scenario.world, scenario.patches).as_bytes());
     h.update(format!("{:?}", scenario.vehicle.vehicle).as_bytes());
     h.update(format!("{:?}", levels_of(scenario, config)?).as_bytes());
     h.update(format!("{:?}{:?}{MAP_FORMAT}", map_config(config), config.lidar).as_bytes());

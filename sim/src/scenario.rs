@@ -330,6 +330,10 @@ fn default_seed() -> u64 {
     1
 }
 
+fn default_pavement_texture() -> Remission {
+    Remission(0.05)
+}
+
 fn default_ground_remission() -> Remission {
     Remission(0.2)
 }
@@ -422,9 +426,9 @@ pub struct WorldSpec {
     #[serde(default = "default_ground_remission")]
     pub ground_remission: Remission,
     /// Texture of the pavement: each 0.5 m square's remission (bare ground or a patch) is off by
-    /// up to this much, in [0, 1] (what a remission map of real asphalt or concrete shows).
-    /// Default 0: uniform.
-    #[serde(default)]
+    /// up to this much, in [0, 1] (what a remission map of real asphalt or concrete shows, and
+    /// what a remission localizer reads). Default 0.05; 0 makes a featureless ground.
+    #[serde(default = "default_pavement_texture")]
     pub pavement_texture: Remission,
 }
 
