@@ -7,10 +7,17 @@ use sim::config::RunConfig;
 use sim::run::{RunSetup, run};
 use sim::scenario::Scenario;
 
-/// Runs a found scenario after its mapping drive.
+/// Runs a found scenario after its mapping drive (with the configuration the campaign found it
+/// with: the true pose - every one was found before the particle filter became the default).
 fn run_found(s: &Scenario) -> sim::report::RunReport {
+    run_found_with(s, |c| c.pose_source = sim::config::PoseSourceConfig::Truth)
+}
+
+/// [`run_found`] with the configuration changed by `change`.
+fn run_found_with(s: &Scenario, change: impl FnOnce(&mut RunConfig)) -> sim::report::RunReport {
     let dir = tempfile::tempdir().unwrap();
-    let config = RunConfig::for_scenario(s, None).unwrap();
+    let mut config = RunConfig::for_scenario(s, None).unwrap();
+    change(&mut config);
     sim::mapping::map_drive(s, &config, dir.path(), &mut |_, _| {}).unwrap();
     let setup = RunSetup {
         config,
@@ -97,4 +104,22 @@ fn fixme_the_car_passes_a_container_inside_the_danger_distance() {
         .fold(f64::INFINITY, f64::min);
     assert!((0.15..0.2).contains(&closest), "{p:?}");
     assert!(!p.met);
+}
+
+/// With the particle filter (the default since issue #24) the same variant passes the container
+/// 0.68 m off: the estimate's uncertainty widens the margins. The cause above is not found yet;
+/// this only shows the default hides it.
+#[test]
+fn with_the_particle_filter_the_container_is_passed_outside_the_danger_distance() {
+    let r = run_found_with(&found("parking_lot_variant_505"), |_| {});
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
+    let o = r.obstacles.iter().find(|o| o.id == "cone_path_1").unwrap();
+    let p = &o.passes[0];
+    assert_eq!(p.outcome, sim::judge::PassOutcome::Deviated);
+    let closest = p
+        .min_clearance_m
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    assert!(closest > 0.5 && p.met, "{p:?}");
 }

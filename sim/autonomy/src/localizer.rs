@@ -88,11 +88,14 @@ pub struct LocalizerConfig {
     pub diffusion_rad: f64,
     /// A revolution updates the particles only once the vehicle has moved this far since the last
     /// update, metres (standing still, the same view would collapse them) - or while the
-    /// estimate's cross-track standard deviation has not yet been below `settled_sigma_m` since
-    /// the fix. Default 0.05.
+    /// estimate's standard deviations have not yet been below `settled_sigma_m` and
+    /// `settled_sigma_rad` since the fix. Default 0.05.
     pub min_travel_m: f64,
     /// See `min_travel_m`, metres. Default 0.1.
     pub settled_sigma_m: f64,
+    /// ... and the heading's below this, radians (a long wing turns a heading error into a
+    /// lateral one: the A320's tips are 17 m out). Default 0.005.
+    pub settled_sigma_rad: f64,
     /// Resample when the effective sample size falls below this fraction of the particles.
     /// Default 0.5.
     pub resample_ess_fraction: f64,
@@ -127,6 +130,7 @@ impl Default for LocalizerConfig {
             diffusion_rad: 0.002,
             min_travel_m: 0.05,
             settled_sigma_m: 0.1,
+            settled_sigma_rad: 0.005,
             resample_ess_fraction: 0.5,
             fix_sigma_m: 0.5,
             fix_sigma_rad: 0.05,
@@ -156,6 +160,7 @@ impl LocalizerConfig {
             ("diffusion_rad", self.diffusion_rad),
             ("min_travel_m", self.min_travel_m),
             ("settled_sigma_m", self.settled_sigma_m),
+            ("settled_sigma_rad", self.settled_sigma_rad),
             ("fix_sigma_m", self.fix_sigma_m),
             ("fix_sigma_rad", self.fix_sigma_rad),
             ("max_ground_range_m", self.max_ground_range_m),
@@ -618,7 +623,9 @@ impl ParticleFilter {
         // Standing still, the same view again would collapse the particles onto one reading of
         // it, and each update's diffusion would walk them - except at the start, from the fix,
         // until they have settled once.
-        self.settled |= self.estimate().cross_track_sigma_m() < self.config.settled_sigma_m;
+        let e = self.estimate().at(0.0);
+        self.settled |= e.cross_track_sigma_m() < self.config.settled_sigma_m
+            && e.heading_sigma_rad() < self.config.settled_sigma_rad;
         if self.travelled_m < self.config.min_travel_m && self.settled {
             return Ok(stats);
         }
