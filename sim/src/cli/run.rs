@@ -315,7 +315,9 @@ pub fn table(r: &RunReport) -> String {
         );
     }
     if let Some(l) = &r.localization {
-        for e in std::iter::once(&l.run).chain(&l.laps) {
+        // The laps one by one when there is more than one.
+        let laps = if l.laps.len() > 1 { &l.laps[..] } else { &[] };
+        for e in std::iter::once(&l.run).chain(laps) {
             let _ = writeln!(
                 t,
                 "localization {}: cross-track RMSE {:.3} m (p95 {:.3}, max {:.3}), along {:.3} m, heading {:.4} rad; its sigma {:.3} m mean, {:.3} max",
