@@ -83,10 +83,9 @@ impl Localizer {
         seed: u64,
         context: LocalizationContext<'_>,
     ) -> crate::error::Result<Self> {
-        let map_config = context.map;
         let start = context.start.translation.vector;
         let map = mapper::MultiHeightMap::with_stores(
-            map_config,
+            context.map,
             context.levels,
             start.into(),
             Some(context.blocks_dir),

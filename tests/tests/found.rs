@@ -87,12 +87,9 @@ fn fixme_the_car_goes_round_a_cone_it_should_pass_under() {
     assert!(others_met, "{:?}", r.obstacles);
 }
 
-/// FIXME (README, Known problems): the car goes round a 0.98 m container 0.11 m right of the
-/// route 0.19 m from it, inside the danger distance (0.2 m). Found by the parking-lot campaign
-/// (variant 505).
-#[test]
-fn fixme_the_car_passes_a_container_inside_the_danger_distance() {
-    let r = run_found(&found("parking_lot_variant_505"));
+/// Variant 505's container pass, with no contact in the run and the car deviating round it, and
+/// its smallest clearance over the levels.
+fn container_pass(r: &sim::report::RunReport) -> (&sim::judge::Pass, f64) {
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     let o = r.obstacles.iter().find(|o| o.id == "cone_path_1").unwrap();
     let p = &o.passes[0];
@@ -102,6 +99,16 @@ fn fixme_the_car_passes_a_container_inside_the_danger_distance() {
         .iter()
         .copied()
         .fold(f64::INFINITY, f64::min);
+    (p, closest)
+}
+
+/// FIXME (README, Known problems): the car goes round a 0.98 m container 0.11 m right of the
+/// route 0.19 m from it, inside the danger distance (0.2 m). Found by the parking-lot campaign
+/// (variant 505).
+#[test]
+fn fixme_the_car_passes_a_container_inside_the_danger_distance() {
+    let r = run_found(&found("parking_lot_variant_505"));
+    let (p, closest) = container_pass(&r);
     assert!((0.15..0.2).contains(&closest), "{p:?}");
     assert!(!p.met);
 }
@@ -112,14 +119,6 @@ fn fixme_the_car_passes_a_container_inside_the_danger_distance() {
 #[test]
 fn with_the_particle_filter_the_container_is_passed_outside_the_danger_distance() {
     let r = run_found_with(&found("parking_lot_variant_505"), |_| {});
-    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
-    let o = r.obstacles.iter().find(|o| o.id == "cone_path_1").unwrap();
-    let p = &o.passes[0];
-    assert_eq!(p.outcome, sim::judge::PassOutcome::Deviated);
-    let closest = p
-        .min_clearance_m
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
+    let (p, closest) = container_pass(&r);
     assert!(closest > 0.5 && p.met, "{p:?}");
 }

@@ -792,8 +792,8 @@ pub fn estimate_of(particles: &[Particle], log_w: &[f64]) -> Estimate {
 /// the particles of a block stand within a few cells of each other, so one return placed from
 /// each of them reads the same few cache lines of the tables (particle-major, each particle
 /// would sweep the whole window on its own). One thread: on this 2-core machine the blocks in
-/// parallel ran no faster (`taxi-sim bench localization`: 0.96-1.01x), and in the loop the
-/// other core is mapping.
+/// parallel ran 0.96-1.46x its speed from run to run (`taxi-sim bench localization`), and in
+/// the loop the other core is mapping.
 pub fn weigh(
     particles: &[Particle],
     obs: &Observation,
