@@ -44,6 +44,7 @@ use crate::occupancy::{ObstacleTest, ObstacleTestParams, OccupancyParams, probab
 use crate::odm::{DistanceMap, DistanceMaps};
 use crate::remission::RemissionCell;
 use crate::scan::Scan;
+use crate::self_hits::SelfHitFilter;
 
 /// How the live map and the offline prior combine.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -66,6 +67,12 @@ pub struct MapConfig {
     pub block_cells: usize,
     /// Blocks per window side, odd. Default 3 (a 210 m window).
     pub window_blocks: usize,
+    /// The window moves once the position is this far past its middle block's edge, metres
+    /// (hysteresis: a route along a block edge would otherwise move it back and forth at every
+    /// revolution - 418 moves in an aerodrome lap, a sixth of its wall time). Default 8 m; at
+    /// most half a block. What lies beyond the window then starts up to this much nearer on
+    /// the side the vehicle crossed.
+    pub recenter_margin_m: f64,
     /// Log-odds update.
     pub occupancy: OccupancyParams,
     /// Obstacle test.
@@ -126,6 +133,7 @@ impl Default for MapConfig {
             resolution_m: 0.2,
             block_cells: 350,
             window_blocks: 3,
+            recenter_margin_m: 8.0,
             occupancy: OccupancyParams::default(),
             obstacle_test: ObstacleTestParams::default(),
             free_space_stop_cells: 2,
@@ -150,6 +158,16 @@ impl MapConfig {
             return Err(MapError::invalid(
                 "window_blocks",
                 format!("{}: must be odd", self.window_blocks),
+            ));
+        }
+        let m = self.recenter_margin_m;
+        if !(m.is_finite() && m >= 0.0 && m <= 0.5 * self.block_m()) {
+            return Err(MapError::invalid(
+                "recenter_margin_m",
+                format!(
+                    "{m}: must be in [0, half a block: {}]",
+                    0.5 * self.block_m()
+                ),
             ));
         }
         let o = &self.occupancy;
@@ -315,6 +333,8 @@ pub struct MultiHeightMap {
     prior_store: Option<BlockStore>,
     live_store: Option<BlockStore>,
     classified: Vec<Classified>,
+    /// The vehicle's self-hit test, binned; rebuilt when the model or the margin changes.
+    self_hits: Option<SelfHitFilter>,
     /// Per column, per level (column-major): the summary of the classification pass.
     column_levels: Vec<ColumnLevel>,
     /// Per level, the live cells that may be occupied: what forgetting visits.
@@ -482,6 +502,7 @@ impl MultiHeightMap {
             prior_store,
             live_store,
             classified: Vec::new(),
+            self_hits: None,
             column_levels: Vec::new(),
             occupied: vec![OccupiedCells::default(); n],
             last_hits: vec![Vec::new(); n],
@@ -503,6 +524,22 @@ impl MultiHeightMap {
             x: (p.x / b).floor() as i64 - half,
             y: (p.y / b).floor() as i64 - half,
         }
+    }
+
+    /// Whether `p` is within `recenter_margin_m` of the window's middle block (inside it
+    /// included).
+    fn near_middle(&self, p: Point2<f64>) -> bool {
+        let half = (self.config.window_blocks / 2) as i64;
+        let b = self.config.block_m();
+        let lo = Point2::new(
+            (self.window_lo.x + half) as f64 * b,
+            (self.window_lo.y + half) as f64 * b,
+        );
+        let past = (lo.x - p.x)
+            .max(p.x - (lo.x + b))
+            .max(lo.y - p.y)
+            .max(p.y - (lo.y + b));
+        past <= self.config.recenter_margin_m
     }
 
     fn window_blocks(&self, lo: BlockIndex) -> Vec<BlockIndex> {
@@ -543,13 +580,14 @@ impl MultiHeightMap {
         &self.spec
     }
 
-    /// Re-centres the window on the block holding `position` if it left the middle block.
-    /// Returns whether the window moved. On error (a bad block file) the map is unchanged.
+    /// Re-centres the window on the block holding `position` once it is more than
+    /// `recenter_margin_m` past the middle block's edge. Returns whether the window moved. On
+    /// error (a bad block file) the map is unchanged.
     pub fn recenter(&mut self, position: Point2<f64>) -> Result<bool> {
         crate::error::finite("position.x", position.x)?;
         crate::error::finite("position.y", position.y)?;
         let new_lo = Self::window_lo_for(&self.config, position);
-        if new_lo == self.window_lo {
+        if new_lo == self.window_lo || self.near_middle(position) {
             return Ok(false);
         }
         let old_lo = self.window_lo;
@@ -831,6 +869,15 @@ impl MultiHeightMap {
         let params = self.config.obstacle_test;
         let test = ObstacleTest::new(params);
         let margin = self.config.self_hit_margin_m;
+        if let Some(model) = vehicle
+            && !self
+                .self_hits
+                .as_ref()
+                .is_some_and(|f| f.is_for(model, margin))
+        {
+            self.self_hits = Some(SelfHitFilter::new(model, margin));
+        }
+        let self_filter = vehicle.and(self.self_hits.as_ref());
         let geometry = self.geometry;
         // Returns at or above the ceiling belong to no level (CARMEN drops points above the
         // vehicle plus a margin): dropped here, before the obstacle test pairs them.
@@ -892,8 +939,8 @@ impl MultiHeightMap {
                         far += 1;
                         continue;
                     };
-                    if let Some(model) = vehicle
-                        && model.is_self_hit(&(vehicle_from_world * xy), height, margin)
+                    if let Some(filter) = self_filter
+                        && filter.is_self_hit(&(vehicle_from_world * xy), height)
                     {
                         self_hits += 1;
                         continue;

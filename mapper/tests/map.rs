@@ -350,8 +350,9 @@ fn recentring_saves_and_reloads_blocks_with_their_cells() {
     let at = Point2::new(7.5, 3.0); // on the box's near face
     let p_before = map.probability_at(0, &at).unwrap();
 
-    // One block east: the window moves by 70 m, cells move with their world positions.
-    assert!(map.recenter(Point2::new(75.0, 0.0)).unwrap());
+    // One block east (past the re-centring margin): the window moves by 70 m, cells move with
+    // their world positions.
+    assert!(map.recenter(Point2::new(80.0, 0.0)).unwrap());
     assert_eq!(map.probability_at(0, &at), Some(p_before));
     // Far away: the whole window goes to disk.
     assert!(map.recenter(Point2::new(1000.0, 1000.0)).unwrap());
@@ -1007,6 +1008,46 @@ fn distance_maps_kept_from_the_touched_cells_equal_a_fresh_transform() {
 /// Regression: re-centring reset the distance maps but not the obstacle cells they were
 /// computed from, so a whole-window update after a whole-window update and a re-centring
 /// updated an empty map only around the cells that differed from the old window's.
+/// A route along a block edge (the aerodrome's taxiway at y = 0) crosses it back and forth:
+/// the window moves only once the position is `recenter_margin_m` past the middle block, in
+/// any direction, and then centres on the block the position is in.
+#[test]
+fn the_window_moves_past_a_margin_not_at_every_crossing_of_a_block_edge() {
+    let mut map = map_with(Levels::cumulative(vec![0.0]).unwrap());
+    let margin = map.config().recenter_margin_m;
+    assert_eq!(margin, 8.0);
+    let lo = map.window_origin_block();
+    // Middle block: [0, 70) x [0, 70). Zig-zag across y = 0 and x = 70, within the margin.
+    for k in 0..40 {
+        let wiggle = if k % 2 == 0 { -1.0 } else { 1.0 } * (0.05 + 0.19 * k as f64);
+        for at in [
+            Point2::new(30.0, wiggle),
+            Point2::new(70.0 + wiggle, 30.0),
+            Point2::new(-margin + 0.01, 70.0 + margin - 0.01),
+        ] {
+            assert!(!map.recenter(at).unwrap(), "{at:?}");
+            assert_eq!(map.window_origin_block(), lo);
+        }
+    }
+    // Just past the margin to the south: the window centres on the block below.
+    assert!(map.recenter(Point2::new(30.0, -margin - 0.01)).unwrap());
+    assert_eq!(
+        (map.window_origin_block().x, map.window_origin_block().y),
+        (lo.x, lo.y - 1)
+    );
+    // Back north across the edge, within the margin of the new middle block: stays.
+    assert!(!map.recenter(Point2::new(30.0, margin - 0.01)).unwrap());
+    assert!(map.recenter(Point2::new(30.0, margin + 0.01)).unwrap());
+    assert_eq!(map.window_origin_block(), lo);
+    // A margin over half a block is refused, naming the field.
+    let config = MapConfig {
+        recenter_margin_m: 36.0,
+        ..MapConfig::default()
+    };
+    let err = config.validate().unwrap_err().to_string();
+    assert!(err.contains("recenter_margin_m"), "{err}");
+}
+
 #[test]
 fn whole_window_distance_maps_after_a_recentring_start_over() {
     let mut map = map_with(Levels::cumulative(vec![0.0, 0.7]).unwrap());
@@ -1017,7 +1058,7 @@ fn whole_window_distance_maps_after_a_recentring_start_over() {
     insert(&mut map, &world, 2);
     map.update_distance_maps();
     assert_distance_maps_fresh(&map, "before");
-    assert!(map.recenter(Point2::new(75.0, 0.0)).unwrap());
+    assert!(map.recenter(Point2::new(80.0, 0.0)).unwrap());
     map.update_distance_maps();
     assert_distance_maps_fresh(&map, "after re-centring");
 }

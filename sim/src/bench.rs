@@ -113,11 +113,68 @@ pub fn mapper_figures(samples: usize, progress: &mut dyn FnMut(&str)) -> Vec<Fig
     out.push(against(coarse, &every));
     out.push(every);
 
+    progress("self_hits");
+    out.extend(self_hit_figures(samples, &scan));
+
     out.extend(edt_figures(samples, progress));
 
     progress("check_pose");
     out.extend(check_figures(samples));
     out
+}
+
+/// The self-hit test of a revolution's 69,984 returns against the 62-circle jet: the binned
+/// filter the mapper uses against every circle per return (inside the bounding circle), one
+/// thread each, in alternation.
+fn self_hit_figures(samples: usize, scan: &mapper::Scan) -> Vec<Figure> {
+    let jet = workloads::jet_62_circles();
+    let margin = MapConfig::default().self_hit_margin_m;
+    let filter = mapper::SelfHitFilter::new(&jet, margin);
+    let beams = scan.beams().max(1);
+    let points: Vec<(nalgebra::Point2<f64>, f64)> = scan
+        .returns()
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| {
+            let (r, column) = (r.as_ref()?, scan.columns().get(i / beams)?);
+            let p = r.point_in_world;
+            let v = column.world_from_vehicle.inverse() * nalgebra::Point2::new(p.x, p.y);
+            Some((v, p.z))
+        })
+        .collect();
+    let (binned, every) = alternating(
+        samples,
+        1,
+        || {
+            black_box(
+                points
+                    .iter()
+                    .filter(|(p, z)| filter.is_self_hit(p, *z))
+                    .count(),
+            );
+        },
+        || {
+            black_box(
+                points
+                    .iter()
+                    .filter(|(p, z)| jet.is_self_hit(p, *z, margin))
+                    .count(),
+            );
+        },
+    );
+    let every = figure(
+        "self_hits/hdl32e_69984_returns/62_circles/every_circle",
+        every,
+        "ms",
+        None,
+    );
+    let binned = figure(
+        "self_hits/hdl32e_69984_returns/62_circles",
+        binned,
+        "ms",
+        None,
+    );
+    vec![against(binned, &every), every]
 }
 
 /// The 62-circle pose check near obstacles, and far from them the bounding-circle early out
@@ -540,6 +597,7 @@ pub fn loop_figures(
         ("distance_maps_per_scan", s.distance_maps),
         ("planning_per_scan", s.planning),
         ("physics_per_scan", s.physics),
+        ("localization_per_scan", s.localization),
     ] {
         out.push(figure(&name(what), per_scan(seconds), "ms", None));
     }

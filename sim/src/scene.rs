@@ -195,7 +195,7 @@ pub fn pavement(base: f32, amplitude: f32, x: f64, y: f64) -> f32 {
     if amplitude == 0.0 {
         return base;
     }
-    let (i, j) = ((x * 2.0).floor() as i64, (y * 2.0).floor() as i64);
+    let (i, j) = (floor_i64(x * 2.0), floor_i64(y * 2.0));
     // SplitMix64 of the square's coordinates.
     let mut z = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
         ^ (j as u64).wrapping_add(0x632B_E59B_D9B4_E019);
@@ -204,6 +204,14 @@ pub fn pavement(base: f32, amplitude: f32, x: f64, y: f64) -> f32 {
     z ^= z >> 31;
     let u = (z >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0;
     (base + amplitude * u).clamp(0.0, 1.0)
+}
+
+/// `v.floor() as i64` without the libm call `f64::floor` is on baseline x86-64 (once per LiDAR
+/// ground return here): truncate, then step down where that rounded up.
+#[inline]
+fn floor_i64(v: f64) -> i64 {
+    let t = v as i64;
+    t - i64::from((t as f64) > v)
 }
 
 /// [`Scene::ground_remission_at`] with each patch's rotation computed once, and the patches
@@ -354,6 +362,17 @@ impl GroundTexture {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The floor without libm is the floor, on both sides of zero, on integers and NaN.
+    #[test]
+    fn floor_without_libm_is_the_floor() {
+        for v in [
+            -2.5, -2.0, -1.0000001, -0.3, -0.0, 0.0, 0.3, 0.9999999, 1.0, 7.5, 1e12, -1e12,
+        ] {
+            assert_eq!(floor_i64(v), v.floor() as i64, "{v}");
+        }
+        assert_eq!(floor_i64(f64::NAN), f64::NAN.floor() as i64);
+    }
 
     /// The pavement's texture: the same value anywhere in a 0.5 m square and every time,
     /// within the amplitude of the base, spread over it (mean near the base, both signs).
