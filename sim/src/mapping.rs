@@ -219,15 +219,38 @@ pub fn map_drive(
     // One revolution every 0.1 s at the route's speed.
     let spacing = (scenario.route.speed_m_s * 0.1).max(0.05);
     let scans = (route.length_m() / spacing).ceil() as usize + 1;
-    for k in 0..scans {
-        let s = (k as f64 * spacing).min(route.length_m());
-        let (p, heading) = route.at(s);
-        let pose = Isometry2::new(p.coords, heading);
-        world.set_vehicle_pose(&pose, k as f64 * 0.1);
-        let scan = lidar.scan(&world, &SweepPoses::still(pose), k as u64, scenario.seed);
-        map.recenter(p)?;
-        map.insert_scan(&scan.scan, Some(&self_filter))?;
-        progress(k + 1, scans);
+    // Each revolution is cast beside the insertion of the one before (the same insertions, in
+    // the same order: the same map).
+    let mut taken: Option<(Point2<f64>, mapper::Scan)> = None;
+    for k in 0..=scans {
+        let cast = (k < scans).then(|| {
+            let s = (k as f64 * spacing).min(route.length_m());
+            let (p, heading) = route.at(s);
+            let pose = Isometry2::new(p.coords, heading);
+            world.set_vehicle_pose(&pose, k as f64 * 0.1);
+            (p, pose)
+        });
+        let (scan, inserted) = rayon::join(
+            || {
+                cast.map(|(p, pose)| {
+                    let scan =
+                        lidar.scan(&world, &SweepPoses::still(pose), k as u64, scenario.seed);
+                    (p, scan.scan)
+                })
+            },
+            || -> Result<()> {
+                if let Some((p, scan)) = taken.take() {
+                    map.recenter(p)?;
+                    map.insert_scan(&scan, Some(&self_filter))?;
+                }
+                Ok(())
+            },
+        );
+        inserted?;
+        if k > 0 {
+            progress(k, scans);
+        }
+        taken = scan;
     }
     map.flush()?;
     let store = BlockStore::open(&blocks_dir, map.block_spec().clone())?;
