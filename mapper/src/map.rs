@@ -586,10 +586,10 @@ impl MultiHeightMap {
     pub fn recenter(&mut self, position: Point2<f64>) -> Result<bool> {
         crate::error::finite("position.x", position.x)?;
         crate::error::finite("position.y", position.y)?;
-        let new_lo = Self::window_lo_for(&self.config, position);
-        if new_lo == self.window_lo || self.near_middle(position) {
+        if self.near_middle(position) {
             return Ok(false);
         }
+        let new_lo = Self::window_lo_for(&self.config, position);
         let old_lo = self.window_lo;
         let entering: Vec<BlockIndex> = self
             .window_blocks(new_lo)

@@ -76,16 +76,6 @@ impl SelfHitFilter {
         }
     }
 
-    /// The model it tests against.
-    pub fn model(&self) -> &CollisionModel {
-        &self.model
-    }
-
-    /// The margin it was built with, metres.
-    pub fn margin_m(&self) -> f64 {
-        self.margin_m
-    }
-
     /// Whether it is the filter of `model` at `margin_m`.
     pub fn is_for(&self, model: &CollisionModel, margin_m: f64) -> bool {
         self.margin_m == margin_m.max(0.0) && self.model == *model

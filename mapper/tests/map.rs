@@ -1005,9 +1005,6 @@ fn distance_maps_kept_from_the_touched_cells_equal_a_fresh_transform() {
     }
 }
 
-/// Regression: re-centring reset the distance maps but not the obstacle cells they were
-/// computed from, so a whole-window update after a whole-window update and a re-centring
-/// updated an empty map only around the cells that differed from the old window's.
 /// A route along a block edge (the aerodrome's taxiway at y = 0) crosses it back and forth:
 /// the window moves only once the position is `recenter_margin_m` past the middle block, in
 /// any direction, and then centres on the block the position is in.
@@ -1048,6 +1045,9 @@ fn the_window_moves_past_a_margin_not_at_every_crossing_of_a_block_edge() {
     assert!(err.contains("recenter_margin_m"), "{err}");
 }
 
+/// Regression: re-centring reset the distance maps but not the obstacle cells they were
+/// computed from, so a whole-window update after a whole-window update and a re-centring
+/// updated an empty map only around the cells that differed from the old window's.
 #[test]
 fn whole_window_distance_maps_after_a_recentring_start_over() {
     let mut map = map_with(Levels::cumulative(vec![0.0, 0.7]).unwrap());
