@@ -28,7 +28,7 @@
 //!    ([`FreeSpaceWalks::CoarseToFine`]) only every 2^j-th column walks there, adding 2^j
 //!    `l_free`: the same map with fewer cell updates.
 
-use std::collections::HashMap;
+use foldhash::HashMap;
 
 use nalgebra::{Point2, Point3};
 use rayon::prelude::*;
@@ -506,7 +506,7 @@ impl MultiHeightMap {
             column_levels: Vec::new(),
             occupied: vec![OccupiedCells::default(); n],
             last_hits: vec![Vec::new(); n],
-            hit_spans: vec![HashMap::new(); n],
+            hit_spans: vec![HashMap::default(); n],
             edt_scratch: EdtScratch::default(),
             levels,
         };
@@ -1472,6 +1472,14 @@ fn insert_hits(
     };
     let mut hits = 0;
     hit_cells.clear();
+    // The height span of consecutive hits in one cell, not yet merged into `spans`.
+    let mut pending: Option<(u32, HitSpan)> = None;
+    let mut merge = |cell: u32, (lo, hi): HitSpan| {
+        let i = cell as usize;
+        let at = ((i % width) as i64 + cell0.0, (i / width) as i64 + cell0.1);
+        let span = spans.entry(at).or_insert((lo, hi));
+        *span = (span.0.min(lo), span.1.max(hi));
+    };
     for ci in 0..classified.len() / beams.max(1) {
         let nearest = summary.get(ci).nearest_hit;
         if nearest == NONE {
@@ -1492,12 +1500,21 @@ fn insert_hits(
             }
             hits += 1;
             hit_cells.push(c.cell);
-            let i = c.cell as usize;
-            let at = ((i % width) as i64 + cell0.0, (i / width) as i64 + cell0.1);
-            let span = spans.entry(at).or_insert((c.height_m, c.height_m));
-            span.0 = span.0.min(c.height_m);
-            span.1 = span.1.max(c.height_m);
+            // A column's beams up one face mostly hit one cell: its heights are gathered here
+            // and looked up in the table once (a lookup is a cache miss in a table this size).
+            let h = c.height_m;
+            match &mut pending {
+                Some((cell, span)) if *cell == c.cell => *span = (span.0.min(h), span.1.max(h)),
+                _ => {
+                    if let Some((cell, span)) = pending.replace((c.cell, (h, h))) {
+                        merge(cell, span);
+                    }
+                }
+            }
         }
+    }
+    if let Some((cell, span)) = pending {
+        merge(cell, span);
     }
     hit_cells.sort_unstable();
     hit_cells.dedup();

@@ -18,7 +18,7 @@
 //! cells it hit since its last jump: a step its motion does not explain may be another object's
 //! hits taken over, so what it painted before is no longer its to clear, nor what it took over.
 
-use std::collections::HashMap;
+use foldhash::HashMap;
 
 use nalgebra::Point2;
 use serde::{Deserialize, Serialize};
@@ -175,7 +175,7 @@ impl Tracker {
             resolution_m,
             tracks: Vec::new(),
             next_id: 0,
-            cells: HashMap::new(),
+            cells: HashMap::default(),
         }
     }
 
@@ -335,7 +335,7 @@ impl Tracker {
     /// eight neighbours.
     fn clusters(&self, hits: &[WorldCell]) -> Vec<Cluster> {
         let g = ((self.config.cluster_gap_m / self.resolution_m).ceil() as i64).max(1);
-        let mut buckets: HashMap<(i64, i64), usize> = HashMap::new();
+        let mut buckets: HashMap<(i64, i64), usize> = HashMap::default();
         let mut bucket_of = Vec::with_capacity(hits.len());
         for &(x, y) in hits {
             let key = (x.div_euclid(g), y.div_euclid(g));
@@ -360,7 +360,7 @@ impl Tracker {
                 }
             }
         }
-        let mut index_of_root: HashMap<usize, usize> = HashMap::new();
+        let mut index_of_root: HashMap<usize, usize> = HashMap::default();
         let mut clusters: Vec<Cluster> = Vec::new();
         let r = self.resolution_m;
         for (&c, &b) in hits.iter().zip(&bucket_of) {
