@@ -1758,6 +1758,38 @@ struct Walk {
     stop_short: usize,
 }
 
+/// A [`Walk`] in Bresenham steps: `d` = (|dx|, -|dy|), `s` the signs, the steps it may take
+/// (`stop_short` off its cells), metres per step, and the first step it updates (`start_m`).
+struct WalkSteps {
+    d: (i64, i64),
+    s: (i64, i64),
+    steps: i64,
+    per_step: f64,
+    first: i64,
+}
+
+impl Walk {
+    fn steps(&self) -> WalkSteps {
+        let (a, b) = (self.from, self.to);
+        let (dx, dy) = ((b.0 - a.0).abs(), -(b.1 - a.1).abs());
+        let cells = dx.max(-dy) + 1;
+        let steps = (cells - self.stop_short as i64).max(0);
+        let per_step = self.length_m / (cells - 1).max(1) as f64;
+        let first = if self.start_m > 0.0 {
+            ((self.start_m / per_step).ceil() as i64).min(steps)
+        } else {
+            0
+        };
+        WalkSteps {
+            d: (dx, dy),
+            s: ((b.0 - a.0).signum(), (b.1 - a.1).signum()),
+            steps,
+            per_step,
+            first,
+        }
+    }
+}
+
 /// One step of the all-octant Bresenham loop (`d` = (|dx|, -|dy|), `s` the signs). Without
 /// branches: on a slanted line which axis steps is as good as random, and the mispredicted
 /// branches cost more than the free-space walk's memory accesses. [`walk_free`] takes the same
@@ -1809,16 +1841,13 @@ fn walk_free(
 ) -> (usize, f64) {
     let (watch, touched) = touched;
     let (a, b) = (walk.from, walk.to);
-    let (dx, dy) = ((b.0 - a.0).abs(), -(b.1 - a.1).abs());
-    let (sx, sy) = ((b.0 - a.0).signum(), (b.1 - a.1).signum());
-    let cells = dx.max(-dy) + 1;
-    let steps = (cells - walk.stop_short as i64).max(0);
-    let per_step = walk.length_m / (cells - 1).max(1) as f64;
-    let first = if walk.start_m > 0.0 {
-        ((walk.start_m / per_step).ceil() as i64).min(steps)
-    } else {
-        0
-    };
+    let WalkSteps {
+        d: (dx, dy),
+        s: (sx, sy),
+        steps,
+        per_step,
+        first,
+    } = walk.steps();
     if first >= steps {
         return (0, per_step * steps as f64);
     }
@@ -1891,16 +1920,13 @@ fn walk_free_plain(
 ) -> (usize, f64) {
     let (watch, touched) = touched;
     let (a, b) = (walk.from, walk.to);
-    let (dx, dy) = ((b.0 - a.0).abs(), -(b.1 - a.1).abs());
-    let (sx, sy) = ((b.0 - a.0).signum(), (b.1 - a.1).signum());
-    let cells = dx.max(-dy) + 1;
-    let steps = (cells - walk.stop_short as i64).max(0);
-    let per_step = walk.length_m / (cells - 1).max(1) as f64;
-    let first = if walk.start_m > 0.0 {
-        ((walk.start_m / per_step).ceil() as i64).min(steps)
-    } else {
-        0
-    };
+    let WalkSteps {
+        d: (dx, dy),
+        s: (sx, sy),
+        steps,
+        per_step,
+        first,
+    } = walk.steps();
     let (mut x, mut y, mut err) = bresenham_at(a, b, first);
     let mut updated = 0;
     let mut delta = 0.0;
