@@ -1852,8 +1852,8 @@ fn walk_free(
         return (0, per_step * steps as f64);
     }
     let inside = |(x, y, _): (i64, i64, i64)| x >= 0 && y >= 0 && x < w && y < h;
-    let (x, y, mut err) = bresenham_at(a, b, first);
-    if !inside((x, y, err)) {
+    let start = bresenham_at(a, b, first);
+    if !inside(start) {
         return (0, per_step * first as f64);
     }
     // The first step outside the window (or `steps`): inside is a prefix of the walk from here.
@@ -1875,6 +1875,7 @@ fn walk_free(
     // the update; anything else takes the full path. The cell's index is stepped along with the
     // line's error term, x and y are not needed.
     let fast_below = watch.min(-f32::MIN_POSITIVE);
+    let (x, y, mut err) = start;
     let mut i = y * w + x;
     let (di_x, di_y) = (sx, sy * w);
     let mut step = first;
