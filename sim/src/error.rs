@@ -5,9 +5,9 @@ use std::path::PathBuf;
 /// What can go wrong in the simulator's library.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// A scenario or run configuration file is wrong (file, line, column, field).
+    /// A scenario, run configuration or campaign file is wrong (file, line, column, field).
     #[error(transparent)]
-    Scenario(#[from] crate::scenario::ScenarioError),
+    Located(#[from] crate::toml_file::LocatedError),
     /// A value of the run configuration is wrong.
     #[error("{origin}: {message}")]
     Config {
@@ -34,7 +34,7 @@ pub enum Error {
     },
     /// A map directory's manifest exists but cannot be used.
     #[error(transparent)]
-    Manifest(#[from] crate::mapping::ManifestError),
+    Manifest(#[from] ManifestError),
     /// A file the simulator wrote earlier is not what it should be (a map manifest, a PLY).
     #[error("{}: {message}", path.display())]
     BadFile {
@@ -56,3 +56,32 @@ pub enum Error {
 
 /// The library's result.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// A map's `manifest.json` exists but cannot be used: rebuilding over it would hide the cause.
+#[derive(Debug, thiserror::Error)]
+pub enum ManifestError {
+    /// The file exists but cannot be read (permissions, not UTF-8, a directory...).
+    #[error("{}: cannot read the map manifest: {error}; {remedy}", path.display())]
+    Read {
+        /// The manifest file.
+        path: PathBuf,
+        /// The underlying error.
+        error: std::io::Error,
+        /// What to do about it.
+        remedy: String,
+    },
+    /// The file is not a manifest (garbage, truncated, another format).
+    #[error("{}:{line}:{column}: not a map manifest: {message}; {remedy}", path.display())]
+    Parse {
+        /// The manifest file.
+        path: PathBuf,
+        /// 1-based line of the mistake (serde_json's).
+        line: usize,
+        /// 1-based column of the mistake (serde_json's).
+        column: usize,
+        /// What serde_json says is wrong.
+        message: String,
+        /// What to do about it.
+        remedy: String,
+    },
+}

@@ -1,50 +1,45 @@
 //! taxi-sim: the closed-loop taxi simulator around the multi-height occupancy grid map.
 //!
-//! This library holds what the `taxi-sim` binary runs; the binary alone knows the terminal. The
-//! stack under test is the `autonomy` crate; this one is the world around it and the engine.
-//! - [`scene`]: what a world is made of (ground, solids, painted patches), independent of Rapier.
-//! - [`scenario`]: scenario files (TOML) and their errors, converted to a scene.
-//! - [`world`]: the Rapier world and the ground truth (contacts, clearances).
-//! - [`motion`]: the kinematic bicycle that moves the vehicle.
-//! - [`lidar`]: the synthetic HDL-32E (fast path and Rapier's generic query); [`ply`] writes it.
-//! - [`mapping`]: the mapping drive that builds a scenario's offline map.
-//! - The engine: [`config`] (the run configuration), [`pose_source`] (truth, noisy truth),
-//!   [`schedule`] (sequential or overlapped sensing), [`judge`] (passes, stops, laps, contacts,
-//!   verdicts), [`observer`] (what watches a run), [`report`], and [`run`], the loop.
-//! - [`replay`]: the Rerun recording and live view of a run (the only module that knows Rerun).
+//! This library holds what the `taxi-sim` binary (crate `sim/cli`) runs; the binary alone knows
+//! the terminal. The stack under test is the `autonomy` crate; this one is the world around it
+//! and the engine. Its modules are layered, each importing only those listed before it (CI
+//! checks it, `.ci/check_layers.py`):
+//! - the leaves: [`error`] (the library's typed errors), [`toml_file`] (located errors in TOML
+//!   files, dotted-path edits), [`chart`] (the charts' font);
+//! - [`world`]: the simulator's side of the message boundary - the scene, the Rapier world and
+//!   its ground truth, motion, the LiDAR, odometry, faults, the capture of a revolution. The
+//!   only module that names Rapier or parry;
+//! - [`scenario`]: what a run is asked to do - scenario files and run configurations, resolved;
+//! - [`offline_map`]: the mapping drive that builds a scenario's offline map, and its manifest;
+//! - [`engine`]: one run - the rig, the loop, the schedule, pose sources, the judge, the
+//!   observer hook and the report;
+//! - [`replay`]: the Rerun recording and live view of a run (the only module that names Rerun);
+//! - [`studies`]: the mapping demo and the small-obstacle sweep;
+//! - [`campaign`]: scenario families sampled, run in parallel, searched for failures;
+//! - [`tune`]: collision-model tuning on the campaign engine;
 //! - [`bench`]: the headline performance figures, measured without criterion.
-//! - [`campaign`]: campaigns - scenario families sampled, run in parallel, searched for
-//!   failures, summarised.
-//! - [`small_obstacles`]: the sweep that finds the smallest obstacle seen in time per speed.
-//! - [`demo`]: a mapping drive through a synthetic parking lot, exporting every level.
-//! - [`error`]: the library's typed errors.
+
+pub mod chart;
+pub mod error;
+pub mod toml_file;
+
+pub mod world;
+
+pub mod scenario;
+
+pub mod offline_map;
+
+pub mod engine;
+
+pub mod replay;
+
+pub mod studies;
+
+pub mod campaign;
+
+pub mod tune;
 
 pub mod bench;
-pub mod bench_blocks;
-pub mod bench_localization;
-pub mod campaign;
-pub mod config;
-pub mod demo;
-pub mod error;
-pub mod faults;
-pub mod judge;
-pub mod lidar;
-pub mod localization;
-pub mod mapping;
-pub mod motion;
-pub mod observer;
-pub mod odometry;
-pub mod ply;
-pub mod pose_source;
-pub mod replay;
-pub mod report;
-pub mod run;
-pub mod scenario;
-pub mod scene;
-pub mod schedule;
-pub mod small_obstacles;
-pub mod tune;
-pub mod world;
 
 pub use error::{Error, Result};
 

@@ -1,4 +1,9 @@
-//! End-to-end and scenario regression tests of the workspace (see `tests/tests/`).
+//! The workspace's end-to-end and scenario regression tests; this library holds no code.
 //!
-//! The scenario runs of the thesis' experiments land here as the simulator grows; until then it
-//! checks the mapping demo end to end: scans in, per-level maps and files out.
+//! The tests are one integration-test binary, `tests/tests/it/` (`cargo test --release -p tests
+//! --test it`), with the helpers its files share in `tests/tests/it/common`. They run whole
+//! scenarios through the `sim` library: the closed loop on the small scenarios, the thesis'
+//! experiments against their goldens (`tests/golden/`, rewritten with `TAXI_SIM_BLESS=1`), the
+//! failures the campaigns found (`tests/found/`, plain scenario files asserted as they behave),
+//! localization, overhead structures, permanence of what is unseen, the distance cap and the
+//! mapping demo. Tests that need the `taxi-sim` binary live in its package (`sim/cli/tests/it`).

@@ -70,11 +70,12 @@ pub struct LocalizerConfig {
     /// independent; CARMEN's particles weight factor). Default 0.05.
     pub likelihood_weight: f64,
     /// Spread of each particle's odometry speed-scale error, drawn afresh at every measurement
-    /// update (white, not a per-particle bias: along a straight line with nothing to see
-    /// along it, resampling would otherwise let the particles' shared bias wander - 8 % in a
-    /// kilometre of taxiway). CARMEN's velocity noise, 0.15, by default: along a taxiway whose
-    /// lines say nothing of the along-track position, the particles must spread far enough
-    /// for the next marker or turn to find the odometry's error.
+    /// update: white, never a per-particle bias, which resampling would turn into one bias
+    /// shared by the particles, free to wander wherever nothing along the route says where
+    /// along it the vehicle is. CARMEN's velocity noise, 0.15, by default: along a taxiway
+    /// whose lines say nothing of the along-track position, the particles must spread far
+    /// enough for the next marker or turn to find the odometry's error. Guarded by
+    /// `the_filter_converges_from_a_wrong_fix_on_biased_odometry` (odometry 3 % fast).
     pub speed_scale_sigma: f64,
     /// Spread of each particle's steering error, radians, drawn the same way. Default 0.01.
     pub steering_sigma_rad: f64,
@@ -791,9 +792,10 @@ pub fn estimate_of(particles: &[Particle], log_w: &[f64]) -> Estimate {
 /// Each particle's log-likelihood of `obs` over `lmap`. Point-major over blocks of particles:
 /// the particles of a block stand within a few cells of each other, so one return placed from
 /// each of them reads the same few cache lines of the tables (particle-major, each particle
-/// would sweep the whole window on its own). One thread: on this 2-core machine the blocks in
-/// parallel ran 0.96-1.46x its speed from run to run (`taxi-sim bench localization`), and in
-/// the loop the other core is mapping.
+/// would sweep the whole window on its own). One thread: in the closed loop the other cores
+/// are mapping, so the blocks run one after the other; [`weigh_parallel`] is the parallel form
+/// `taxi-sim bench localization` measures against it. Equal to [`weigh_straightforward`] to
+/// rounding (`the_tables_weigh_like_the_straightforward_way`).
 pub fn weigh(
     particles: &[Particle],
     obs: &Observation,

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::execute::{RunRecord, read_results};
+use super::record::{RunRecord, read_results};
 use crate::error::{Error, Result};
 
 /// What a merge found.
@@ -170,44 +170,5 @@ mod tests {
         assert_eq!(ranges(&[]), "");
         assert_eq!(ranges(&[3]), "3");
         assert_eq!(ranges(&[3, 7, 8, 9, 12]), "3, 7-9, 12");
-    }
-
-    #[test]
-    fn a_shard_is_parsed_from_the_flag_or_the_scheduler_and_checked() {
-        use super::super::execute::Shard;
-        let none = |_: &str| None;
-        assert_eq!(Shard::parse("2/4", &none), Ok(Shard { index: 2, count: 4 }));
-        let slurm = |k: &str| (k == "SLURM_ARRAY_TASK_ID").then(|| "3".to_string());
-        assert_eq!(
-            Shard::parse("auto/4", &slurm),
-            Ok(Shard { index: 3, count: 4 })
-        );
-        let k8s = |k: &str| (k == "JOB_COMPLETION_INDEX").then(|| "0".to_string());
-        assert_eq!(
-            Shard::parse("auto/2", &k8s),
-            Ok(Shard { index: 0, count: 2 })
-        );
-        for (text, env, says) in [
-            (
-                "4/4",
-                &none as &dyn Fn(&str) -> Option<String>,
-                "not below N = 4",
-            ),
-            ("1/0", &none, "N must be"),
-            ("x/3", &none, "not a whole number"),
-            ("auto/3", &none, "neither SLURM_ARRAY_TASK_ID"),
-            (
-                "auto/3",
-                &slurm,
-                "SLURM_ARRAY_TASK_ID = 3 is not below N = 3",
-            ),
-            ("3", &none, "expected I/N"),
-        ] {
-            let e = Shard::parse(text, env).unwrap_err();
-            assert!(e.contains(says), "{text}: {e}");
-        }
-        let s = Shard { index: 1, count: 3 };
-        let held: Vec<u64> = (0..10).filter(|i| s.holds(*i)).collect();
-        assert_eq!(held, vec![1, 4, 7]);
     }
 }

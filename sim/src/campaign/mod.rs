@@ -9,12 +9,19 @@
 //! distributions into a plain scenario text ([`Campaign::variant`]) that `taxi-sim run` runs
 //! alone. [`execute`] runs them in parallel into `results.jsonl`; [`summary`] reads that back.
 
-pub mod bench;
 pub mod dist;
-pub mod execute;
+mod execute;
+mod map_cache;
 pub mod merge;
+mod record;
 pub mod sampler;
+mod shard;
 pub mod summary;
+
+pub use execute::{Outcome, RunOptions, proposals_for, run_campaign, total_runs, variant};
+pub use map_cache::static_world_key;
+pub use record::{INVALID, ObstacleOutcome, RunRecord, read_results, record};
+pub use shard::Shard;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -23,8 +30,11 @@ use autonomy::RoutePath;
 use serde::Deserialize;
 use toml::{Spanned, Table, Value};
 
-use crate::config::RunConfig;
-use crate::scenario::{Scenario, ScenarioError};
+use crate::toml_file::set_path;
+
+use crate::scenario::RunConfig;
+use crate::scenario::Scenario;
+use crate::toml_file::LocatedError;
 use dist::{Layout, Node};
 pub use sampler::SamplerKind;
 
@@ -156,8 +166,8 @@ fn at(
     span: std::ops::Range<usize>,
     field: &str,
     m: String,
-) -> ScenarioError {
-    ScenarioError::at(file, text, span, field, m)
+) -> LocatedError {
+    LocatedError::at(file, text, span, field, m)
 }
 
 impl Campaign {
@@ -175,7 +185,7 @@ impl Campaign {
     pub fn from_str(text: &str, path: &Path) -> crate::Result<Self> {
         let file = path.display().to_string();
         let spec: CampaignFile =
-            toml::from_str(text).map_err(|e| ScenarioError::toml(&file, text, &e))?;
+            toml::from_str(text).map_err(|e| LocatedError::toml(&file, text, &e))?;
         let base_path = path
             .parent()
             .unwrap_or_else(|| Path::new(""))
@@ -191,43 +201,8 @@ impl Campaign {
         })?;
         let base = Scenario::from_str(&base_text, &base_path)?;
         let base_doc: Table = toml::from_str(&base_text)
-            .map_err(|e| ScenarioError::toml(&base_path.display().to_string(), &base_text, &e))?;
-        if *spec.runs.get_ref() == 0 {
-            return Err(at(
-                &file,
-                text,
-                spec.runs.span(),
-                "runs",
-                "must be at least 1".into(),
-            )
-            .into());
-        }
-        let grid_steps = spec.grid_steps.as_ref().map_or(3, |g| *g.get_ref());
-        if let Some(g) = &spec.grid_steps
-            && *g.get_ref() == 0
-        {
-            return Err(at(
-                &file,
-                text,
-                g.span(),
-                "grid_steps",
-                "must be at least 1".into(),
-            )
-            .into());
-        }
-        let f = &spec.falsify;
-        if f.batch == 0
-            || !(f.elite_fraction > 0.0 && f.elite_fraction <= 1.0)
-            || !(0.0..=1.0).contains(&f.smoothing)
-        {
-            return Err(crate::Error::Config {
-                origin: format!("{file}: [falsify]"),
-                message: format!(
-                    "batch = {} must be >= 1, elite_fraction = {} in (0, 1], smoothing = {} in [0, 1]",
-                    f.batch, f.elite_fraction, f.smoothing
-                ),
-            });
-        }
+            .map_err(|e| LocatedError::toml(&base_path.display().to_string(), &base_text, &e))?;
+        let grid_steps = checked_counts(&spec, &file, text)?;
         let mut layout = Layout::default();
         let e = |span: std::ops::Range<usize>, field: &str, m: String| -> crate::Error {
             at(&file, text, span, field, m).into()
@@ -508,37 +483,6 @@ fn config_of(base_doc: &Table, setting: &Setting) -> Result<RunConfig, String> {
     })
 }
 
-/// Sets `value` at dotted `path` of `doc`: a table merges key by key into a table there.
-pub fn set_path(doc: &mut Table, path: &str, value: Value) {
-    let (head, rest) = match path.split_once('.') {
-        Some((h, r)) => (h, Some(r)),
-        None => (path, None),
-    };
-    match rest {
-        Some(rest) => {
-            let entry = doc
-                .entry(head)
-                .or_insert_with(|| Value::Table(Table::new()));
-            if !entry.is_table() {
-                *entry = Value::Table(Table::new());
-            }
-            if let Value::Table(t) = entry {
-                set_path(t, rest, value);
-            }
-        }
-        None => match (doc.get_mut(head), value) {
-            (Some(Value::Table(old)), Value::Table(new)) => {
-                for (k, v) in new {
-                    set_path(old, &k, v);
-                }
-            }
-            (_, v) => {
-                doc.insert(head.to_string(), v);
-            }
-        },
-    }
-}
-
 /// Shape keys a new `kind` replaces.
 const SHAPE_KEYS: [&str; 3] = ["size_m", "radius_m", "height_m"];
 
@@ -634,4 +578,46 @@ fn absolutize(doc: &mut Table, dir: &Path) {
             }
         }
     }
+}
+
+/// The file's counts checked (`runs`, `grid_steps`, `[falsify]`); the grid's steps per
+/// dimension (3 unless given).
+fn checked_counts(spec: &CampaignFile, file: &str, text: &str) -> crate::Result<u32> {
+    if *spec.runs.get_ref() == 0 {
+        return Err(at(
+            file,
+            text,
+            spec.runs.span(),
+            "runs",
+            "must be at least 1".into(),
+        )
+        .into());
+    }
+    let grid_steps = spec.grid_steps.as_ref().map_or(3, |g| *g.get_ref());
+    if let Some(g) = &spec.grid_steps
+        && *g.get_ref() == 0
+    {
+        return Err(at(
+            file,
+            text,
+            g.span(),
+            "grid_steps",
+            "must be at least 1".into(),
+        )
+        .into());
+    }
+    let f = &spec.falsify;
+    if f.batch == 0
+        || !(f.elite_fraction > 0.0 && f.elite_fraction <= 1.0)
+        || !(0.0..=1.0).contains(&f.smoothing)
+    {
+        return Err(crate::Error::Config {
+            origin: format!("{file}: [falsify]"),
+            message: format!(
+                "batch = {} must be >= 1, elite_fraction = {} in (0, 1], smoothing = {} in [0, 1]",
+                f.batch, f.elite_fraction, f.smoothing
+            ),
+        });
+    }
+    Ok(grid_steps)
 }

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::execute::{INVALID, RunRecord};
+use super::record::{INVALID, RunRecord};
 use crate::error::Result;
 
 /// Failing variants listed in the error table (the rest are in `results.jsonl`).
@@ -190,7 +190,7 @@ pub fn write(dir: &Path, records: &[RunRecord]) -> Result<()> {
 /// index, failures in red - where a search converges, and how far the passing runs keep off.
 pub fn chart(dir: &Path, title: &str, records: &[RunRecord]) -> Result<()> {
     use plotters::prelude::*;
-    crate::tune::draw::register_font();
+    crate::chart::register_font();
     let path = dir.join("clearance.svg");
     let tmp = dir.join(".clearance.svg.partial");
     let top = records

@@ -4,7 +4,6 @@
 //! machine without fonts draws the same picture.
 
 use std::path::Path;
-use std::sync::Once;
 
 use aircraft::FittedModel;
 use aircraft::footprint::Footprint;
@@ -13,19 +12,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::SettingFigures;
+use crate::chart::register_font;
 use crate::error::{Error, Result};
-
-static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
-static REGISTER: Once = Once::new();
-
-/// Registers the bundled font as plotters' `sans-serif` (once): every chart of the crate calls this
-/// before drawing text.
-pub(crate) fn register_font() {
-    REGISTER.call_once(|| {
-        // The bundled file is a valid font (a test draws with it): nothing to report here.
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
-    });
-}
 
 type DrawResult = std::result::Result<(), String>;
 

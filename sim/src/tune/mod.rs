@@ -18,10 +18,10 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::campaign::Campaign;
-use crate::campaign::execute::{RunRecord, static_world_key, variant};
-use crate::config::{CollisionModelConfig, RunConfig};
+use crate::campaign::{RunRecord, static_world_key, variant};
 use crate::error::{Error, Result};
 use crate::scenario::Scenario;
+use crate::scenario::{CollisionModelConfig, RunConfig};
 use probe::Probe;
 
 /// Everything measured about one setting.

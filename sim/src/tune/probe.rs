@@ -10,8 +10,8 @@ use nalgebra::{Isometry2, Vector2};
 use rand::{RngExt as _, SeedableRng as _};
 use serde::Serialize;
 
-use crate::config::RunConfig;
 use crate::error::{Error, Result};
+use crate::scenario::RunConfig;
 use crate::scenario::Scenario;
 
 /// How far beyond a part's footprint the exact check looks for obstacles, metres.
@@ -37,7 +37,7 @@ pub fn distance_maps(
     config: &RunConfig,
     map_dir: &Path,
 ) -> Result<Vec<DistanceMaps>> {
-    let levels = crate::mapping::levels_of(scenario, config)?;
+    let levels = crate::offline_map::levels_of(scenario, config)?;
     let route = autonomy::RoutePath::new(&scenario.route.waypoints_m, scenario.route.closed);
     let blocks = map_dir.join("blocks");
     if !blocks.is_dir() {

@@ -1,0 +1,3 @@
+//! The autonomy crate's integration tests, one binary: the particle filter on an analytic scene.
+
+mod localizer;

@@ -1,0 +1,134 @@
+//! `taxi-sim bench`: the headline performance figures on this machine, each against its
+//! straightforward baseline, as a table or JSON lines.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use clap::ValueEnum;
+use indicatif::ProgressBar;
+
+use crate::emit;
+
+/// Arguments of `taxi-sim bench`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct BenchArgs {
+    /// What to measure.
+    pub what: BenchTarget,
+    /// One JSON object per figure on stdout instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Timed batches per figure, the median reported (default 15; `bench loop`: runs of each
+    /// schedule, in alternation, default 1 - it then says it ran once).
+    #[arg(long)]
+    pub samples: Option<usize>,
+    /// Scenario of `bench loop` and `bench blocks`.
+    #[arg(long, default_value = "scenarios/parking_lot.toml")]
+    pub scenario: PathBuf,
+    /// Laps of `bench loop` (default 1; 0: the scenario's own).
+    #[arg(long, default_value_t = 1)]
+    pub laps: u32,
+    /// Campaign of `bench campaign`.
+    #[arg(long, default_value = "scenarios/campaigns/parking_lot_random.toml")]
+    pub campaign: PathBuf,
+    /// `bench campaign`: variants a round, run both ways.
+    #[arg(long, default_value_t = 4)]
+    pub variants: u64,
+    /// `bench campaign`: rounds (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    pub rounds: usize,
+    /// `bench campaign`: runs at a time, both ways (default: the cores).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+}
+
+/// What `taxi-sim bench` measures.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum BenchTarget {
+    /// Scan insertion, exact EDT vs chamfer, pose checks.
+    Mapper,
+    /// One HDL-32E revolution: the fast cast vs Rapier's generic per-ray query.
+    Lidar,
+    /// The closed loop on `--scenario`: real-time factor and wall time per stage.
+    Loop,
+    /// A campaign's runs per hour against the same variants as separate `taxi-sim run`
+    /// processes.
+    Campaign,
+    /// The offline map of `--scenario` (built if missing): its blocks written and read in the
+    /// compressed format against the uncompressed one, and bytes per block.
+    Blocks,
+    /// The particle filter on `--scenario`'s offline map (built if missing): one revolution's
+    /// update, the weighing's tables against the straightforward way (one thread each).
+    Localization,
+}
+
+/// Runs `taxi-sim bench`.
+pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    let campaign = sim::bench::campaign::CampaignBench {
+        campaign: &args.campaign,
+        variants: args.variants,
+        rounds: args.rounds,
+        jobs: args
+            .jobs
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
+        exe: std::env::current_exe()?,
+    };
+    bench(
+        args.what,
+        args.json,
+        args.samples,
+        (&args.scenario, args.laps),
+        &campaign,
+    )
+}
+
+fn bench(
+    what: BenchTarget,
+    json: bool,
+    samples: Option<usize>,
+    (scenario, laps): (&std::path::Path, u32),
+    campaign: &sim::bench::campaign::CampaignBench<'_>,
+) -> anyhow::Result<()> {
+    let progress = ProgressBar::new_spinner();
+    let mut report = |what: &str| progress.set_message(format!("measuring {what}"));
+    let figures = match what {
+        BenchTarget::Mapper => sim::bench::mapper_figures(samples.unwrap_or(15), &mut report),
+        BenchTarget::Lidar => sim::bench::lidar_figures(samples.unwrap_or(15), &mut report)?,
+        BenchTarget::Loop => {
+            sim::bench::loop_figures(scenario, laps, samples.unwrap_or(1), &mut report)?
+        }
+        BenchTarget::Campaign => sim::bench::campaign::campaign_figures(campaign, &mut report)?,
+        BenchTarget::Blocks => sim::bench::blocks::figures_for(scenario, &mut report)?,
+        BenchTarget::Localization => {
+            sim::bench::localization::figures_for(scenario, samples.unwrap_or(15), &mut report)?
+        }
+    };
+    progress.finish_and_clear();
+    let mut t = String::new();
+    if json {
+        for f in &figures {
+            writeln!(t, "{}", serde_json::to_string(f)?)?;
+        }
+        return emit(&t);
+    }
+    writeln!(
+        t,
+        "{:<45} {:>12}  {:<14} vs baseline",
+        "figure", "median", "target"
+    )?;
+    for f in &figures {
+        let vs = match (&f.baseline, f.ratio) {
+            (Some(b), Some(r)) => format!("{r:.2}x ({b})"),
+            _ => String::new(),
+        };
+        writeln!(
+            t,
+            "{:<45} {:>9.3} {:<2}  {:<14} {}",
+            f.name,
+            f.median,
+            f.unit,
+            f.target.unwrap_or(""),
+            vs
+        )?;
+    }
+    emit(&t)
+}

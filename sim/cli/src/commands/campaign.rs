@@ -1,0 +1,217 @@
+//! `taxi-sim campaign run | show`: runs a campaign's variants in parallel with a progress bar
+//! (runs done, failures so far, ETA), Ctrl-C stopping cleanly, and prints its summary.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use sim::campaign::Campaign;
+use sim::campaign::{RunOptions, Shard, read_results, run_campaign, total_runs};
+
+/// `taxi-sim campaign ...`.
+#[derive(Debug, clap::Subcommand)]
+pub enum CampaignCommand {
+    /// Run a campaign's variants not yet in DIR (resumable; Ctrl-C keeps every finished run).
+    /// Exit code 0 when no run failed, 1 when some did, 2 on bad input.
+    Run(CampaignRunArgs),
+    /// Print the summary of a campaign directory (rewritten from its results).
+    Show {
+        /// The campaign's output directory.
+        dir: PathBuf,
+    },
+    /// Merge the output directories of a campaign's shards into one (as if run on one
+    /// machine). Exit code 0 when every variant is in, 1 when some are missing (it says which,
+    /// and how to run them).
+    Merge {
+        /// The merged directory: results.jsonl, summary.md, failures/.
+        #[arg(long)]
+        out: PathBuf,
+        /// The shards' output directories.
+        #[arg(required = true)]
+        shards: Vec<PathBuf>,
+    },
+}
+
+/// Arguments of `taxi-sim campaign run`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct CampaignRunArgs {
+    /// The campaign file (`scenarios/campaigns/*.toml`).
+    pub campaign: PathBuf,
+    /// Output directory: results.jsonl, summary.md, failures/, maps/.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Runs at a time (default: the cores).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Variants 0..N (default: the campaign's `runs`).
+    #[arg(long)]
+    pub runs: Option<u64>,
+    /// Sampler instead of the file's (`grid`, `random`, `halton`, `falsify`): the same family
+    /// searched another way (its results go to another directory).
+    #[arg(long)]
+    pub sampler: Option<String>,
+    /// Run one shard of the campaign: `I/N` runs the variants `i` with `i % N == I`; `auto/N`
+    /// takes `I` from SLURM_ARRAY_TASK_ID or JOB_COMPLETION_INDEX. Merge the shards' `--out`
+    /// directories with `campaign merge`.
+    #[arg(long)]
+    pub shard: Option<String>,
+    /// Where the offline maps are cached (default: OUT/maps). Shards on a shared filesystem can
+    /// share one: maps are built in a scratch directory and renamed into place under a name
+    /// that is a digest of what they depend on.
+    #[arg(long)]
+    pub maps_dir: Option<PathBuf>,
+    /// Complete a merged directory: run only the variants missing from it (refuses a directory
+    /// with no results).
+    #[arg(long)]
+    pub only_missing: bool,
+}
+
+/// Runs `taxi-sim campaign ...`; returns whether no run failed.
+pub fn run(cmd: &CampaignCommand) -> anyhow::Result<bool> {
+    match cmd {
+        CampaignCommand::Show { dir } => {
+            let records = read_results(dir)?;
+            anyhow::ensure!(
+                dir.join("campaign.json").exists(),
+                "{}: not a campaign directory (no campaign.json)",
+                dir.display()
+            );
+            sim::campaign::summary::write(dir, &records)?;
+            let text = std::fs::read_to_string(dir.join("summary.md"))?;
+            crate::emit(&text)?;
+            Ok(records.iter().all(|r| !r.failed))
+        }
+        CampaignCommand::Merge { out, shards } => merge(out, shards),
+        CampaignCommand::Run(args) => {
+            let (failed, interrupted) = run_args(args)?;
+            Ok(failed == 0 && !interrupted)
+        }
+    }
+}
+
+/// Runs (or resumes) the campaign of `args`; returns the failed runs and whether Ctrl-C cut it.
+pub(crate) fn run_args(args: &CampaignRunArgs) -> anyhow::Result<(usize, bool)> {
+    anyhow::ensure!(args.jobs != Some(0), "--jobs 0: at least one");
+    anyhow::ensure!(args.runs != Some(0), "--runs 0: at least one");
+    let mut campaign = Campaign::from_file(&args.campaign)?;
+    if let Some(name) = &args.sampler {
+        let kind: sim::campaign::SamplerKind =
+            serde_json::from_value(serde_json::Value::String(name.clone())).map_err(|_| {
+                anyhow::anyhow!("--sampler {name}: expected grid, random, halton or falsify")
+            })?;
+        campaign.set_sampler(kind);
+    }
+    let jobs = args
+        .jobs
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let shard = match &args.shard {
+        Some(text) => {
+            Some(Shard::parse(text, &|k| std::env::var(k).ok()).map_err(anyhow::Error::msg)?)
+        }
+        None => None,
+    };
+    let existing = read_results(&args.out)?;
+    let mut runs = args.runs;
+    if args.only_missing {
+        anyhow::ensure!(
+            !existing.is_empty(),
+            "--only-missing: {} holds no results to complete (merge the shards into it first, or run without --only-missing)",
+            args.out.display()
+        );
+        // The merged directory says how many variants the shards were asked for.
+        if runs.is_none() {
+            runs = std::fs::read_to_string(args.out.join("campaign.json"))
+                .ok()
+                .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+                .and_then(|m| m.get("total").and_then(|t| t.as_u64()));
+        }
+    }
+    let total = total_runs(&campaign, runs);
+    let mine = |i: u64| i < total && shard.is_none_or(|s| s.holds(i));
+    let before = existing.iter().filter(|r| mine(r.index)).count();
+    let bar = ProgressBar::new((0..total).filter(|i| mine(*i)).count() as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {msg} [{elapsed} < {eta}]")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_position(before as u64);
+    eprintln!(
+        "campaign {}{}: {} runs ({} already in {}), {} random dimensions, {} parameter settings, {} at a time",
+        campaign.name,
+        shard.map_or(String::new(), |s| format!(", shard {s}")),
+        bar.length().unwrap_or(0),
+        before,
+        args.out.display(),
+        campaign.layout.dims.len(),
+        campaign.settings.len(),
+        jobs
+    );
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
+    let failures = AtomicUsize::new(0);
+    let outcome = run_campaign(
+        &campaign,
+        &RunOptions {
+            out: args.out.clone(),
+            shard,
+            maps_dir: args.maps_dir.clone(),
+            jobs,
+            runs,
+            stop: &stop,
+            progress: &|r| {
+                let f = failures.fetch_add(usize::from(r.failed), Ordering::Relaxed)
+                    + usize::from(r.failed);
+                bar.set_message(format!("{f} failed"));
+                bar.inc(1);
+            },
+        },
+    )?;
+    bar.finish_and_clear();
+    let failed = outcome.records.iter().filter(|r| r.failed).count();
+    crate::emit(&format!(
+        "{}: {} runs recorded ({} now), {} failed; {}\nwrote {}\n",
+        campaign.name,
+        outcome.records.len(),
+        outcome.ran,
+        failed,
+        if outcome.interrupted {
+            "interrupted: run the same command again to resume"
+        } else {
+            "done"
+        },
+        args.out.join("summary.md").display()
+    ))?;
+    Ok((failed, outcome.interrupted))
+}
+
+/// `taxi-sim campaign merge`: returns whether every variant is in.
+fn merge(out: &std::path::Path, shards: &[PathBuf]) -> anyhow::Result<bool> {
+    let m = sim::campaign::merge::merge(shards, out)?;
+    let failed = m.records.iter().filter(|r| r.failed).count();
+    let mut text = format!(
+        "merged {} shard directories into {}: {} of {} runs, {} failed\nwrote {}\n",
+        shards.len(),
+        out.display(),
+        m.records.len(),
+        m.total,
+        failed,
+        out.join("summary.md").display()
+    );
+    if !m.missing.is_empty() {
+        let campaign = std::fs::read_to_string(out.join("campaign.json"))
+            .ok()
+            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+            .and_then(|v| v.get("campaign").and_then(|c| c.as_str()).map(String::from))
+            .unwrap_or_else(|| "<campaign.toml>".into());
+        text += &format!(
+            "missing {} variants: {}\nrun them with: taxi-sim campaign run {campaign} --out {} --only-missing\n",
+            m.missing.len(),
+            sim::campaign::merge::ranges(&m.missing),
+            out.display()
+        );
+    }
+    crate::emit(&text)?;
+    Ok(m.missing.is_empty())
+}

@@ -1,0 +1,13 @@
+//! The `taxi-sim` commands, one module each: its arguments (clap) and its `run`, which parses
+//! them into the library's types and prints what the command shows.
+
+pub mod bench;
+pub mod campaign;
+pub mod check;
+pub mod demo;
+pub mod map;
+pub mod model;
+pub mod run;
+pub mod scan;
+pub mod small;
+pub mod tune;

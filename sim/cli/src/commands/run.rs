@@ -1,0 +1,367 @@
+//! `taxi-sim run`: the closed loop (its offline map built first when missing or stale), with
+//! progress bars, the report table and the JSON report.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use anyhow::Context as _;
+use sim::engine::EndReason;
+use sim::engine::RunReport;
+use sim::engine::{NoObserver, Observer};
+use sim::engine::{RunHandles, RunSetup, run_with};
+use sim::offline_map::{default_map_dir, fresh_manifest};
+use sim::replay::{Replay, ReplayOptions};
+use sim::scenario::Scenario;
+use sim::scenario::{NoisyTruthConfig, PoseSourceConfig, RunConfig, Schedule};
+
+/// The pose sources `--pose-source` can pick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PoseSourceKind {
+    /// The true pose.
+    Truth,
+    /// The particle filter over the offline map.
+    ParticleFilter,
+}
+
+/// Arguments of `taxi-sim run`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// The scenario file.
+    pub scenario: PathBuf,
+    /// Laps (default: the scenario's; at least 1).
+    #[arg(long)]
+    pub laps: Option<u32>,
+    /// Run configuration (TOML; `taxi-sim config` prints the defaults). Flags below override it.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Seed (default: the scenario's).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// The offline map (default: out/maps/<scenario file name>; built there when missing or stale).
+    #[arg(long)]
+    pub map_dir: Option<PathBuf>,
+    /// Where the stack's pose comes from: `truth`, or `particle-filter` (the configuration's
+    /// settings, or the defaults). Default: the configuration's.
+    #[arg(long, value_enum)]
+    pub pose_source: Option<PoseSourceKind>,
+    /// Pose source `noisy_truth` with this white noise in position, metres (standard deviation,
+    /// each axis, at the source's rate); the configuration's other noisy-truth settings are kept.
+    #[arg(long)]
+    pub pose_noise_m: Option<f64>,
+    /// Pose source `noisy_truth` with this white noise in heading, radians (standard deviation).
+    #[arg(long)]
+    pub pose_noise_rad: Option<f64>,
+    /// Map and plan each revolution the instant it is taken (no latency; slower), instead of
+    /// while the LiDAR takes the next one.
+    #[arg(long)]
+    pub sequential_sensing: bool,
+    /// Write a Rerun recording of the run here (.rrd; open it with `rerun FILE`, viewer 0.36).
+    #[arg(long, value_name = "FILE")]
+    pub record: Option<PathBuf>,
+    /// Start a Rerun viewer (`rerun` on the PATH) and stream the run to it.
+    #[arg(long)]
+    pub spawn: bool,
+    /// Stream the run to a running Rerun viewer (default 127.0.0.1:9876).
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:9876")]
+    pub connect: Option<String>,
+    /// Replay: LiDAR points and planner candidates every N revolutions (10 per second).
+    #[arg(long, value_name = "N", default_value_t = ReplayOptions::default().scan_every)]
+    pub replay_scan_every: u32,
+    /// Replay: keep every K-th column of a logged revolution (all 32 beams).
+    #[arg(long, value_name = "K", default_value_t = ReplayOptions::default().point_stride)]
+    pub replay_point_stride: usize,
+    /// Replay: occupancy and distance maps per second of simulated time (0: none).
+    #[arg(long, value_name = "HZ", default_value_t = ReplayOptions::default().maps_hz)]
+    pub replay_maps_hz: f64,
+    /// Replay: half side of the square of map logged around the vehicle, metres.
+    #[arg(long, value_name = "M", default_value_t = ReplayOptions::default().map_half_m)]
+    pub replay_map_half_m: f64,
+    /// Replay: vehicle pose and time series per second of simulated time.
+    #[arg(long, value_name = "HZ", default_value_t = ReplayOptions::default().steps_hz)]
+    pub replay_steps_hz: f64,
+}
+
+impl RunArgs {
+    fn replay_options(&self) -> ReplayOptions {
+        ReplayOptions {
+            record: self.record.clone(),
+            spawn: self.spawn,
+            connect: self.connect.clone(),
+            scan_every: self.replay_scan_every,
+            point_stride: self.replay_point_stride,
+            maps_hz: self.replay_maps_hz,
+            map_half_m: self.replay_map_half_m,
+            steps_hz: self.replay_steps_hz,
+        }
+    }
+}
+
+/// Runs `taxi-sim run`; returns whether every expectation held.
+pub fn run(args: &RunArgs) -> anyhow::Result<bool> {
+    anyhow::ensure!(
+        args.laps != Some(0),
+        "--laps 0: a run drives at least one lap"
+    );
+    let scenario = Scenario::from_file(&args.scenario)?;
+    let config = run_config(args, &scenario)?;
+    let replay_options = args.replay_options();
+    replay_options.validate()?;
+    let dir = args
+        .map_dir
+        .clone()
+        .unwrap_or_else(|| default_map_dir(&scenario, &config));
+    if fresh_manifest(&scenario, &config, &dir)?.is_none() {
+        eprintln!(
+            "offline map {} is missing or stale: building it (mapping drive)",
+            dir.display()
+        );
+        super::map::build_map(&scenario, &config, &dir)?;
+    }
+    let setup = RunSetup {
+        laps: args.laps,
+        seed: args.seed,
+        config,
+        ..RunSetup::new(dir)
+    };
+    let stop = Arc::new(AtomicBool::new(false));
+    let stop_flag = stop.clone();
+    // A second Ctrl-C falls through to the default handler only if this one could not be set.
+    let _ = ctrlc::set_handler(move || stop_flag.store(true, Ordering::Relaxed));
+    let mut replay = if replay_options.enabled() {
+        Some(Replay::new(&replay_options, &scenario.name)?)
+    } else {
+        None
+    };
+    let mut no_observer = NoObserver;
+    let observer: &mut (dyn Observer + Send) = match replay.as_mut() {
+        Some(r) => r,
+        None => &mut no_observer,
+    };
+    let progress = crate::bar(1000, "running");
+    let report = run_with(
+        &scenario,
+        &setup,
+        RunHandles {
+            stop: Some(&stop),
+            progress: &mut |p| {
+                progress.set_position((p.fraction * 1000.0) as u64);
+                progress.set_message(format!(
+                    "lap {} t={:.0}s",
+                    p.laps_completed + 1,
+                    p.sim_time_s
+                ));
+            },
+            observer,
+        },
+    )?;
+    progress.finish_and_clear();
+    if let Some(replay) = &replay {
+        let summary = replay.summary();
+        for w in &summary.warnings {
+            eprintln!("replay: {w}");
+        }
+        if let Some((path, bytes)) = &summary.recorded {
+            eprintln!(
+                "replay: wrote {} ({:.1} MB, {:.0} kB per simulated second)",
+                path.display(),
+                *bytes as f64 / 1e6,
+                *bytes as f64 / 1e3 / report.sim_time_s.max(1e-9)
+            );
+        }
+        if let Some(url) = &summary.streamed_to {
+            eprintln!("replay: streamed to {url}");
+        }
+    }
+    if let Some(path) = &args.report {
+        mapper::write_atomically(path, serde_json::to_string_pretty(&report)?.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    crate::emit(&table(&report))?;
+    Ok(report.expectations_met)
+}
+
+/// The run's configuration: the file's (or the defaults), with the flags' overrides.
+fn run_config(args: &RunArgs, scenario: &Scenario) -> anyhow::Result<RunConfig> {
+    let mut config = RunConfig::for_scenario(scenario, args.config.as_deref())?;
+    if args.sequential_sensing {
+        config.schedule = Schedule::Sequential;
+    }
+    match args.pose_source {
+        Some(PoseSourceKind::Truth) => config.pose_source = PoseSourceConfig::Truth,
+        Some(PoseSourceKind::ParticleFilter)
+            if !matches!(config.pose_source, PoseSourceConfig::ParticleFilter(_)) =>
+        {
+            config.pose_source = PoseSourceConfig::ParticleFilter(Default::default());
+        }
+        _ => {}
+    }
+    if args.pose_noise_m.is_some() || args.pose_noise_rad.is_some() {
+        let mut noisy = match &config.pose_source {
+            PoseSourceConfig::NoisyTruth(n) => n.clone(),
+            PoseSourceConfig::Truth | PoseSourceConfig::ParticleFilter(_) => {
+                NoisyTruthConfig::default()
+            }
+        };
+        if let Some(m) = args.pose_noise_m {
+            noisy.white_sigma_m = m;
+        }
+        if let Some(rad) = args.pose_noise_rad {
+            noisy.white_sigma_rad = rad;
+        }
+        config.pose_source = PoseSourceConfig::NoisyTruth(noisy);
+    }
+    config
+        .validate()
+        .map_err(|m| anyhow::anyhow!("run configuration (with the flags): {m}"))?;
+    Ok(config)
+}
+
+/// The human summary of a run.
+pub fn table(r: &RunReport) -> String {
+    use std::fmt::Write as _;
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "{} (seed {}): {}",
+        r.scenario,
+        r.seed,
+        if r.expectations_met {
+            "every expectation held"
+        } else {
+            "EXPECTATIONS NOT MET"
+        }
+    );
+    let _ = writeln!(
+        t,
+        "laps {}/{}  lap times {:?} s  stops {}  contacts {}{}",
+        r.laps_completed,
+        r.laps,
+        r.lap_times_s
+            .iter()
+            .map(|x| (x * 10.0).round() / 10.0)
+            .collect::<Vec<_>>(),
+        r.stops.len(),
+        r.contacts.len(),
+        match r.end {
+            EndReason::Completed => "",
+            EndReason::TimedOut => "  (timed out)",
+            EndReason::Interrupted => "  (interrupted)",
+            EndReason::WaitingForHiddenObstacle =>
+                "  (waiting for a hidden obstacle: pilot called)",
+        }
+    );
+    let f = &r.faults;
+    if *f != sim::world::FaultCounts::default() {
+        let _ = writeln!(
+            t,
+            "faults: {} revolutions lost, {} delivered late, {} returns dropped, {} spurious returns; the watchdog held the vehicle {} times",
+            f.lost_revolutions,
+            f.delayed_revolutions,
+            f.dropped_returns,
+            f.spurious_returns,
+            f.watchdog_stops
+        );
+    }
+    if let Some(l) = &r.localization {
+        // The laps one by one when there is more than one.
+        let laps = if l.laps.len() > 1 { &l.laps[..] } else { &[] };
+        for e in std::iter::once(&l.run).chain(laps) {
+            let _ = writeln!(
+                t,
+                "localization {}: cross-track RMSE {:.3} m (p95 {:.3}, max {:.3}), along {:.3} m, heading {:.4} rad; its sigma {:.3} m mean, {:.3} max",
+                e.lap.map_or("(run)".to_string(), |k| format!("lap {k}")),
+                e.cross_m.rmse,
+                e.cross_m.p95,
+                e.cross_m.max,
+                e.along_m.rmse,
+                e.heading_rad.rmse,
+                e.mean_sigma_cross_m,
+                e.max_sigma_cross_m
+            );
+        }
+    }
+    if let Some(w) = &r.waiting_for {
+        let _ = writeln!(
+            t,
+            "waiting since {:.1} s for an obstacle at ({:.1}, {:.1}) m the sensor last hit {}",
+            w.since_s,
+            w.x_m,
+            w.y_m,
+            w.last_seen_s
+                .map_or("never (offline map)".to_string(), |s| format!(
+                    "at {s:.1} s"
+                ))
+        );
+    }
+    obstacle_rows(&mut t, r);
+    for c in &r.contacts {
+        let _ = writeln!(
+            t,
+            "contact at {:.2} s: {} ({:?}) touched by {}",
+            c.time_s, c.object, c.kind, c.part
+        );
+    }
+    let s = &r.time_split_s;
+    let _ = writeln!(
+        t,
+        "sim {:.1} s in {:.1} s wall: {:.1}x real time (lidar {:.1} s, mapping {:.1} s, distance maps {:.1} s, planning {:.1} s, physics {:.1} s, localization {:.1} s)",
+        r.sim_time_s,
+        r.wall_time_s,
+        r.real_time_factor,
+        s.lidar,
+        s.mapping,
+        s.distance_maps,
+        s.planning,
+        s.physics,
+        s.localization
+    );
+    t
+}
+
+/// The obstacle table of a run's summary: one row per pass (or `not passed`).
+fn obstacle_rows(t: &mut String, r: &RunReport) {
+    use std::fmt::Write as _;
+    let _ = writeln!(
+        t,
+        "{:<22} {:<10} {:<11} {:>4} {:<9} {:>10} {:>22}",
+        "obstacle", "kind", "expected", "lap", "outcome", "offset_m", "min clearance per level"
+    );
+    for o in &r.obstacles {
+        if o.passes.is_empty() {
+            let _ = writeln!(
+                t,
+                "{:<22} {:<10} {:<11} {:>4} {:<9}",
+                o.id, o.kind, o.expected, "-", "not passed"
+            );
+        }
+        for p in &o.passes {
+            let clear: Vec<String> = p
+                .min_clearance_m
+                .iter()
+                .map(|c| {
+                    if c.is_finite() {
+                        format!("{c:.2}")
+                    } else {
+                        "-".into()
+                    }
+                })
+                .collect();
+            let _ = writeln!(
+                t,
+                "{:<22} {:<10} {:<11} {:>4} {:<9} {:>10.2} {:>22}{}",
+                o.id,
+                o.kind,
+                o.expected,
+                p.lap,
+                p.outcome,
+                p.max_offset_m,
+                clear.join(" / "),
+                if p.met { "" } else { "  <- not as expected" }
+            );
+        }
+    }
+}

@@ -1,0 +1,112 @@
+//! `taxi-sim scan`: one LiDAR revolution of a scenario's world from a point of its route, as PLY.
+
+use std::path::PathBuf;
+
+use anyhow::Context as _;
+use nalgebra::{Isometry2, Vector2};
+use sim::scenario::RunConfig;
+use sim::scenario::Scenario;
+use sim::world::World;
+use sim::world::{Lidar, SweepPoses};
+
+/// Arguments of `taxi-sim scan`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ScanArgs {
+    /// The scenario file.
+    pub scenario: PathBuf,
+    /// Where on the route, metres along it from its first point (0 = the start pose).
+    #[arg(long, default_value_t = 0.0)]
+    pub at: f64,
+    /// Output PLY file.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Frame of the points.
+    #[arg(long, value_enum, default_value_t = Frame::World)]
+    pub frame: Frame,
+    /// Leave out the run-time obstacles (the world of the mapping drive).
+    #[arg(long)]
+    pub static_only: bool,
+    /// Run configuration (TOML) whose `[lidar]` settings to use (default: the defaults).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+}
+
+/// Which frame the points are written in (`sim::world::ply::Frame` on the command line).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Frame {
+    /// The world frame (x east, y north, z up).
+    World,
+    /// The sensor frame (x forward, z up), as the sensor reports it.
+    Sensor,
+}
+
+impl From<Frame> for sim::world::ply::Frame {
+    fn from(frame: Frame) -> Self {
+        match frame {
+            Frame::World => Self::World,
+            Frame::Sensor => Self::Sensor,
+        }
+    }
+}
+
+/// Runs `taxi-sim scan`.
+pub fn run(args: &ScanArgs) -> anyhow::Result<()> {
+    let scenario = Scenario::from_file(&args.scenario)?;
+    anyhow::ensure!(
+        args.at.is_finite() && args.at >= 0.0,
+        "--at {}: must be a distance >= 0 along the route",
+        args.at
+    );
+    let pose = if args.at == 0.0 {
+        scenario.vehicle.world_from_start
+    } else {
+        pose_along(&scenario, args.at)?
+    };
+    let vehicle = &scenario.vehicle.vehicle;
+    let world = if args.static_only {
+        World::static_only(&scenario.static_scene(), vehicle, &pose)
+    } else {
+        World::with_obstacles(&scenario.full_scene(), vehicle, &pose)
+    };
+    let config = match &args.config {
+        Some(path) => RunConfig::from_file(path)?,
+        None => RunConfig::default(),
+    };
+    let lidar =
+        Lidar::new(config.lidar, vehicle.vehicle_from_lidar()).map_err(anyhow::Error::msg)?;
+    let scan = lidar.scan(&world, &SweepPoses::still(pose), 0, scenario.seed);
+    sim::world::ply::write(&scan, args.frame.into(), &args.out)
+        .with_context(|| format!("writing {}", args.out.display()))?;
+    let n = scan.scan.returns().iter().flatten().count();
+    crate::emit(&format!(
+        "{}: {n} of {} rays returned, vehicle at ({:.2}, {:.2}) heading {:.1} deg; wrote {}\n",
+        scenario.name,
+        lidar.rays(),
+        pose.translation.x,
+        pose.translation.y,
+        pose.rotation.angle().to_degrees(),
+        args.out.display()
+    ))
+}
+
+/// The pose `s` metres along the route's polyline, heading along its segment.
+fn pose_along(scenario: &Scenario, s: f64) -> anyhow::Result<Isometry2<f64>> {
+    let route = &scenario.route;
+    let mut points = route.waypoints_m.clone();
+    if route.closed
+        && let Some(first) = points.first().copied()
+    {
+        points.push(first);
+    }
+    let mut left = s;
+    for w in points.windows(2) {
+        let d = w[1] - w[0];
+        let len = d.norm();
+        if left <= len && len > 0.0 {
+            let p = w[0] + d * (left / len);
+            return Ok(Isometry2::new(Vector2::new(p.x, p.y), d.y.atan2(d.x)));
+        }
+        left -= len;
+    }
+    anyhow::bail!("--at {s}: the route is only {:.1} m long", route.length_m())
+}

@@ -1,0 +1,195 @@
+//! The `taxi-sim` binary end to end: exit codes, messages on bad input, files written.
+
+use std::process::Command;
+
+fn taxi_sim(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_taxi-sim"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+#[test]
+fn check_accepts_every_shipped_scenario() {
+    for entry in std::fs::read_dir("../../scenarios").unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let (code, stdout, stderr) = taxi_sim(&["check", path.to_str().unwrap()]);
+            assert_eq!(code, 0, "{}: {stderr}", path.display());
+            assert!(
+                stdout.contains("valid") && stdout.contains("route"),
+                "{stdout}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_bad_scenario_exits_2_naming_file_line_and_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    let text = std::fs::read_to_string("../../scenarios/straight_cone_under_wing.toml")
+        .unwrap()
+        .replacen("speed_m_s = ", "speed_m_s = -", 1);
+    std::fs::write(&bad, text).unwrap();
+    let (code, _, stderr) = taxi_sim(&["check", bad.to_str().unwrap()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("bad.toml:") && stderr.contains("speed_m_s"),
+        "{stderr}"
+    );
+    let (code, _, stderr) = taxi_sim(&["check", "no/such/file.toml"]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("no/such/file.toml"), "{stderr}");
+    let (code, _, stderr) = taxi_sim(&["model", "fit", "cessna"]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("praetor600"), "{stderr}");
+}
+
+#[test]
+fn scan_writes_a_ply_from_a_point_of_the_route() {
+    let dir = tempfile::tempdir().unwrap();
+    let ply = dir.path().join("scan.ply");
+    let (code, stdout, stderr) = taxi_sim(&[
+        "scan",
+        "../../scenarios/cone_in_path_car.toml",
+        "--at",
+        "20",
+        "--out",
+        ply.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("rays returned"), "{stdout}");
+    let points = sim::world::ply::decode(&std::fs::read(&ply).unwrap()).unwrap();
+    assert!(points.len() > 30_000, "{} points", points.len());
+    let (code, _, stderr) = taxi_sim(&[
+        "scan",
+        "../../scenarios/cone_in_path_car.toml",
+        "--at",
+        "100000",
+        "--out",
+        ply.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("route is only"), "{stderr}");
+}
+
+/// `--laps 0` used to run one lap and exit 0 (`laps = 0` in a file exits 2): it is refused.
+#[test]
+fn run_with_laps_0_exits_2() {
+    let (code, _, stderr) = taxi_sim(&[
+        "run",
+        "../../scenarios/straight_cone_under_wing.toml",
+        "--laps",
+        "0",
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("--laps 0"), "{stderr}");
+}
+
+/// `taxi-sim config` prints the defaults as TOML, which `--config` reads back; a mistake in a
+/// configuration file names the file, the line and the field, or the field and what is wrong.
+#[test]
+fn the_printed_default_configuration_reads_back_and_mistakes_are_located() {
+    let (code, stdout, stderr) = taxi_sim(&["config"]);
+    assert_eq!(code, 0, "{stderr}");
+    let parsed = sim::scenario::RunConfig::from_toml(&stdout, "printed").unwrap();
+    assert_eq!(parsed, sim::scenario::RunConfig::default());
+    assert!(stdout.contains("[pose_source]") && stdout.contains("schedule = \"overlapped\""));
+
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("run.toml");
+    let run_with = |text: &str| {
+        std::fs::write(&file, text).unwrap();
+        taxi_sim(&[
+            "run",
+            "../../scenarios/straight_cone_under_wing.toml",
+            "--config",
+            file.to_str().unwrap(),
+        ])
+    };
+    let (code, _, stderr) =
+        run_with("scan_hz = 10.0\n\n[autonomy]\nhorizon_m = 30.0\nhorizn = 3\n");
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("run.toml:5:") && stderr.contains("horizn"),
+        "{stderr}"
+    );
+    let (code, _, stderr) = run_with("[pose_source]\nkind = \"noisy_truth\"\nrate_hz = -5.0\n");
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("run.toml") && stderr.contains("pose_source.rate_hz = -5"),
+        "{stderr}"
+    );
+}
+
+/// `taxi-sim campaign run`, interrupted by Ctrl-C (SIGINT) once a run is recorded: it exits
+/// with whole runs only in `results.jsonl`, says how to resume, and `campaign show` prints the
+/// summary of what is there.
+#[test]
+fn a_campaign_stopped_by_ctrl_c_keeps_whole_runs_and_shows_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("smoke");
+    let child = Command::new(env!("CARGO_BIN_EXE_taxi-sim"))
+        .args([
+            "campaign",
+            "run",
+            "../../scenarios/campaigns/smoke.toml",
+            "--jobs",
+            "1",
+            "--out",
+        ])
+        .arg(&out)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let results = out.join("results.jsonl");
+    let t = std::time::Instant::now();
+    while std::fs::read_to_string(&results).map_or(true, |s| s.is_empty()) {
+        assert!(t.elapsed().as_secs() < 300, "no run recorded in 300 s");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let done = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&done.stdout);
+    assert_eq!(done.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("interrupted: run the same command again to resume"),
+        "{stdout}"
+    );
+    let text = std::fs::read_to_string(&results).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(
+        !lines.is_empty() && lines.len() < 20 && text.ends_with('\n'),
+        "{text}"
+    );
+    for line in &lines {
+        let v: serde_json::Value = serde_json::from_str(line).unwrap();
+        assert!(
+            v["end"].as_str().is_some_and(|e| e != "interrupted"),
+            "{line}"
+        );
+    }
+    let (code, shown, stderr) = taxi_sim(&["campaign", "show", out.to_str().unwrap()]);
+    assert!(matches!(code, 0 | 1), "{stderr}");
+    assert!(
+        shown.contains(&format!("{} runs recorded", lines.len()))
+            && shown.contains("## Per parameter setting"),
+        "{shown}"
+    );
+    let (code, _, stderr) = taxi_sim(&["campaign", "show", dir.path().to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("not a campaign directory"), "{stderr}");
+}

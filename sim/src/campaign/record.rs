@@ -1,0 +1,309 @@
+//! A run's record in a campaign's `results.jsonl` ([`RunRecord`], one JSON line per run: the
+//! sampled values, the setting, contacts, clearances, passes, the end, the wall time), made from
+//! a run's report ([`record`]) or for a variant that is not a valid scenario ([`INVALID`]), and
+//! read back ([`read_results`], which drops a last line cut short).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::{Campaign, Variant};
+use crate::engine::{EndReason, PassOutcome, RunReport};
+use crate::error::{Error, Result};
+use crate::scenario::{Expectation, ExpectedEnd, Scenario};
+
+/// One pass-level outcome of an obstacle in a run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ObstacleOutcome {
+    /// Its id.
+    pub id: String,
+    /// Its kind.
+    pub kind: String,
+    /// What the scenario expects.
+    pub expect: String,
+    /// Outcome of its worst pass (`collided` over `stopped` over `deviated` over `passed`;
+    /// `not_passed` when the vehicle never came by it).
+    pub outcome: String,
+    /// Whether every pass met the expectation.
+    pub met: bool,
+    /// Smallest ground-truth clearance per level over its passes, metres.
+    pub min_clearance_m: Vec<Option<f64>>,
+}
+
+/// One line of `results.jsonl`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord {
+    /// Variant index.
+    pub index: u64,
+    /// Sample (`index / settings`).
+    pub sample: u64,
+    /// Parameter setting (`index % settings`).
+    pub setting: usize,
+    /// The scenario seed the run had.
+    pub seed: u64,
+    /// Each draw by label.
+    pub sampled: BTreeMap<String, serde_json::Value>,
+    /// The setting's parameters by dotted path.
+    pub parameters: BTreeMap<String, serde_json::Value>,
+    /// The point of the unit cube (the falsifier refits on these).
+    pub u: Vec<f64>,
+    /// Why the run ended.
+    pub end: String,
+    /// Whether every expectation held.
+    pub expectations_met: bool,
+    /// A contact, or an unmet expectation.
+    pub failed: bool,
+    /// What failed, one line each.
+    pub failures: Vec<String>,
+    /// Ground-truth contacts.
+    pub contacts: usize,
+    /// The objects touched.
+    pub contacts_with: Vec<String>,
+    /// Contacts that began while the vehicle stood still (something ran into it).
+    #[serde(default)]
+    pub contacts_while_stopped: usize,
+    /// Per run-time obstacle.
+    pub obstacles: Vec<ObstacleOutcome>,
+    /// Smallest ground-truth clearance per level to any object, metres.
+    pub min_clearance_m: Vec<Option<f64>>,
+    /// Smallest clearance to any run-time obstacle at any level over the passes, metres.
+    pub obstacle_clearance_m: Option<f64>,
+    /// Stops of the vehicle.
+    pub stops: usize,
+    /// Passes that deviated.
+    pub deviations: usize,
+    /// Passes that stopped where the expectation was to drive on (pass under or deviate).
+    pub false_stops: usize,
+    /// Passes that deviated where the expectation was to pass under.
+    pub needless_deviations: usize,
+    /// Lap times, seconds.
+    pub lap_times_s: Vec<f64>,
+    /// Simulated time, seconds.
+    pub sim_time_s: f64,
+    /// Wall time of the run, seconds (the one field that differs between identical runs).
+    pub wall_time_s: f64,
+    /// What the falsifier minimises: the obstacle clearance, minus 1 on failure, minus the
+    /// contacts.
+    pub score: f64,
+    /// The failure file, relative to the campaign directory.
+    pub failure_file: Option<String>,
+    /// What injected faults did (`[faults]` of the run configuration).
+    #[serde(default)]
+    pub faults: crate::world::FaultCounts,
+}
+
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+fn worst(outcomes: impl Iterator<Item = PassOutcome>) -> Option<PassOutcome> {
+    let rank = |o: &PassOutcome| match o {
+        PassOutcome::Passed => 0,
+        PassOutcome::Deviated => 1,
+        PassOutcome::Stopped => 2,
+        PassOutcome::Collided => 3,
+    };
+    outcomes.max_by_key(rank)
+}
+
+/// Drawn or set values as JSON, by label.
+fn as_json<'a>(
+    pairs: impl Iterator<Item = (&'a String, &'a toml::Value)>,
+) -> BTreeMap<String, serde_json::Value> {
+    pairs
+        .map(|(k, x)| (k.clone(), serde_json::to_value(x).unwrap_or_default()))
+        .collect()
+}
+
+/// The record of a run of variant `v`.
+pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunReport) -> RunRecord {
+    let mut failures = Vec::new();
+    let mut contacts_with: Vec<String> = r.contacts.iter().map(|c| c.object.clone()).collect();
+    contacts_with.dedup();
+    let standing = |t: f64| {
+        r.stops
+            .iter()
+            .any(|s| s.start_s <= t && s.end_s.is_none_or(|e| t <= e))
+    };
+    let mut contacts_while_stopped = 0;
+    for c in &r.contacts {
+        let still = standing(c.time_s);
+        contacts_while_stopped += usize::from(still);
+        let how = if still { " (standing)" } else { "" };
+        failures.push(format!(
+            "contact{how}: {} with {} at {:.1} s",
+            c.part, c.object, c.time_s
+        ));
+    }
+    let (mut false_stops, mut needless, mut deviations) = (0, 0, 0);
+    let mut obstacles = Vec::new();
+    let mut obstacle_clearance = f64::INFINITY;
+    for o in &r.obstacles {
+        for p in &o.passes {
+            let expect_drive = matches!(o.expected, Expectation::PassUnder | Expectation::Deviate);
+            false_stops += usize::from(p.outcome == PassOutcome::Stopped && expect_drive);
+            needless += usize::from(
+                p.outcome == PassOutcome::Deviated && o.expected == Expectation::PassUnder,
+            );
+            deviations += usize::from(p.outcome == PassOutcome::Deviated);
+            if !p.met {
+                failures.push(format!(
+                    "{} lap {}: {}, expected {} (clearance {:.2} m)",
+                    o.id,
+                    p.lap,
+                    p.outcome,
+                    o.expected,
+                    p.min_clearance_m
+                        .iter()
+                        .copied()
+                        .fold(f64::INFINITY, f64::min)
+                ));
+            }
+        }
+        let levels = o.passes.first().map_or(0, |p| p.min_clearance_m.len());
+        let per_level: Vec<f64> = (0..levels)
+            .map(|k| {
+                o.passes
+                    .iter()
+                    .map(|p| p.min_clearance_m[k])
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect();
+        obstacle_clearance = per_level.iter().copied().fold(obstacle_clearance, f64::min);
+        obstacles.push(ObstacleOutcome {
+            id: o.id.clone(),
+            kind: o.kind.clone(),
+            expect: o.expected.as_str().into(),
+            outcome: worst(o.passes.iter().map(|p| p.outcome))
+                .map_or("not_passed".into(), |p| p.as_str().into()),
+            met: o.passes.iter().all(|p| p.met),
+            min_clearance_m: per_level.into_iter().map(finite).collect(),
+        });
+    }
+    let end = serde_json::to_value(r.end)
+        .ok()
+        .and_then(|v| v.as_str().map(String::from))
+        .unwrap_or_default();
+    let end_met = match scenario.expected_end {
+        ExpectedEnd::Completed => r.end == EndReason::Completed,
+        ExpectedEnd::WaitingForHiddenObstacle => r.end == EndReason::WaitingForHiddenObstacle,
+        ExpectedEnd::StoppedForGood => r.end != EndReason::Completed,
+        ExpectedEnd::Any => true,
+    };
+    if !end_met {
+        failures.push(format!("ended {end}, expected {:?}", scenario.expected_end).to_lowercase());
+    }
+    if !r.expectations_met && failures.is_empty() {
+        failures.push("an expectation was not met".into());
+    }
+    let failed = !r.contacts.is_empty() || !r.expectations_met;
+    let clearance = finite(obstacle_clearance);
+    let score = clearance.unwrap_or(10.0).min(10.0)
+        - if failed { 1.0 } else { 0.0 }
+        - r.contacts.len() as f64;
+    RunRecord {
+        index: v.index,
+        sample: v.sample,
+        setting: v.setting,
+        seed: scenario.seed,
+        sampled: as_json(v.drawn.iter()),
+        parameters: as_json(campaign.settings[v.setting].iter().map(|(k, x)| (k, x))),
+        u: v.u.clone(),
+        end,
+        expectations_met: r.expectations_met,
+        failed,
+        failures,
+        contacts: r.contacts.len(),
+        contacts_with,
+        contacts_while_stopped,
+        obstacles,
+        min_clearance_m: r.min_clearance_m.iter().copied().map(finite).collect(),
+        obstacle_clearance_m: clearance,
+        stops: r.stops.len(),
+        deviations,
+        false_stops,
+        needless_deviations: needless,
+        lap_times_s: r.lap_times_s.clone(),
+        sim_time_s: r.sim_time_s,
+        wall_time_s: r.wall_time_s,
+        score,
+        failure_file: failed.then(|| format!("failures/{}.toml", v.index)),
+        faults: r.faults,
+    }
+}
+
+/// The `end` of a variant that is not a valid scenario.
+pub const INVALID: &str = "invalid";
+
+/// The record of a variant that is not a valid scenario: `end` is `invalid`, the reason in
+/// `failures`; not a failure, and scored as a clear run so the falsifier does not chase it.
+pub(super) fn invalid(campaign: &Campaign, v: &Variant, why: &str) -> RunRecord {
+    RunRecord {
+        index: v.index,
+        sample: v.sample,
+        setting: v.setting,
+        seed: 0,
+        sampled: as_json(v.drawn.iter()),
+        parameters: as_json(campaign.settings[v.setting].iter().map(|(k, x)| (k, x))),
+        u: v.u.clone(),
+        end: INVALID.into(),
+        expectations_met: false,
+        failed: false,
+        failures: vec![why.to_string()],
+        contacts: 0,
+        contacts_with: Vec::new(),
+        contacts_while_stopped: 0,
+        obstacles: Vec::new(),
+        min_clearance_m: Vec::new(),
+        obstacle_clearance_m: None,
+        stops: 0,
+        deviations: 0,
+        false_stops: 0,
+        needless_deviations: 0,
+        lap_times_s: Vec::new(),
+        sim_time_s: 0.0,
+        wall_time_s: 0.0,
+        score: 10.0,
+        failure_file: None,
+        faults: Default::default(),
+    }
+}
+
+/// Reads `results.jsonl`; a last line cut short (a killed process) is dropped and the file
+/// rewritten without it. Any other bad line is an error naming it.
+pub fn read_results(dir: &Path) -> Result<Vec<RunRecord>> {
+    let path = dir.join("results.jsonl");
+    let text = match std::fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(source) => {
+            return Err(Error::Io {
+                what: "reading the results",
+                path,
+                source,
+            });
+        }
+    };
+    let lines: Vec<&str> = text.lines().collect();
+    let mut records = Vec::with_capacity(lines.len());
+    for (i, line) in lines.iter().enumerate() {
+        match serde_json::from_str::<RunRecord>(line) {
+            Ok(r) => records.push(r),
+            Err(_) if i + 1 == lines.len() && !text.ends_with('\n') => {
+                let mut kept: String = lines[..i].iter().map(|l| format!("{l}\n")).collect();
+                kept.shrink_to_fit();
+                mapper::write_atomically(&path, kept.as_bytes())?;
+            }
+            Err(e) => {
+                return Err(Error::BadFile {
+                    path,
+                    message: format!("line {}: not a run record: {e}", i + 1),
+                });
+            }
+        }
+    }
+    records.sort_by_key(|r| r.index);
+    records.dedup_by_key(|r| r.index);
+    Ok(records)
+}

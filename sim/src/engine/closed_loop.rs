@@ -1,0 +1,277 @@
+//! The closed loop: each physics step, obstacles move, the stack hears odometry and its pose
+//! estimate, a revolution is taken and planned from every `1 / scan_hz`, the stack commands, the
+//! vehicle moves, the judge judges.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use nalgebra::Isometry2;
+
+use super::observer::{Observer, RevolutionFrame, StepFrame};
+use super::outcome::{EndReason, Event};
+use super::report::Progress;
+use super::rig::{Rig, start_state};
+use super::schedule::Planned;
+use crate::error::{Error, Result};
+use crate::world::{Captured, Sensor};
+
+impl Rig<'_> {
+    /// The loop: each physics step, as a schedule - obstacles move, the stack hears odometry and
+    /// its pose estimate, a revolution is taken and planned from every `1 / scan_hz`, the stack
+    /// commands, the vehicle moves, the judge judges.
+    pub(super) fn drive<'s>(
+        &mut self,
+        tasks: &rayon::Scope<'s>,
+        stop: Option<&AtomicBool>,
+        progress: &mut (dyn FnMut(Progress) + Send),
+        observer: &mut (dyn Observer + Send),
+    ) -> Result<EndReason> {
+        let dt = 1.0 / self.config.physics_hz;
+        while !self.judge.done() {
+            if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+                return Ok(EndReason::Interrupted);
+            }
+            if self.t_s > self.timeout_s {
+                return Ok(EndReason::TimedOut);
+            }
+            if self.driver.calls_for_pilot(self.t_s) {
+                return Ok(EndReason::WaitingForHiddenObstacle);
+            }
+            let physics = Instant::now();
+            self.move_obstacles();
+            self.split.physics += physics.elapsed().as_secs_f64();
+            let truth = self.state.world_from_vehicle();
+            self.sense_pose(&truth);
+            if self.step.is_multiple_of(self.steps_per_scan) {
+                self.revolution(tasks, &truth, observer)?;
+            }
+            self.deliver_due(tasks, observer)?;
+            let holding = self.driver.watchdog_tripped();
+            if holding != self.watchdog_holding {
+                self.watchdog_holding = holding;
+                self.fault_counts.watchdog_stops += u64::from(holding);
+                observer.event(self.t_s, &Event::Watchdog { holding })?;
+            }
+            let physics = Instant::now();
+            let command = self.driver.command();
+            self.bicycle.step(&mut self.state, &command, dt);
+            self.t_s += dt;
+            self.step += 1;
+            self.world
+                .set_vehicle_pose(&self.state.world_from_vehicle(), self.t_s);
+            self.split.physics += physics.elapsed().as_secs_f64();
+            let verdict =
+                self.judge
+                    .after_step(self.t_s, &self.state, command.speed_m_s, &self.world);
+            for (t, event) in self.judge.drain_events() {
+                observer.event(t, &event)?;
+            }
+            observer.step(&StepFrame {
+                t_s: self.t_s,
+                state: &self.state,
+                command: &command,
+                clearance_m: self.judge.clearance_now_m(),
+                real_time_factor: self.t_s / self.wall.elapsed().as_secs_f64().max(1e-9),
+                world: &self.world,
+            })?;
+            if verdict.lap_ended && !self.route.closed() && !self.judge.done() {
+                self.restart_open_route()?;
+            }
+            if self.step.is_multiple_of(100) {
+                progress(Progress {
+                    sim_time_s: self.t_s,
+                    laps_completed: self.judge.laps_completed(),
+                    fraction: verdict.fraction,
+                });
+            }
+        }
+        Ok(EndReason::Completed)
+    }
+
+    /// The odometry of this step to the stack and the pose source; the pose source's estimate
+    /// (through the pose faults) to the stack, its error logged.
+    fn sense_pose(&mut self, truth: &Isometry2<f64>) {
+        let odometry =
+            self.odometry
+                .measure(self.t_s, self.state.speed_m_s, self.state.steering_rad);
+        self.driver.on_odometry(odometry);
+        let t0 = Instant::now();
+        self.pose_source.on_odometry(&odometry);
+        let published = self.pose_source.publish(self.t_s, truth);
+        self.split.localization += t0.elapsed().as_secs_f64();
+        if let Some(mut estimate) = published {
+            estimate.world_from_vehicle = self
+                .config
+                .faults
+                .bias_pose(self.t_s, &estimate.world_from_vehicle);
+            if let Some(log) = &mut self.localization_errors {
+                log.record(self.judge.laps_completed() + 1, truth, &estimate);
+            }
+            self.driver.on_pose(estimate);
+        }
+    }
+
+    /// The pose source reads a revolution as the stack receives it.
+    fn localize(&mut self, captured: &Captured) -> Result<()> {
+        let t0 = Instant::now();
+        self.pose_source.on_revolution(&captured.revolution)?;
+        self.split.localization += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// A revolution: taken, then (at once, or when its latency has passed) mapped and planned
+    /// from as the schedule says, shown to the observer.
+    fn revolution<'s>(
+        &mut self,
+        tasks: &rayon::Scope<'s>,
+        truth: &Isometry2<f64>,
+        observer: &mut (dyn Observer + Send),
+    ) -> Result<()> {
+        let Some(estimate) = self.driver.estimate().map(|e| e.world_from_vehicle) else {
+            return Ok(());
+        };
+        let (index, seed, t_s) = (self.step / self.steps_per_scan, self.seed, self.t_s);
+        let faults = &self.config.faults;
+        if faults.any() && self.lost.is_lost(faults, seed, index) {
+            // It never reaches the stack.
+            self.fault_counts.lost_revolutions += 1;
+            return Ok(());
+        }
+        let sensor = Sensor {
+            world: &self.world,
+            lidar: &self.lidar,
+            faults,
+            seed,
+            dropped: &self.dropped_returns,
+            spurious: &self.spurious_returns,
+        };
+        let delay_s = faults.delay_s(seed, index);
+        if delay_s > 0.0 {
+            // Cast now, in the world as it is now; delivered later, in order.
+            let captured = sensor.capture(truth, &estimate, index, t_s)?;
+            let last = self.in_transit.back().map_or(0.0, |(at, _)| *at);
+            self.in_transit
+                .push_back(((t_s + delay_s).max(last), captured));
+            self.fault_counts.delayed_revolutions += 1;
+            return Ok(());
+        }
+        self.driver.on_revolution(t_s);
+        let capture = || sensor.capture(truth, &estimate, index, t_s);
+        let (lidar_s, planned) = self.scheduler.revolution(capture, &mut self.driver)?;
+        self.planned(tasks, lidar_s, planned, observer)
+    }
+
+    /// Delivers the late revolutions whose time has come.
+    fn deliver_due<'s>(
+        &mut self,
+        tasks: &rayon::Scope<'s>,
+        observer: &mut (dyn Observer + Send),
+    ) -> Result<()> {
+        while self
+            .in_transit
+            .front()
+            .is_some_and(|(at, _)| *at <= self.t_s + 1e-9)
+        {
+            let Some((_, captured)) = self.in_transit.pop_front() else {
+                break;
+            };
+            // The watchdog counts a revolution's age from when it was taken.
+            self.driver.on_revolution(captured.revolution.t_s);
+            let (lidar_s, planned) = self
+                .scheduler
+                .revolution(move || Ok(captured), &mut self.driver)?;
+            self.planned(tasks, lidar_s, planned, observer)?;
+        }
+        Ok(())
+    }
+
+    /// After a revolution's plan: accounts, shows, and (overlapped) starts mapping the next.
+    fn planned<'s>(
+        &mut self,
+        tasks: &rayon::Scope<'s>,
+        lidar_s: f64,
+        planned: Option<Planned>,
+        observer: &mut (dyn Observer + Send),
+    ) -> Result<()> {
+        self.split.lidar += lidar_s;
+        if let Some(planned) = &planned {
+            self.show(planned, observer)?;
+        }
+        self.scheduler.dispatch(tasks);
+        if let Some(planned) = &planned {
+            // The localizer reads the revolution once the stack has it (overlapped: the one
+            // taken a revolution ago, brought forward to now on odometry), beside the mapping
+            // of the next.
+            self.localize(&planned.captured)?;
+        }
+        Ok(())
+    }
+
+    /// Accounts for a plan and shows it.
+    fn show(&mut self, planned: &Planned, observer: &mut (dyn Observer + Send)) -> Result<()> {
+        self.split.mapping += planned.mapping_s;
+        self.split.distance_maps += planned.times.distance_maps_s;
+        self.split.planning += planned.times.planning_s;
+        let plan = self.driver.last_plan().ok_or_else(|| {
+            Error::Invalid("the driver planned but holds no plan (no pose estimate)".into())
+        })?;
+        self.judge.on_plan(self.t_s, plan.chosen().offset_m);
+        for (t, event) in self.judge.drain_events() {
+            observer.event(t, &event)?;
+        }
+        let map = self
+            .scheduler
+            .map()
+            .ok_or_else(|| Error::Invalid("the online map is not ready".into()))?;
+        let v = self.driver.speed_command_m_s();
+        let wanted = self.scenario.route.speed_m_s;
+        observer.revolution(&RevolutionFrame {
+            t_s: self.t_s,
+            truth: planned.captured.truth,
+            estimate: planned.captured.revolution.world_from_vehicle_estimate,
+            revolution: &planned.captured.revolution,
+            owners: &planned.captured.owners,
+            map: map.map(),
+            plan,
+            speed_cmd_m_s: v,
+            speed_scale: if wanted > 0.0 { v / wanted } else { 0.0 },
+            world: &self.world,
+            particles: self.pose_source.particles(),
+            pose_estimate: self.driver.estimate().copied(),
+        })
+    }
+
+    /// Run-time obstacles appear, move and go as the scenario says.
+    fn move_obstacles(&mut self) {
+        let first = self.scenario.objects.len();
+        for (k, o) in self.scenario.obstacles.iter().enumerate() {
+            let i = first + k;
+            match o.pose_at(self.t_s) {
+                Some((x, y, yaw)) => {
+                    if !self.world.object_active(i) {
+                        self.world.set_object_active(i, true);
+                    }
+                    if o.motion.is_some() {
+                        self.world.set_object_pose(i, x, y, yaw);
+                    }
+                }
+                None if self.world.object_active(i) => self.world.set_object_active(i, false),
+                None => {}
+            }
+        }
+    }
+
+    /// An open route starts its next lap from its start pose.
+    fn restart_open_route(&mut self) -> Result<()> {
+        self.state = start_state(&self.scenario.vehicle.world_from_start);
+        self.judge.restart_lap();
+        self.driver.restart();
+        self.pose_source
+            .reset(&self.scenario.vehicle.world_from_start)?;
+        // Revolutions of the last lap still in transit would carry its poses into this one.
+        self.in_transit.clear();
+        self.world
+            .set_vehicle_pose(&self.state.world_from_vehicle(), self.t_s);
+        Ok(())
+    }
+}

@@ -1,0 +1,97 @@
+//! A run's report: the judge's verdicts, the configuration it ran with, why it ended, and where
+//! the wall time went.
+
+use serde::Serialize;
+
+use super::outcome::{EndReason, ObstacleReport, Stop};
+use crate::scenario::RunConfig;
+use crate::world::Contact;
+
+/// What a run did.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunReport {
+    /// Scenario name.
+    pub scenario: String,
+    /// Seed used.
+    pub seed: u64,
+    /// True when every expectation held and every lap was completed.
+    pub expectations_met: bool,
+    /// Why the run ended: `completed`, `timed_out`, `interrupted` or
+    /// `waiting_for_hidden_obstacle`.
+    pub end: EndReason,
+    /// When the run ended waiting for a hidden obstacle: which, and since when.
+    pub waiting_for: Option<HiddenObstacle>,
+    /// Laps asked for.
+    pub laps: u32,
+    /// Laps completed.
+    pub laps_completed: u32,
+    /// Lap times, seconds.
+    pub lap_times_s: Vec<f64>,
+    /// Ground-truth contacts.
+    pub contacts: Vec<Contact>,
+    /// Per run-time obstacle.
+    pub obstacles: Vec<ObstacleReport>,
+    /// Stops.
+    pub stops: Vec<Stop>,
+    /// Smallest ground-truth clearance per level to any object, metres.
+    pub min_clearance_m: Vec<f64>,
+    /// The scenario's danger distance, metres (`None`: not stated): a pass closer than this to
+    /// its obstacle, at any level, does not meet its expectation.
+    pub danger_distance_m: Option<f64>,
+    /// Simulated time, seconds.
+    pub sim_time_s: f64,
+    /// Wall time, seconds.
+    pub wall_time_s: f64,
+    /// Simulated seconds per wall second.
+    pub real_time_factor: f64,
+    /// Where the wall time went, seconds: LiDAR, mapping, distance maps, planning, physics.
+    pub time_split_s: TimeSplit,
+    /// The configuration the run ran with.
+    pub config: RunConfig,
+    /// What the faults did: lost revolutions, dropped and spurious returns, watchdog stops.
+    #[serde(default)]
+    pub faults: crate::world::FaultCounts,
+    /// The pose estimate against the truth (`None` when the pose source is the truth).
+    pub localization: Option<super::pose_error::LocalizationReport>,
+}
+
+/// The obstacle a vehicle waits for without seeing it.
+#[derive(Clone, Debug, Serialize)]
+pub struct HiddenObstacle {
+    /// Its nearest cell to the vehicle's first colliding pose, metres (the estimate's frame).
+    pub x_m: f64,
+    /// See `x_m`.
+    pub y_m: f64,
+    /// When a revolution last hit it, seconds (`None`: not since the window held it).
+    pub last_seen_s: Option<f64>,
+    /// When the wait began, seconds.
+    pub since_s: f64,
+}
+
+/// Wall time per stage, seconds.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct TimeSplit {
+    /// Ray casting.
+    pub lidar: f64,
+    /// Scan insertion.
+    pub mapping: f64,
+    /// Distance maps.
+    pub distance_maps: f64,
+    /// Planner and avoider.
+    pub planning: f64,
+    /// Motion, ground truth, obstacles.
+    pub physics: f64,
+    /// The pose source (the particle filter's motion and measurement updates).
+    pub localization: f64,
+}
+
+/// Progress of a run, for a progress bar.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Simulated time, seconds.
+    pub sim_time_s: f64,
+    /// Laps completed.
+    pub laps_completed: u32,
+    /// Fraction of the whole run done, 0..1.
+    pub fraction: f64,
+}

@@ -1,0 +1,14 @@
+//! The offline map: the mapping drive that builds a scenario's multi-height map along its route
+//! ([`map_drive`]), its settings ([`levels_of`], [`map_config`], [`self_filter_model`]), and the
+//! manifest whose fingerprint says whether a map directory is fresh ([`MapManifest`],
+//! [`fresh_manifest`]).
+
+mod drive;
+mod manifest;
+mod settings;
+
+pub use crate::error::ManifestError;
+pub use drive::map_drive;
+pub(crate) use manifest::MAP_FORMAT;
+pub use manifest::{MapManifest, default_map_dir, fingerprint, fresh_manifest};
+pub use settings::{levels_of, map_config, self_filter_model};

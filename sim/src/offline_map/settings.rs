@@ -1,0 +1,39 @@
+//! The offline map's settings, shared by the mapping drive, the closed loop and the replay: the
+//! map configuration of a run configuration, the levels of a scenario's vehicle, the self-hit
+//! filter's circles.
+
+use mapper::{Levels, MapConfig};
+
+use crate::error::Result;
+use crate::scenario::{RunConfig, Scenario};
+
+/// The map settings of a configuration's mapping drive (its mapping settings as they are).
+pub fn map_config(config: &RunConfig) -> MapConfig {
+    config.mapping.map
+}
+
+/// The circles the LiDAR self-hit filter uses: every part at its own level (the banded fit keeps
+/// the parts a cumulative fit drops because they lie over a lower level's parts, such as a wing
+/// root over the fuselage), so returns off the vehicle's own wing are dropped while a cone under
+/// the wing is not.
+pub fn self_filter_model(vehicle: &aircraft::Vehicle) -> Result<mapper::CollisionModel> {
+    let options = aircraft::FitOptions {
+        banded_maps: true,
+        ..vehicle.spec.fit.clone()
+    };
+    Ok(vehicle
+        .fit_with(&vehicle.spec.heights_of_interest_m, &options)?
+        .model)
+}
+
+/// The levels a scenario's vehicle asks for under `config`: its heights of interest (or the
+/// configuration's), cumulative, under its ceiling (`aircraft::Vehicle::ceiling_m`: its top plus
+/// its overhead clearance).
+pub fn levels_of(scenario: &Scenario, config: &RunConfig) -> Result<Levels> {
+    let vehicle = &scenario.vehicle.vehicle;
+    Ok(Levels::new(
+        config.heights_of_interest_m(vehicle).to_vec(),
+        mapper::LevelMode::Cumulative,
+        Some(vehicle.ceiling_m()),
+    )?)
+}

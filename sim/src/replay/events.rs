@@ -1,0 +1,74 @@
+//! The lines of the `events` text log: the run's events and its end, each with its level.
+
+use rerun::components::TextLogLevel;
+
+use crate::engine::{EndReason, Event, RunReport};
+
+/// An event's line and level (a `TextLogLevel` name).
+pub(super) fn event_line(event: &Event) -> (String, &'static str) {
+    match event {
+        Event::Stop { route_s_m } => (
+            format!("stop at {route_s_m:.1} m along the route"),
+            TextLogLevel::WARN,
+        ),
+        Event::Resume { stopped_s } => {
+            (format!("resume after {stopped_s:.1} s"), TextLogLevel::INFO)
+        }
+        Event::Deviate { offset_m } => (
+            format!("deviate: offset {offset_m:+.2} m"),
+            TextLogLevel::INFO,
+        ),
+        Event::BackOnRoute => ("back on the route".to_string(), TextLogLevel::INFO),
+        Event::Watchdog { holding: true } => (
+            "watchdog: no fresh LiDAR revolution, stopping".to_string(),
+            TextLogLevel::WARN,
+        ),
+        Event::Watchdog { holding: false } => (
+            "watchdog: revolutions are back".to_string(),
+            TextLogLevel::INFO,
+        ),
+        Event::Contact(c) => (
+            format!("contact: {} ({:?}) touched by {}", c.object, c.kind, c.part),
+            TextLogLevel::ERROR,
+        ),
+        Event::Lap { lap, time_s } => (format!("lap {lap} in {time_s:.1} s"), TextLogLevel::INFO),
+        Event::Pass { id, outcome, met } => (
+            format!(
+                "pass {id}: {outcome}{}",
+                if *met { "" } else { " (not as expected)" }
+            ),
+            if *met {
+                TextLogLevel::INFO
+            } else {
+                TextLogLevel::WARN
+            },
+        ),
+    }
+}
+
+/// The run's last line: laps, contacts and whether every expectation held; and its level.
+pub(super) fn end_line(report: &RunReport) -> (String, &'static str) {
+    let text = format!(
+        "end: {}/{} laps, {} contacts, {}{}",
+        report.laps_completed,
+        report.laps,
+        report.contacts.len(),
+        if report.expectations_met {
+            "every expectation held"
+        } else {
+            "expectations not met"
+        },
+        match report.end {
+            EndReason::Completed => "",
+            EndReason::TimedOut => " (timed out)",
+            EndReason::Interrupted => " (interrupted)",
+            EndReason::WaitingForHiddenObstacle => " (waiting for a hidden obstacle: pilot called)",
+        }
+    );
+    let level = if report.expectations_met {
+        TextLogLevel::INFO
+    } else {
+        TextLogLevel::WARN
+    };
+    (text, level)
+}

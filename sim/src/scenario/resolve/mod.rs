@@ -1,0 +1,229 @@
+//! The resolver: turns a scenario file as written ([`ScenarioFile`]) into a [`Scenario`], with
+//! the cross-field checks (one route source, ids unique across objects, rows, patches and
+//! obstacles, everything inside the world, nothing over the vehicle at its start) on the spans
+//! toml keeps. Every mistake becomes a [`LocatedError`] naming the file, the line, the column and
+//! the field, with the offending line quoted. This file holds the entry ([`Resolver::resolve`])
+//! and the helpers the parts share: ids, the world and its bounds, polylines, the start overlap.
+
+mod objects;
+mod route;
+mod rows;
+
+use std::collections::HashMap;
+use std::ops::Range;
+use std::path::Path;
+
+use nalgebra::Point2;
+use toml::Spanned;
+
+use super::model::{Ground, Scenario, ScenarioVehicle};
+use super::overlap::start_overlap;
+use super::spec::{ScenarioFile, WorldSpec};
+use crate::toml_file::LocatedError;
+use crate::world::Solid;
+
+/// Turns the file as written into a [`Scenario`], with the cross-field checks.
+pub(super) struct Resolver<'a> {
+    pub(super) text: &'a str,
+    pub(super) file: &'a str,
+    pub(super) dir: &'a Path,
+}
+
+impl Resolver<'_> {
+    fn err(&self, span: Range<usize>, field: &str, message: impl Into<String>) -> LocatedError {
+        LocatedError::at(self.file, self.text, span, field, message.into())
+    }
+
+    pub(super) fn resolve(
+        &self,
+        spec: ScenarioFile,
+        path: &Path,
+    ) -> Result<Scenario, LocatedError> {
+        let world = self.world(&spec.world)?;
+        let route = self.route(&spec.route, &world)?;
+        let vehicle = self.vehicle(&spec.vehicle, &route, &world)?;
+        // Every id, with who uses it (as error messages name it).
+        let mut ids: HashMap<String, String> = HashMap::new();
+        let mut objects = self.objects(&spec.objects, &world, &vehicle, &mut ids)?;
+        self.rows(&spec.rows, &world, &route, &vehicle, &mut ids, &mut objects)?;
+        let patches = self.patches(&spec.patches, &world, &mut ids)?;
+        let obstacles = self.obstacles(&spec.obstacles, &world, &vehicle, &mut ids)?;
+        if let Some(c) = &spec.config {
+            crate::scenario::RunConfig::from_table(c.get_ref().clone())
+                .map_err(|m| LocatedError::at(self.file, self.text, c.span(), "config", m))?;
+        }
+        Ok(Scenario {
+            path: path.to_path_buf(),
+            name: spec.name,
+            description: spec.description,
+            seed: spec.seed,
+            laps: spec.laps.0,
+            world,
+            vehicle,
+            route,
+            objects,
+            patches,
+            obstacles,
+            danger_distance_m: spec.expectations.danger_distance_m.map(|d| d.0),
+            expected_end: spec.expectations.end.unwrap_or_default(),
+            config: spec.config.map(Spanned::into_inner),
+        })
+    }
+
+    /// Claims `id` in `ids` for `owner` (as error messages name it): an empty id or one
+    /// already claimed is refused at `span` under `field`, the message starting with `made`.
+    fn claim(
+        &self,
+        ids: &mut HashMap<String, String>,
+        id: &str,
+        span: Range<usize>,
+        field: &str,
+        owner: String,
+        made: &str,
+    ) -> Result<(), LocatedError> {
+        if id.is_empty() {
+            return Err(self.err(span, field, "an id must not be empty"));
+        }
+        if let Some(first) = ids.insert(id.to_string(), owner) {
+            return Err(self.err(
+                span,
+                field,
+                format!("{made}duplicate id `{id}` (already used by {first})"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Claims the id of table `field` (`objects[3]`), named `<field>.id` as field and owner.
+    fn claim_id(
+        &self,
+        ids: &mut HashMap<String, String>,
+        id: &Spanned<String>,
+        field: &str,
+    ) -> Result<(), LocatedError> {
+        let field = format!("{field}.id");
+        self.claim(
+            ids,
+            id.get_ref(),
+            id.span(),
+            &field,
+            format!("`{field}`"),
+            "",
+        )
+    }
+
+    fn world(&self, w: &WorldSpec) -> Result<Ground, LocatedError> {
+        let min_m = [w.min_m[0].0, w.min_m[1].0];
+        let max_m = [w.max_m.get_ref()[0].0, w.max_m.get_ref()[1].0];
+        if max_m[0] <= min_m[0] || max_m[1] <= min_m[1] {
+            return Err(self.err(
+                w.max_m.span(),
+                "world.max_m",
+                format!(
+                    "the upper corner {max_m:?} must be above the lower corner {min_m:?} in x and y"
+                ),
+            ));
+        }
+        Ok(Ground {
+            min_m,
+            max_m,
+            ground_remission: w.ground_remission.0,
+            pavement_texture: w.pavement_texture.0,
+        })
+    }
+
+    fn inside_world(
+        &self,
+        world: &Ground,
+        field: &str,
+        span: Range<usize>,
+        x: f64,
+        y: f64,
+    ) -> Result<(), LocatedError> {
+        if x < world.min_m[0] || x > world.max_m[0] || y < world.min_m[1] || y > world.max_m[1] {
+            return Err(self.err(
+                span,
+                field,
+                format!(
+                    "({x}, {y}) lies outside the world [{}, {}] .. [{}, {}]",
+                    world.min_m[0], world.min_m[1], world.max_m[0], world.max_m[1]
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Checks a polyline: at least `min` points, no two consecutive equal (nor, when `closed`,
+    /// the last and the first).
+    #[allow(clippy::too_many_arguments)]
+    fn polyline(
+        &self,
+        points: &[Point2<f64>],
+        min: usize,
+        closed: bool,
+        span: Range<usize>,
+        field: &str,
+        what: &str,
+    ) -> Result<(), LocatedError> {
+        if points.len() < min {
+            return Err(self.err(
+                span,
+                field,
+                format!(
+                    "{} point(s): {}{what} needs at least {min}",
+                    points.len(),
+                    if closed { "closed, " } else { "" }
+                ),
+            ));
+        }
+        for (k, w) in points.windows(2).enumerate() {
+            if w[0] == w[1] {
+                return Err(self.err(
+                    span,
+                    field,
+                    format!(
+                        "points {k} and {} are the same ({}, {})",
+                        k + 1,
+                        w[0].x,
+                        w[0].y
+                    ),
+                ));
+            }
+        }
+        if closed && points.first() == points.last() {
+            return Err(self.err(
+                span,
+                field,
+                "the last point repeats the first: a closed route joins them itself, drop the last",
+            ));
+        }
+        Ok(())
+    }
+
+    fn no_start_overlap(
+        &self,
+        vehicle: &ScenarioVehicle,
+        solid: &Solid,
+        field: &str,
+        span: Range<usize>,
+    ) -> Result<(), LocatedError> {
+        if let Some(hit) = start_overlap(&vehicle.vehicle, &vehicle.world_from_start, solid) {
+            let t = vehicle.world_from_start.translation.vector;
+            return Err(self.err(
+                span,
+                field,
+                format!(
+                    "`{}` ({}, z {:.2}..{:.2} m) overlaps the vehicle at its start pose ({:.2}, {:.2}) m, yaw {:.3} rad: {hit}",
+                    solid.id,
+                    solid.kind.name(),
+                    solid.z_min_m,
+                    solid.z_min_m + solid.shape.height_m(),
+                    t.x,
+                    t.y,
+                    vehicle.world_from_start.rotation.angle(),
+                ),
+            ));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,351 @@
+//! A scenario file as written: the serde structs ([`ScenarioFile`] and the `*Spec` structs),
+//! every field's unit and default documented on it, unknown keys rejected everywhere. Numbers are
+//! checked while they are read (validating newtypes such as [`Positive`]), so toml's error points
+//! at the value; the cross-field checks are the resolver's, on the spans toml keeps
+//! ([`toml::Spanned`]).
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::numbers::{Finite, Laps, NonNegative, Positive, Remission};
+use crate::world::ObjectKind;
+
+fn default_seed() -> u64 {
+    1
+}
+
+fn default_pavement_texture() -> Remission {
+    Remission(0.05)
+}
+
+fn default_ground_remission() -> Remission {
+    Remission(0.2)
+}
+
+/// A scenario file as written. See `scenarios/README.md` for a commented example.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioFile {
+    /// Short human name (reports, replay). Required.
+    pub name: String,
+    /// Free text. Optional.
+    pub description: Option<String>,
+    /// Seed of every random draw of a run (sensor noise, dropout). Default 1.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// How many times the route is driven (a closed route loops). Integer >= 1, default 1.
+    #[serde(default)]
+    pub laps: Laps,
+    /// The ground. Required.
+    pub world: WorldSpec,
+    /// The vehicle and its start pose. Required.
+    pub vehicle: VehicleEntry,
+    /// The route to follow. Required.
+    pub route: Spanned<RouteSpec>,
+    /// Static objects: in the world from the start, and in the offline map. Default none.
+    #[serde(default)]
+    pub objects: Vec<Spanned<ObjectSpec>>,
+    /// Rows of static objects along a line (edge markers, parked cars): each expands into
+    /// ordinary static objects. Default none.
+    #[serde(default)]
+    pub rows: Vec<Spanned<RowSpec>>,
+    /// Painted markings on the ground (remission texture). Default none.
+    #[serde(default)]
+    pub patches: Vec<Spanned<PatchSpec>>,
+    /// Run-time obstacles: absent from the mapping drive and the offline map. Default none.
+    #[serde(default)]
+    pub obstacles: Vec<Spanned<ObstacleSpec>>,
+    /// Expectations about the whole run, beyond each obstacle's `expect`. Default none.
+    #[serde(default)]
+    pub expectations: ExpectationsSpec,
+    /// The run configuration this scenario runs with, as in a `--config` file (only what
+    /// differs from the defaults). A campaign's failure file carries its setting here. Default
+    /// none: the defaults.
+    pub config: Option<Spanned<toml::Table>>,
+}
+
+/// `[expectations]`: what must hold over the whole run, beside each obstacle's `expect`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExpectationsSpec {
+    /// The danger distance, metres, > 0: the smallest ground-truth clearance between any part of
+    /// the vehicle and any run-time obstacle must never fall under it (the thesis' tall
+    /// obstacles were passed inside the safety distance but never closer than the danger
+    /// distance). Default none: only a contact fails.
+    pub danger_distance_m: Option<Positive>,
+    /// How the run must end: `completed` (every lap driven; the default),
+    /// `waiting_for_hidden_obstacle` (stopped for an obstacle the sensor can no longer see, the
+    /// vehicle calls for a pilot rather than guess it has gone) or `stopped_for_good` (stopped
+    /// before an obstacle that never goes, timed out or calling for a pilot) or `any` (only
+    /// contacts and the obstacles' expectations count, and an obstacle never passed counts for
+    /// nothing: a campaign's randomized obstacles, which may block the way or appear late).
+    pub end: Option<ExpectedEnd>,
+}
+
+/// How a scenario's run must end (`[expectations] end`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ExpectedEnd {
+    /// Every lap driven.
+    #[default]
+    Completed,
+    /// Waiting for a hidden obstacle, calling for a pilot.
+    WaitingForHiddenObstacle,
+    /// Stopped for good before an obstacle that never goes: the run ends timed out or calling
+    /// for a pilot, the vehicle still standing.
+    StoppedForGood,
+    /// However it ends: only contacts and the obstacles' expectations count.
+    Any,
+}
+
+/// `[world]`: the ground, a rectangle of the plane z = 0.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WorldSpec {
+    /// Lower corner `[x, y]` of the ground, metres. Required.
+    pub min_m: [Finite; 2],
+    /// Upper corner `[x, y]` of the ground, metres; each coordinate > the lower one. Required.
+    pub max_m: Spanned<[Finite; 2]>,
+    /// Remission of bare ground, in [0, 1]. Default 0.2 (asphalt, concrete).
+    #[serde(default = "default_ground_remission")]
+    pub ground_remission: Remission,
+    /// Texture of the pavement: each 0.5 m square's remission (bare ground or a patch) is off by
+    /// up to this much, in [0, 1] (what a remission map of real asphalt or concrete shows, and
+    /// what a remission localizer reads). Default 0.05; 0 makes a featureless ground.
+    #[serde(default = "default_pavement_texture")]
+    pub pavement_texture: Remission,
+}
+
+/// `[vehicle]`: which vehicle, and where it starts.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VehicleEntry {
+    /// A shipped vehicle (`praetor600`, `iara_car`, `iara_car_fake_wing`) or the path of a
+    /// vehicle sidecar TOML, relative to the scenario file's directory. Required.
+    pub description: Spanned<String>,
+    /// Start pose of the vehicle frame (origin on the ground under the rear axle / main gear).
+    /// Default: on the first route point, heading to the second.
+    pub start: Option<Spanned<StartPose>>,
+}
+
+/// A start pose, `{ x_m = .., y_m = .., yaw_rad = .. }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StartPose {
+    /// Position, metres. Required.
+    pub x_m: Finite,
+    /// Position, metres. Required.
+    pub y_m: Finite,
+    /// Heading, radians counter-clockwise from x. Default 0.
+    #[serde(default)]
+    pub yaw_rad: Finite,
+}
+
+/// `[route]`: the path the vehicle follows. Exactly one of `waypoints_m` and `pose_file`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RouteSpec {
+    /// Waypoints `[[x, y], ...]`, metres; at least 2 (3 when closed), no two consecutive equal.
+    pub waypoints_m: Option<Spanned<Vec<[Finite; 2]>>>,
+    /// A pose file, relative to the scenario file's directory: one pose a line,
+    /// `x_m,y_m[,yaw_rad]`; blank lines and `#` comments are skipped.
+    pub pose_file: Option<Spanned<String>>,
+    /// True when the last point joins the first (do not repeat the first point). Default false.
+    #[serde(default)]
+    pub closed: bool,
+    /// Target speed along the route, m/s, > 0. Required.
+    pub speed_m_s: Positive,
+}
+
+/// `[[objects]]`: a static object. Shape fields depend on the kind:
+/// round kinds (`cone`, `marker`, `lamp_post`, `cylinder`) take `radius_m` and `height_m`,
+/// the others (`container`, `parked_car`, `vehicle`, `debris`, `building`, `box`) take `size_m`.
+///
+/// | kind | shape | default size | default remission |
+/// | --- | --- | --- | --- |
+/// | cone | cone | radius 0.18, height 0.45 | 0.5 |
+/// | marker | cylinder | radius 0.10, height 0.35 | 0.7 |
+/// | lamp_post | cylinder | radius 0.12, height 6.0 | 0.3 |
+/// | cylinder | cylinder | required | 0.3 |
+/// | container | box | 0.8 x 0.6 x 1.1 | 0.4 |
+/// | parked_car, vehicle | box | 4.5 x 1.8 x 1.5 | 0.3 |
+/// | debris | box | 0.3 x 0.3 x 0.15 | 0.2 |
+/// | building | box | required | 0.2 |
+/// | box | box | required | 0.3 |
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectSpec {
+    /// Unique name across objects, rows, patches and obstacles. Required.
+    pub id: Spanned<String>,
+    /// What it is (snake_case [`ObjectKind`]). Required.
+    pub kind: ObjectKind,
+    /// Position of its axis (box: its centre), metres. Required.
+    pub x_m: Finite,
+    /// Position of its axis (box: its centre), metres. Required.
+    pub y_m: Finite,
+    /// Heading, radians counter-clockwise from x (box: its x extent runs along it). Default 0.
+    #[serde(default)]
+    pub yaw_rad: Finite,
+    /// Height of its base above the ground, metres, >= 0. Default 0 (standing on the ground).
+    #[serde(default)]
+    pub z_min_m: NonNegative,
+    /// Box kinds: full extents `[x, y, z]`, metres, each > 0. Default per kind (table above).
+    pub size_m: Option<Spanned<[Positive; 3]>>,
+    /// Round kinds: base radius, metres, > 0. Default per kind.
+    pub radius_m: Option<Spanned<Positive>>,
+    /// Round kinds: height, metres, > 0. Default per kind.
+    pub height_m: Option<Spanned<Positive>>,
+    /// LiDAR remission in [0, 1]. Default per kind.
+    pub remission: Option<Remission>,
+}
+
+/// `[[patches]]`: a painted rectangle on the ground with its own remission (lines, patches).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PatchSpec {
+    /// Unique name across objects, rows, patches and obstacles. Required.
+    pub id: Spanned<String>,
+    /// Centre, metres. Required.
+    pub x_m: Finite,
+    /// Centre, metres. Required.
+    pub y_m: Finite,
+    /// Heading of its length, radians. Default 0.
+    #[serde(default)]
+    pub yaw_rad: Finite,
+    /// Extent along its heading, metres, > 0. Required.
+    pub length_m: Positive,
+    /// Extent across, metres, > 0. Required.
+    pub width_m: Positive,
+    /// LiDAR remission in [0, 1]. Default 0.8 (white paint).
+    pub remission: Option<Remission>,
+}
+
+/// The line a row follows when it is not given as `along_m`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RowLine {
+    /// The scenario's route (closed or not, as the route is).
+    Route,
+}
+
+/// `[[rows]]`: a row of identical static objects at a regular spacing along a line, repeated at
+/// lateral offsets from it; it expands into ordinary static objects with ids `<id>_<n>`
+/// (`n` from 1, along the line first, then in the order of `offsets_m` at each station). The
+/// shape fields are those of [`ObjectSpec`], with the same per-kind defaults.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RowSpec {
+    /// Prefix of the objects' ids; unique across objects, rows, patches and obstacles, and so
+    /// are the ids it makes. Required.
+    pub id: Spanned<String>,
+    /// What its objects are (snake_case [`ObjectKind`]). Required.
+    pub kind: ObjectKind,
+    /// The line, `[[x, y], ...]`, metres: at least 2 points, no two consecutive equal.
+    /// Exactly one of `along_m` and `along`.
+    pub along_m: Option<Spanned<Vec<[Finite; 2]>>>,
+    /// `"route"`: the line is the route (with its closing segment when it is closed).
+    pub along: Option<Spanned<RowLine>>,
+    /// Distance between stations, measured along the line, metres, > 0. Required.
+    pub spacing_m: Spanned<Positive>,
+    /// Lateral offsets from the line, metres, left of its direction positive; one object per
+    /// offset at each station (`[-11.5, 11.5]`: both edges). No repeats. Default `[0.0]`.
+    pub offsets_m: Option<Spanned<Vec<Finite>>>,
+    /// Arc length of the first station, metres, >= 0. Default 0.
+    pub start_m: Option<Spanned<NonNegative>>,
+    /// Arc length the stations stop at (inclusive), metres, > `start_m`, at most the line's
+    /// length. Default the line's end (on a closed route the station that would repeat the
+    /// first is left out).
+    pub end_m: Option<Spanned<NonNegative>>,
+    /// Heading of each object relative to the line's direction where it stands, radians
+    /// (a box's x extent runs along the line at 0; `1.5708` turns parked cars across it).
+    /// Default 0.
+    #[serde(default)]
+    pub yaw_rad: Finite,
+    /// Height of the objects' base above the ground, metres, >= 0. Default 0.
+    #[serde(default)]
+    pub z_min_m: NonNegative,
+    /// Box kinds: full extents `[x, y, z]`, metres, each > 0. Default per kind.
+    pub size_m: Option<Spanned<[Positive; 3]>>,
+    /// Round kinds: base radius, metres, > 0. Default per kind.
+    pub radius_m: Option<Spanned<Positive>>,
+    /// Round kinds: height, metres, > 0. Default per kind.
+    pub height_m: Option<Spanned<Positive>>,
+    /// LiDAR remission in [0, 1]. Default per kind.
+    pub remission: Option<Remission>,
+}
+
+/// The most objects one row may make (a guard against a spacing typed in the wrong unit).
+pub const MAX_ROW_OBJECTS: usize = 10_000;
+
+/// What the vehicle must do about a run-time obstacle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Expectation {
+    /// Drive on with a part passing over it (a short cone under a wing), without contact.
+    PassUnder,
+    /// Leave the route around it, without contact, and rejoin.
+    Deviate,
+    /// Stop short of it without contact (and resume if it goes away).
+    Stop,
+    /// Anything, as long as nothing touches it.
+    NoContact,
+}
+
+impl std::fmt::Display for Expectation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.as_str())
+    }
+}
+
+impl Expectation {
+    /// The name used in files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Expectation::PassUnder => "pass_under",
+            Expectation::Deviate => "deviate",
+            Expectation::Stop => "stop",
+            Expectation::NoContact => "no_contact",
+        }
+    }
+}
+
+/// `[[obstacles]]`: a run-time obstacle (not in the offline map). The object fields of
+/// [`ObjectSpec`] (with the same per-kind defaults), plus the expectation and optional timing
+/// and motion.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleSpec {
+    /// Unique name across objects, rows, patches and obstacles. Required.
+    pub id: Spanned<String>,
+    /// What it is (snake_case [`ObjectKind`]). Required.
+    pub kind: ObjectKind,
+    /// Position, metres. Required unless `path_m` is given (then not allowed).
+    pub x_m: Option<Finite>,
+    /// Position, metres. Required unless `path_m` is given (then not allowed).
+    pub y_m: Option<Finite>,
+    /// Heading, radians; for a moving obstacle, an offset to the heading of its path. Default 0.
+    #[serde(default)]
+    pub yaw_rad: Finite,
+    /// Height of its base above the ground, metres, >= 0. Default 0.
+    #[serde(default)]
+    pub z_min_m: NonNegative,
+    /// Box kinds: full extents `[x, y, z]`, metres. Default per kind.
+    pub size_m: Option<Spanned<[Positive; 3]>>,
+    /// Round kinds: base radius, metres. Default per kind.
+    pub radius_m: Option<Spanned<Positive>>,
+    /// Round kinds: height, metres. Default per kind.
+    pub height_m: Option<Spanned<Positive>>,
+    /// LiDAR remission in [0, 1]. Default per kind.
+    pub remission: Option<Remission>,
+    /// What the vehicle must do: `pass_under`, `deviate`, `stop` or `no_contact`. Required.
+    pub expect: Expectation,
+    /// When it appears, seconds from the start, >= 0. Default 0 (there from the start).
+    pub appears_s: Option<Spanned<NonNegative>>,
+    /// When it disappears, seconds, > `appears_s`. Default never.
+    pub disappears_s: Option<Spanned<NonNegative>>,
+    /// A moving obstacle: the polyline `[[x, y], ...]` it follows from its appearance, metres,
+    /// at least 2 points, no two consecutive equal; it stays at the last point. Default static.
+    pub path_m: Option<Spanned<Vec<[Finite; 2]>>>,
+    /// Its speed along `path_m`, m/s, > 0. Required with `path_m`, not allowed without.
+    pub speed_m_s: Option<Spanned<Positive>>,
+}

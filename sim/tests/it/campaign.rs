@@ -1,0 +1,395 @@
+//! Campaigns through the library on the smoke campaign (`scenarios/campaigns/smoke.toml`, 20
+//! runs of a car on a straight road): the results are the same whatever the number of jobs; a
+//! campaign resumes where it stopped, over a half-written last line, without running a variant
+//! twice; a stop leaves only whole runs; bad campaign files are refused with their place; an
+//! invalid variant is recorded and the campaign goes on. What needs the `taxi-sim` binary
+//! (reproducing failure files with `taxi-sim run`, merging shards) is tested in the `taxi-sim`
+//! package (`sim/cli/tests/it/campaign.rs`).
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use sim::campaign::{Campaign, RunOptions, RunRecord, Shard, read_results, run_campaign, variant};
+
+fn smoke_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/campaigns/smoke.toml")
+}
+
+fn smoke() -> Campaign {
+    Campaign::from_file(&smoke_path()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn run(campaign: &Campaign, out: &Path, jobs: usize, runs: Option<u64>) -> Vec<RunRecord> {
+    let stop = AtomicBool::new(false);
+    run_campaign(
+        campaign,
+        &RunOptions {
+            shard: None,
+            maps_dir: None,
+            out: out.to_path_buf(),
+            jobs,
+            runs,
+            stop: &stop,
+            progress: &|_| {},
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+    .records
+}
+
+/// A record without its wall time (the one field identical runs differ in).
+fn timeless(r: &RunRecord) -> RunRecord {
+    RunRecord {
+        wall_time_s: 0.0,
+        ..r.clone()
+    }
+}
+
+/// The whole smoke campaign on two workers, once for every test of this file.
+fn full() -> &'static (tempfile::TempDir, Vec<RunRecord>) {
+    static FULL: OnceLock<(tempfile::TempDir, Vec<RunRecord>)> = OnceLock::new();
+    FULL.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let records = run(&smoke(), dir.path(), 2, None);
+        (dir, records)
+    })
+}
+
+#[test]
+fn the_smoke_campaign_runs_every_variant_under_every_setting() {
+    let (dir, records) = full();
+    assert_eq!(records.len(), 20);
+    assert!(records.iter().enumerate().all(|(i, r)| r.index == i as u64));
+    for pair in records.chunks(2) {
+        // A sample's two runs drew the same world and differ in the setting only.
+        assert_eq!(pair[0].sampled, pair[1].sampled);
+        assert_eq!((pair[0].setting, pair[1].setting), (0, 1));
+        assert_ne!(pair[0].parameters, pair[1].parameters);
+    }
+    // The results file is the records, one per line, by index.
+    assert_eq!(read_results(dir.path()).unwrap(), *records);
+    let summary = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
+    assert!(
+        summary.contains("| autonomy.planner_safety_m = 0.4 | 10 |"),
+        "{summary}"
+    );
+    assert!(
+        summary.contains("| autonomy.planner_safety_m = 0.6 | 10 |"),
+        "{summary}"
+    );
+    // Every failing variant and only those has a failure file, listed in the error table.
+    let files = std::fs::read_dir(dir.path().join("failures"))
+        .unwrap()
+        .count();
+    assert_eq!(files, records.iter().filter(|r| r.failed).count());
+    for r in records.iter().filter(|r| r.failed) {
+        assert!(
+            !r.failures.is_empty() && (r.contacts > 0 || !r.expectations_met),
+            "{r:?}"
+        );
+        assert!(
+            summary.contains(&format!("`failures/{}.toml`", r.index)),
+            "{summary}"
+        );
+    }
+    // The chart: a point per run, and the two of the legend.
+    let svg = std::fs::read_to_string(dir.path().join("clearance.svg")).unwrap();
+    assert_eq!(svg.matches("<circle").count(), records.len() + 2);
+    assert!(summary.contains("(clearance.svg)"));
+    // One map served all 20 runs: the static world never changed.
+    assert_eq!(
+        std::fs::read_dir(dir.path().join("maps")).unwrap().count(),
+        1
+    );
+}
+
+#[test]
+fn results_are_the_same_whatever_jobs() {
+    let (_, records) = full();
+    let dir = tempfile::tempdir().unwrap();
+    let one = run(&smoke(), dir.path(), 1, Some(8));
+    assert_eq!(one.len(), 8);
+    for (a, b) in one.iter().zip(records) {
+        assert_eq!(timeless(a), timeless(b));
+    }
+}
+
+#[test]
+fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
+    let (_, records) = full();
+    let dir = tempfile::tempdir().unwrap();
+    let campaign = smoke();
+    let first = run(&campaign, dir.path(), 2, Some(3));
+    assert_eq!(first.len(), 3);
+    // A process killed in the middle of a line.
+    let results = dir.path().join("results.jsonl");
+    let mut text = std::fs::read_to_string(&results).unwrap();
+    text.push_str("{\"index\":3,\"sample\":1,\"se");
+    std::fs::write(&results, text).unwrap();
+    let stop = AtomicBool::new(false);
+    let outcome = run_campaign(
+        &campaign,
+        &RunOptions {
+            shard: None,
+            maps_dir: None,
+            out: dir.path().to_path_buf(),
+            jobs: 2,
+            runs: Some(5),
+            stop: &stop,
+            progress: &|_| {},
+        },
+    )
+    .unwrap();
+    assert_eq!(outcome.ran, 2, "variants 3 and 4 only");
+    assert_eq!(outcome.records.len(), 5);
+    for (a, b) in outcome.records.iter().zip(records) {
+        assert_eq!(timeless(a), timeless(b));
+    }
+    // Another campaign's results are never mixed in.
+    let other = dir.path().join("other.toml");
+    let text = std::fs::read_to_string(smoke_path())
+        .unwrap()
+        .replace("seed = 1", "seed = 2");
+    std::fs::write(
+        &other,
+        text.replace(
+            "\"../cone_in_path_car.toml\"",
+            &format!(
+                "{:?}",
+                smoke_path()
+                    .parent()
+                    .unwrap()
+                    .join("../cone_in_path_car.toml")
+            ),
+        ),
+    )
+    .unwrap();
+    let e = run_campaign(
+        &Campaign::from_file(&other).unwrap(),
+        &RunOptions {
+            shard: None,
+            maps_dir: None,
+            out: dir.path().to_path_buf(),
+            jobs: 1,
+            runs: Some(1),
+            stop: &stop,
+            progress: &|_| {},
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("campaign.json") && e.contains("another campaign"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_stop_keeps_only_whole_runs_and_the_rest_runs_later() {
+    let (_, records) = full();
+    let dir = tempfile::tempdir().unwrap();
+    let campaign = smoke();
+    let stop = AtomicBool::new(false);
+    let outcome = run_campaign(
+        &campaign,
+        &RunOptions {
+            shard: None,
+            maps_dir: None,
+            out: dir.path().to_path_buf(),
+            jobs: 1,
+            runs: Some(4),
+            stop: &stop,
+            progress: &|_| stop.store(true, Ordering::Relaxed),
+        },
+    )
+    .unwrap();
+    assert!(outcome.interrupted);
+    assert_eq!(
+        outcome.records.len(),
+        1,
+        "the run in flight when stopped finished: {:?}",
+        outcome.records
+    );
+    assert_eq!(read_results(dir.path()).unwrap().len(), 1);
+    let rest = run(&campaign, dir.path(), 2, Some(4));
+    assert_eq!(rest.len(), 4);
+    for (a, b) in rest.iter().zip(records) {
+        assert_eq!(timeless(a), timeless(b));
+    }
+}
+
+#[test]
+fn bad_campaign_files_are_refused_with_their_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = smoke_path()
+        .parent()
+        .unwrap()
+        .join("../cone_in_path_car.toml");
+    let head = format!("name = \"x\"\nbase = {base:?}\nruns = 4\n");
+    let cases = [
+        ("runz = 3\n", "2:1", "unknown field `runz`"),
+        (
+            "[[obstacles]]\nid = \"c\"\nalong_m = { uniform = [5.0, 1.0] }\n",
+            "5:1",
+            "uniform = [5, 1]",
+        ),
+        ("[[obstacles]]\nkind = \"cone\"\n", "5:1", "needs an `id`"),
+        (
+            "[parameters]\n\"autonomy.planner_safty_m\" = [0.4]\n",
+            "5:1",
+            "planner_safty_m",
+        ),
+        ("sampler = \"sobol\"\n", "5:11", "unknown variant `sobol`"),
+    ];
+    for (i, (tail, place, words)) in cases.iter().enumerate() {
+        let text = if tail.starts_with("runz") {
+            format!("name = \"x\"\n{tail}base = {base:?}\nruns = 4\n")
+        } else {
+            format!("{head}\n{tail}")
+        };
+        let file = dir.path().join(format!("c{i}.toml"));
+        std::fs::write(&file, text).unwrap();
+        let e = Campaign::from_file(&file).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("c{i}.toml:{place}")) && e.contains(words),
+            "case {i}: {e}"
+        );
+    }
+}
+
+#[test]
+fn a_scenario_config_table_is_checked_and_used() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(
+        smoke_path()
+            .parent()
+            .unwrap()
+            .join("../cone_in_path_car.toml"),
+    )
+    .unwrap();
+    let file = dir.path().join("s.toml");
+    std::fs::write(
+        &file,
+        format!("{base}\n[config.autonomy]\nplanner_safty_m = 0.4\n"),
+    )
+    .unwrap();
+    let e = sim::scenario::Scenario::from_file(&file)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`config`") && e.contains("planner_safty_m"),
+        "{e}"
+    );
+    std::fs::write(
+        &file,
+        format!("{base}\n[config.autonomy]\nplanner_safety_m = 0.4\n"),
+    )
+    .unwrap();
+    let s = sim::scenario::Scenario::from_file(&file).unwrap();
+    let c = sim::scenario::RunConfig::for_scenario(&s, None).unwrap();
+    assert_eq!(c.autonomy.planner_safety_m, 0.4);
+    assert_eq!(
+        c.autonomy.avoider_safety_m,
+        sim::scenario::RunConfig::default()
+            .autonomy
+            .avoider_safety_m
+    );
+}
+
+#[test]
+fn every_shipped_campaign_reads_and_its_first_variants_are_valid_scenarios() {
+    let dir = smoke_path().parent().unwrap().to_path_buf();
+    let mut names = Vec::new();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let campaign = Campaign::from_file(&path).unwrap_or_else(|e| panic!("{e}"));
+        for i in 0..8 {
+            let v = variant(&campaign, i, &[]);
+            sim::scenario::Scenario::from_str(&v.text, &campaign.variant_path(i))
+                .unwrap_or_else(|e| panic!("{} variant {i}: {e}\n{}", path.display(), v.text));
+        }
+        names.push(path.file_stem().unwrap().to_string_lossy().into_owned());
+    }
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "faults",
+            "faults_aerodrome",
+            "jet_wing_and_engine_paths",
+            "low_debris_car",
+            "parking_lot_random",
+            "smoke",
+            "tune_a320",
+            "tune_car",
+            "tune_praetor",
+            "tune_smoke"
+        ]
+    );
+}
+
+/// A draw the scenario rules refuse (here a cone on the start pose) is recorded as `invalid`,
+/// left out of the statistics, and the campaign goes on; the grid visits both choices.
+#[test]
+fn an_invalid_variant_is_recorded_and_the_campaign_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = smoke_path()
+        .parent()
+        .unwrap()
+        .join("../cone_in_path_car.toml");
+    let file = dir.path().join("c.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "name = \"x\"\nbase = {base:?}\nruns = 10\nsampler = \"grid\"\n\n[[obstacles]]\nid = \"cone_on_centreline\"\nalong_m = {{ choice = [0.0, 60.0] }}\n"
+        ),
+    )
+    .unwrap();
+    let records = run(
+        &Campaign::from_file(&file).unwrap(),
+        &dir.path().join("out"),
+        2,
+        None,
+    );
+    assert_eq!(records.len(), 2, "the grid has two points");
+    assert_eq!(records[0].end, "invalid");
+    assert!(
+        !records[0].failed && records[0].failures[0].contains("overlap"),
+        "{:?}",
+        records[0]
+    );
+    assert_eq!(records[1].end, "completed");
+    let summary = std::fs::read_to_string(dir.path().join("out/summary.md")).unwrap();
+    assert!(
+        summary.contains("1 variants were not valid scenarios"),
+        "{summary}"
+    );
+    assert!(summary.contains("| base | 1 |"), "{summary}");
+}
+
+#[test]
+fn the_falsifier_cannot_be_sharded() {
+    let mut campaign = smoke();
+    campaign.set_sampler(sim::campaign::SamplerKind::Falsify);
+    let dir = tempfile::tempdir().unwrap();
+    let stop = AtomicBool::new(false);
+    let e = run_campaign(
+        &campaign,
+        &RunOptions {
+            shard: Some(Shard { index: 0, count: 2 }),
+            maps_dir: None,
+            out: dir.path().to_path_buf(),
+            jobs: 1,
+            runs: Some(2),
+            stop: &stop,
+            progress: &|_| {},
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("cannot be split"), "{e}");
+}

@@ -1,0 +1,572 @@
+//! The Rapier world and the LiDAR on it: known geometry gives known ranges, the fast path equals
+//! the generic cast, noise is seeded, and the ground truth sees contacts where they happen.
+
+use aircraft::Vehicle;
+use nalgebra::{Isometry2, Isometry3, Vector2};
+use sim::world::{
+    Lidar, LidarConfig, ObjectKind, Owner, Scene, Solid, SolidShape, SweepPoses, World,
+};
+
+fn solid(id: &str, kind: ObjectKind, shape: SolidShape, x: f64, y: f64, yaw: f64) -> Solid {
+    Solid {
+        id: id.into(),
+        kind,
+        shape,
+        x_m: x,
+        y_m: y,
+        z_min_m: 0.0,
+        yaw_rad: yaw,
+        remission: 0.7,
+        runtime: false,
+    }
+}
+
+fn scene(solids: Vec<Solid>) -> Scene {
+    Scene {
+        min_m: [-150.0, -150.0],
+        max_m: [150.0, 150.0],
+        ground_remission: 0.2,
+        pavement_texture: 0.0,
+        solids,
+        patches: vec![],
+    }
+}
+
+fn noiseless() -> LidarConfig {
+    LidarConfig {
+        noise_stddev_m: 0.0,
+        ..Default::default()
+    }
+}
+
+fn car() -> Vehicle {
+    Vehicle::shipped("iara_car_fake_wing").unwrap()
+}
+
+/// The car's sensor mount, from its sidecar.
+fn mount(v: &Vehicle) -> Isometry3<f64> {
+    v.vehicle_from_lidar()
+}
+
+#[test]
+fn the_ground_is_at_each_beams_analytic_distance() {
+    let v = car();
+    let origin = Isometry2::identity();
+    let world = World::with_obstacles(&scene(vec![]), &v, &origin);
+    let lidar = Lidar::new(noiseless(), mount(&v)).unwrap();
+    let scan = lidar.scan(&world, &SweepPoses::still(origin), 0, 1);
+    let h = v.spec.lidar.xyz_m[2];
+    // Column 600 looks left. The lowest beams meet the car's own roof (self-hits, which the
+    // mapper filters); every other descending beam within range meets the ground where
+    // trigonometry says.
+    let (column, first) = (scan.scan.column(600).unwrap().1, 600 * 32);
+    let mut on_ground = 0;
+    for (b, el) in lidar.elevations_rad().iter().enumerate() {
+        let expected = h / (-el).sin();
+        match (column[b], scan.owners[first + b]) {
+            (Some(_), Some(Owner::VehiclePart(_))) => {
+                assert!(*el < -0.3, "beam {b} ({el} rad) hit the car")
+            }
+            (Some(r), Some(Owner::Ground)) => {
+                assert!(
+                    (r.range_m as f64 - expected).abs() < 2e-3,
+                    "beam {b}: {} vs {expected}",
+                    r.range_m
+                );
+                on_ground += 1;
+            }
+            (None, _) => assert!(
+                *el >= 0.0 || expected > 100.0,
+                "beam {b} at {el} rad missed the ground"
+            ),
+            (Some(r), owner) => panic!("beam {b} hit {owner:?} at {} in an empty world", r.range_m),
+        }
+    }
+    assert!(on_ground >= 15, "{on_ground} beams on the ground");
+}
+
+#[test]
+fn a_wall_face_and_a_cone_are_where_they_are() {
+    let v = car();
+    let origin = Isometry2::identity();
+    let wall = solid(
+        "wall",
+        ObjectKind::Building,
+        SolidShape::Box {
+            size_m: [1.0, 10.0, 3.0],
+        },
+        10.5,
+        0.0,
+        0.0,
+    );
+    let cone = solid(
+        "cone",
+        ObjectKind::Cone,
+        SolidShape::Cone {
+            radius_m: 0.18,
+            height_m: 0.45,
+        },
+        0.572,
+        6.0,
+        0.0,
+    );
+    let world = World::with_obstacles(&scene(vec![wall, cone]), &v, &origin);
+    let lidar = Lidar::new(noiseless(), mount(&v)).unwrap();
+    let scan = lidar.scan(&world, &SweepPoses::still(origin), 0, 1);
+    let sensor_x = v.spec.lidar.xyz_m[0];
+    // Column 0: straight ahead; every beam reaching the wall's face (x = 10) below 3 m.
+    let mut wall_hits = 0;
+    for (b, el) in lidar.elevations_rad().iter().enumerate() {
+        let t = (10.0 - sensor_x) / el.cos();
+        let z = 2.15 + t * el.sin();
+        if (0.0..3.0).contains(&z) && scan.owners[b] == Some(Owner::Object(0)) {
+            let r = scan.scan.column(0).unwrap().1[b].unwrap();
+            assert!(
+                (r.range_m as f64 - t).abs() < 2e-3,
+                "beam {b}: {} vs {t}",
+                r.range_m
+            );
+            assert!((r.point_in_world.x - 10.0).abs() < 2e-3);
+            wall_hits += 1;
+        }
+    }
+    // From 2.15 m, 9.43 m away, a 3 m wall spans -12.8 to +5.2 deg: 13 beams 1.33 deg apart.
+    assert!(wall_hits >= 13, "{wall_hits} beams on the wall");
+    // The cone: every hit lies on its lateral surface, radius 0.18 (1 - z / 0.45) from its axis.
+    let mut cone_hits = 0;
+    for (i, owner) in scan.owners.iter().enumerate() {
+        if *owner == Some(Owner::Object(1)) {
+            let p = scan.scan.returns()[i].unwrap().point_in_world;
+            let radial = (p.x - sensor_x).hypot(p.y - 6.0);
+            assert!((radial - 0.18 * (1.0 - p.z / 0.45)).abs() < 3e-3, "{p:?}");
+            cone_hits += 1;
+        }
+    }
+    assert!(cone_hits > 5, "{cone_hits} returns on the cone");
+}
+
+/// About 150 random boxes, cylinders and cones around the car.
+fn cluttered() -> Scene {
+    let mut state = 42u64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % 1_000_000) as f64 / 1_000_000.0
+    };
+    let mut solids = Vec::new();
+    for i in 0..150 {
+        let (x, y) = (next() * 120.0 - 60.0, next() * 120.0 - 60.0);
+        if x.abs() < 4.0 && y.abs() < 4.0 {
+            continue;
+        }
+        let shape = match i % 3 {
+            0 => SolidShape::Box {
+                size_m: [0.5 + 4.0 * next(), 0.5 + 4.0 * next(), 0.3 + 5.0 * next()],
+            },
+            1 => SolidShape::Cylinder {
+                radius_m: 0.1 + next(),
+                height_m: 0.3 + 6.0 * next(),
+            },
+            _ => SolidShape::Cone {
+                radius_m: 0.15 + 0.3 * next(),
+                height_m: 0.3 + next(),
+            },
+        };
+        solids.push(solid(
+            &format!("s{i}"),
+            ObjectKind::Box,
+            shape,
+            x,
+            y,
+            next() * std::f64::consts::TAU,
+        ));
+    }
+    scene(solids)
+}
+
+/// Distance from a point to the surface of a vertical cylinder or cone (apex up), metres.
+fn surface_residual(solid: &Solid, p: &nalgebra::Point3<f64>) -> f64 {
+    let radial = (p.x - solid.x_m).hypot(p.y - solid.y_m);
+    match solid.shape {
+        SolidShape::Cylinder { radius_m, height_m } => {
+            (radial - radius_m).abs().min((p.z - height_m).abs())
+        }
+        SolidShape::Cone { radius_m, height_m } => {
+            (radial - radius_m * (1.0 - p.z / height_m)).abs()
+                * (height_m / radius_m.hypot(height_m))
+        }
+        SolidShape::Box { .. } => f64::NAN,
+    }
+}
+
+/// Distance from a point to a vertical cylinder or cone (0 inside), metres: a bound for grazes.
+fn surface_distance(solid: &Solid, p: &nalgebra::Point3<f64>) -> f64 {
+    let radial = (p.x - solid.x_m).hypot(p.y - solid.y_m);
+    let (r, h) = match solid.shape {
+        SolidShape::Cylinder { radius_m, height_m } => (radius_m, height_m),
+        SolidShape::Cone { radius_m, height_m } => (
+            radius_m * (1.0 - p.z.clamp(0.0, height_m) / height_m),
+            height_m,
+        ),
+        SolidShape::Box { .. } => return f64::INFINITY,
+    };
+    (radial - r).max(0.0).hypot((p.z - h).max(0.0))
+}
+
+/// The fast path equals the generic cast: same hits, same owners, ranges within 1 mm - except
+/// on cylinders and cones, which parry casts by GJK iterations (a few mm off) and the fast path
+/// in closed form: there the fast hit must lie on the true surface (within 0.1 mm).
+fn assert_same(a: &sim::world::LidarScan, b: &sim::world::LidarScan, scene: &Scene) {
+    let mut hits = 0;
+    let mut gjk_differences = 0;
+    let mut grazes = 0;
+    // The nearer of two disagreeing hits is on a cylinder or cone, within 5 mm of its surface.
+    let grazing = |near: &mapper::Return, owner: Option<Owner>, far: Option<&mapper::Return>| {
+        let Some(Owner::Object(o)) = owner else {
+            return false;
+        };
+        far.is_none_or(|f| f.range_m > near.range_m)
+            && surface_distance(&scene.solids[o], &near.point_in_world) < 5e-3
+    };
+    for (i, (ra, rb)) in a.scan.returns().iter().zip(b.scan.returns()).enumerate() {
+        let (oa, ob) = (a.owners[i], b.owners[i]);
+        match (ra, rb) {
+            (Some(x), Some(y)) if oa == ob => {
+                if (x.range_m - y.range_m).abs() >= 1e-3 {
+                    let Some(Owner::Object(o)) = oa else {
+                        panic!("ray {i}: {} vs {}", x.range_m, y.range_m)
+                    };
+                    let solid = &scene.solids[o];
+                    assert!(
+                        !matches!(solid.shape, SolidShape::Box { .. }),
+                        "ray {i} on a box: {} vs {}",
+                        x.range_m,
+                        y.range_m
+                    );
+                    assert!(
+                        (x.range_m - y.range_m).abs() < 0.02,
+                        "ray {i}: {} vs {}",
+                        x.range_m,
+                        y.range_m
+                    );
+                    let r = surface_residual(solid, &x.point_in_world);
+                    assert!(r < 1e-4, "ray {i}: the fast hit is {r} m off the surface");
+                    gjk_differences += 1;
+                }
+                hits += 1;
+            }
+            (None, None) => {}
+            (Some(x), other) if grazing(x, oa, other.as_ref()) => grazes += 1,
+            (other, Some(y)) if grazing(y, ob, other.as_ref()) => grazes += 1,
+            _ => panic!("ray {i}: {ra:?} vs {rb:?} ({oa:?} / {ob:?})"),
+        }
+    }
+    assert!(hits > 40_000, "{hits} hits");
+    assert!(
+        gjk_differences < hits / 100,
+        "{gjk_differences} rays differ by more than 1 mm"
+    );
+    assert!(grazes < 30, "{grazes} grazes");
+}
+
+#[test]
+fn the_fast_path_equals_the_generic_cast() {
+    let v = car();
+    let pose = Isometry2::new(Vector2::new(1.0, -2.0), 0.7);
+    let scene = cluttered();
+    let world = World::with_obstacles(&scene, &v, &pose);
+    let lidar = Lidar::new(noiseless(), mount(&v)).unwrap();
+    let sweep = SweepPoses::still(pose);
+    assert_same(
+        &lidar.scan(&world, &sweep, 3, 9),
+        &lidar.scan_generic(&world, &sweep, 3, 9),
+        &scene,
+    );
+    // Moving during the sweep: every column from its own pose, both paths alike.
+    let moving = Lidar::new(
+        LidarConfig {
+            motion_during_sweep: true,
+            ..noiseless()
+        },
+        mount(&v),
+    )
+    .unwrap();
+    let sweep = SweepPoses {
+        start: pose,
+        end: Isometry2::new(Vector2::new(2.0, -1.5), 0.9),
+    };
+    let (fast, generic) = (
+        moving.scan(&world, &sweep, 3, 9),
+        moving.scan_generic(&world, &sweep, 3, 9),
+    );
+    assert_same(&fast, &generic, &scene);
+    let first = fast.scan.columns()[0].world_from_vehicle.translation.vector;
+    let last = fast.scan.columns()[2186]
+        .world_from_vehicle
+        .translation
+        .vector;
+    assert!(
+        (first - pose.translation.vector).norm() < 1e-9
+            && (last - Vector2::new(2.0, -1.5)).norm() < 0.01
+    );
+}
+
+#[test]
+fn noise_and_dropout_are_reproducible_by_seed() {
+    let v = car();
+    let pose = Isometry2::identity();
+    let world = World::with_obstacles(&cluttered(), &v, &pose);
+    let config = LidarConfig {
+        dropoff_general_rate: 0.3,
+        ..Default::default()
+    };
+    let lidar = Lidar::new(config, mount(&v)).unwrap();
+    let sweep = SweepPoses::still(pose);
+    let bits = |s: &sim::world::LidarScan| {
+        s.scan
+            .returns()
+            .iter()
+            .map(|r| r.map(|r| r.range_m.to_bits()))
+            .collect::<Vec<_>>()
+    };
+    let a = lidar.scan(&world, &sweep, 5, 11);
+    assert_eq!(
+        bits(&a),
+        bits(&lidar.scan(&world, &sweep, 5, 11)),
+        "same seed and scan: same returns"
+    );
+    assert_ne!(
+        bits(&a),
+        bits(&lidar.scan(&world, &sweep, 5, 12)),
+        "another seed: other noise"
+    );
+    assert_ne!(
+        bits(&a),
+        bits(&lidar.scan(&world, &sweep, 6, 11)),
+        "another scan: other noise"
+    );
+    // Thread count does not matter.
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| lidar.scan(&world, &sweep, 5, 11));
+    assert_eq!(bits(&a), bits(&one));
+    // About 30 % dropped among rays that hit something.
+    let noiseless_hits = Lidar::new(noiseless(), mount(&v))
+        .unwrap()
+        .scan(&world, &sweep, 5, 11)
+        .scan
+        .returns()
+        .iter()
+        .flatten()
+        .count();
+    let kept = a.scan.returns().iter().flatten().count();
+    let dropped = 1.0 - kept as f64 / noiseless_hits as f64;
+    assert!((dropped - 0.3).abs() < 0.01, "dropped {dropped}");
+    // The range noise has the configured spread (2 cm) on the ground ahead.
+    let exact = Lidar::new(noiseless(), mount(&v))
+        .unwrap()
+        .scan(&world, &sweep, 5, 11);
+    let noisy = Lidar::new(LidarConfig::default(), mount(&v))
+        .unwrap()
+        .scan(&world, &sweep, 5, 11);
+    let diffs: Vec<f64> = exact
+        .scan
+        .returns()
+        .iter()
+        .zip(noisy.scan.returns())
+        .filter_map(|(e, n)| Some((n.as_ref()?.range_m - e.as_ref()?.range_m) as f64))
+        .collect();
+    let sd = (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len() as f64).sqrt();
+    assert!((sd - 0.02).abs() < 0.001, "noise sd {sd}");
+}
+
+#[test]
+fn intensity_follows_remission_and_distance() {
+    let v = car();
+    let pose = Isometry2::identity();
+    let mut s = scene(vec![]);
+    s.patches.push(sim::world::Patch {
+        id: "line".into(),
+        x_m: 8.0,
+        y_m: 0.0,
+        yaw_rad: 1.57,
+        length_m: 40.0,
+        width_m: 1.0,
+        remission: 0.9,
+    });
+    let world = World::with_obstacles(&s, &v, &pose);
+    let lidar = Lidar::new(noiseless(), mount(&v)).unwrap();
+    let scan = lidar.scan(&world, &SweepPoses::still(pose), 0, 1);
+    let ground = scan
+        .scan
+        .returns()
+        .iter()
+        .zip(&scan.owners)
+        .filter(|(_, o)| **o == Some(Owner::Ground));
+    let mut on = 0;
+    for (r, _) in ground {
+        let Some(r) = r else { continue };
+        let on_line = (r.point_in_world.x - 8.0).abs() < 0.45 && r.point_in_world.y.abs() < 19.0;
+        let off_line = (r.point_in_world.x - 8.0).abs() > 0.55 || r.point_in_world.y.abs() > 21.0;
+        let expected = |rem: f64| (rem * (-0.004 * r.range_m as f64).exp()) as f32;
+        if on_line {
+            assert!((r.intensity - expected(0.9)).abs() < 1e-3);
+            on += 1;
+        } else if off_line {
+            assert!((r.intensity - expected(0.2)).abs() < 1e-3);
+        }
+    }
+    assert!(on > 20, "{on} returns on the painted line");
+}
+
+#[test]
+fn driving_into_a_cone_is_a_contact_and_the_wing_passes_over_a_short_one() {
+    let v = car();
+    // The fake wing is on the right (negative y): a 0.45 m cone in its path, another ahead of the body.
+    let under_wing = solid(
+        "under_wing",
+        ObjectKind::Cone,
+        SolidShape::Cone {
+            radius_m: 0.18,
+            height_m: 0.45,
+        },
+        20.0,
+        -1.4,
+        0.0,
+    );
+    let ahead = solid(
+        "ahead",
+        ObjectKind::Cone,
+        SolidShape::Cone {
+            radius_m: 0.18,
+            height_m: 0.45,
+        },
+        40.0,
+        0.0,
+        0.0,
+    );
+    let mut world =
+        World::with_obstacles(&scene(vec![under_wing, ahead]), &v, &Isometry2::identity());
+    let mut t = 0.0;
+    let mut x = 0.0;
+    while x < 30.0 {
+        world.set_vehicle_pose(&Isometry2::new(Vector2::new(x, 0.0), 0.0), t);
+        x += 0.05;
+        t += 0.01;
+    }
+    assert!(
+        world.contacts().is_empty(),
+        "the wing passed over: {:?}",
+        world.contacts()
+    );
+    let over = world.min_clearances_m()[0];
+    assert!(
+        (over - 0.25).abs() < 0.03,
+        "the board (0.7 m) clears the cone tip (0.45 m) by {over}"
+    );
+    while x < 40.0 {
+        world.set_vehicle_pose(&Isometry2::new(Vector2::new(x, 0.0), 0.0), t);
+        x += 0.05;
+        t += 0.01;
+    }
+    let contacts = world.contacts();
+    assert_eq!(contacts.len(), 1, "{contacts:?}");
+    assert_eq!(contacts[0].object, "ahead");
+    assert_eq!(contacts[0].kind, ObjectKind::Cone);
+    // The front bumper meets the cone when x + front reach = 40 - 0.18 (front ~3.47 m ahead).
+    assert!(contacts[0].time_s > 0.0 && !contacts[0].part.is_empty());
+    assert_eq!(world.min_clearances_m()[1], 0.0);
+}
+
+#[test]
+fn a_scan_written_as_ply_reads_back_point_for_point() {
+    let v = car();
+    let pose = Isometry2::new(Vector2::new(3.0, 4.0), 0.5);
+    let world = World::with_obstacles(&cluttered(), &v, &pose);
+    let lidar = Lidar::new(LidarConfig::default(), mount(&v)).unwrap();
+    let scan = lidar.scan(&world, &SweepPoses::still(pose), 0, 1);
+    let dir = tempfile::tempdir().unwrap();
+    for frame in [
+        sim::world::ply::Frame::World,
+        sim::world::ply::Frame::Sensor,
+    ] {
+        let path = dir.path().join("scan.ply");
+        sim::world::ply::write(&scan, frame, &path).unwrap();
+        let points = sim::world::ply::decode(&std::fs::read(&path).unwrap()).unwrap();
+        let returns: Vec<(usize, mapper::Return)> = scan
+            .scan
+            .returns()
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| Some((i, (*r)?)))
+            .collect();
+        assert_eq!(points.len(), returns.len());
+        for (p, (i, r)) in points.iter().zip(&returns) {
+            let (c, b) = (i / 32, i % 32);
+            assert_eq!((p.column as usize, p.beam as usize), (c, b));
+            let expected = match frame {
+                sim::world::ply::Frame::World => r.point_in_world,
+                sim::world::ply::Frame::Sensor => scan.point_in_sensor(c, b).unwrap(),
+            };
+            for k in 0..3 {
+                assert!((p.xyz[k] as f64 - expected[k]).abs() < 1e-4);
+            }
+            assert_eq!(p.intensity, r.intensity);
+        }
+        // Sensor frame: the range is the distance from the origin.
+        if frame == sim::world::ply::Frame::Sensor {
+            let (p, (_, r)) = (points[100], returns[100]);
+            assert!(
+                ((p.xyz[0].powi(2) + p.xyz[1].powi(2) + p.xyz[2].powi(2)).sqrt() - r.range_m).abs()
+                    < 1e-3
+            );
+        }
+    }
+}
+
+#[test]
+fn the_bicycle_at_100_hz_drives_the_kinematic_body_into_a_cone() {
+    use sim::world::{Bicycle, Command, VehicleState};
+    let v = car();
+    let cone = solid(
+        "cone",
+        ObjectKind::Cone,
+        SolidShape::Cone {
+            radius_m: 0.18,
+            height_m: 0.45,
+        },
+        25.0,
+        2.0,
+        0.0,
+    );
+    let mut world = World::with_obstacles(&scene(vec![cone]), &v, &Isometry2::identity());
+    let bicycle = Bicycle::new(v.spec.motion.clone());
+    let mut state = VehicleState::default();
+    // Accelerate to 4 m/s, steering gently left towards the cone 2 m left of the straight line.
+    let command = Command {
+        speed_m_s: 4.0,
+        steering_rad: 0.012,
+    };
+    let dt = 0.01;
+    let mut t = 0.0;
+    while t < 15.0 && world.contacts().is_empty() {
+        bicycle.step(&mut state, &command, dt);
+        t += dt;
+        world.set_vehicle_pose(&state.world_from_vehicle(), t);
+    }
+    let contact = world
+        .contacts()
+        .first()
+        .unwrap_or_else(|| panic!("no contact; vehicle ended at {state:?}"));
+    assert_eq!(contact.object, "cone");
+    assert!(
+        (contact.time_s - t).abs() < 1e-9 && state.x_m > 20.0 && state.x_m < 25.0,
+        "contact at {} s, x = {}",
+        contact.time_s,
+        state.x_m
+    );
+    assert!(state.y_m > 0.5, "the arc bent left: y = {}", state.y_m);
+}

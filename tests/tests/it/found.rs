@@ -1,0 +1,125 @@
+//! Failures the campaigns found and the stack does not handle yet, kept as plain scenario files
+//! in `tests/found/` and asserted as they are (FIXME), so a fix shows here first.
+
+use std::path::PathBuf;
+
+use sim::engine::{RunSetup, run};
+use sim::scenario::{RunConfig, Scenario};
+
+/// Runs a found scenario after its mapping drive (with the configuration the campaign found it
+/// with: the true pose - every one was found before the particle filter became the default).
+fn run_found(s: &Scenario) -> sim::engine::RunReport {
+    run_found_with(s, |c| {
+        c.pose_source = sim::scenario::PoseSourceConfig::Truth
+    })
+}
+
+/// [`run_found`] with the configuration changed by `change`.
+fn run_found_with(s: &Scenario, change: impl FnOnce(&mut RunConfig)) -> sim::engine::RunReport {
+    let dir = tempfile::tempdir().unwrap();
+    let mut config = RunConfig::for_scenario(s, None).unwrap();
+    change(&mut config);
+    sim::offline_map::map_drive(s, &config, dir.path(), &mut |_, _| {}).unwrap();
+    let setup = RunSetup {
+        config,
+        ..RunSetup::new(dir.path().to_path_buf())
+    };
+    run(s, &setup).unwrap()
+}
+
+fn found(name: &str) -> Scenario {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("found")
+        .join(format!("{name}.toml"));
+    Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// FIXME (README, Known problems: no prediction of movers): a van crossing the taxiway at
+/// 2.8 m/s from 35 m right of it reaches the centreline as the Praetor-like jet's nose does; the
+/// jet, which plans against where things are now, is still moving when its nose meets the van's
+/// side (34.5 s) and stops only after (35.8 s). Found by the jet campaign (variant 7).
+#[test]
+fn fixme_the_jet_drives_into_a_van_crossing_its_path() {
+    let s = found("jet_meets_crossing_vehicle");
+    let r = run_found(&s);
+    let first = r
+        .contacts
+        .first()
+        .expect("FIXME: the jet still meets the van");
+    assert_eq!(first.object, "crossing_vehicle_1");
+    assert_eq!(first.part, "nose");
+    assert!((34.0..35.0).contains(&first.time_s), "{first:?}");
+    // Moving when it met the van: its first stop began after the contact.
+    let stop = r.stops.first().expect("it stops after the contact");
+    assert!(stop.start_s > first.time_s, "{:?}", r.stops);
+}
+
+/// FIXME (README, Known problems): a 0.104 m piece of debris 0.39 m left of the car's
+/// centreline, just over the obstacle height (0.1 m): the car starts round it too late, stops
+/// 0.15 m short of it, and with the debris hidden under its nose waits and calls for a pilot
+/// rather than drive on. Found by the falsifier on the debris family (variant 258).
+#[test]
+fn fixme_the_car_stops_short_of_low_debris_and_calls_a_pilot() {
+    let s = found("car_stops_short_of_low_debris");
+    let r = run_found(&s);
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
+    assert_eq!(r.end, sim::engine::EndReason::WaitingForHiddenObstacle);
+    let pass = &r.obstacles[0].passes[0];
+    assert_eq!(pass.outcome, sim::engine::PassOutcome::Stopped);
+    assert!((0.1..0.2).contains(&pass.min_clearance_m[0]), "{pass:?}");
+}
+
+/// FIXME (README, Known problems): in about one in two hundred passes of the parking-lot
+/// campaign the car goes round a cone under its wing's path that it should pass under; here a
+/// 0.48 m cone 1.69 m right of the route (the wing is at 0.70 m) on the first aisle. Found by
+/// the parking-lot campaign (variant 487); not yet explained.
+#[test]
+fn fixme_the_car_goes_round_a_cone_it_should_pass_under() {
+    let r = run_found(&found("parking_lot_variant_487"));
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
+    let cone = r.obstacles.iter().find(|o| o.id == "cone_wing_1").unwrap();
+    assert_eq!(cone.passes[0].outcome, sim::engine::PassOutcome::Deviated);
+    assert!(!cone.passes[0].met);
+    let others_met = r
+        .obstacles
+        .iter()
+        .filter(|o| o.id != "cone_wing_1")
+        .all(|o| o.passes.iter().all(|p| p.met));
+    assert!(others_met, "{:?}", r.obstacles);
+}
+
+/// Variant 505's container pass, with no contact in the run and the car deviating round it, and
+/// its smallest clearance over the levels.
+fn container_pass(r: &sim::engine::RunReport) -> (&sim::engine::Pass, f64) {
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
+    let o = r.obstacles.iter().find(|o| o.id == "cone_path_1").unwrap();
+    let p = &o.passes[0];
+    assert_eq!(p.outcome, sim::engine::PassOutcome::Deviated);
+    let closest = p
+        .min_clearance_m
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    (p, closest)
+}
+
+/// FIXME (README, Known problems): the car goes round a 0.98 m container 0.11 m right of the
+/// route 0.19 m from it, inside the danger distance (0.2 m). Found by the parking-lot campaign
+/// (variant 505).
+#[test]
+fn fixme_the_car_passes_a_container_inside_the_danger_distance() {
+    let r = run_found(&found("parking_lot_variant_505"));
+    let (p, closest) = container_pass(&r);
+    assert!((0.15..0.2).contains(&closest), "{p:?}");
+    assert!(!p.met);
+}
+
+/// With the particle filter (the default since issue #24) the same variant passes the container
+/// 0.68 m off: the estimate's uncertainty widens the margins. The cause above is not found yet;
+/// this only shows the default hides it.
+#[test]
+fn with_the_particle_filter_the_container_is_passed_outside_the_danger_distance() {
+    let r = run_found_with(&found("parking_lot_variant_505"), |_| {});
+    let (p, closest) = container_pass(&r);
+    assert!(closest > 0.5 && p.met, "{p:?}");
+}

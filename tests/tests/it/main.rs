@@ -1,0 +1,14 @@
+//! End-to-end and regression tests of the workspace, one test binary (`cargo test -p tests --test
+//! it`): the closed loop on the small scenarios, the thesis' experiments against their goldens,
+//! localization, overhead structures, permanence of what is unseen, the failures the campaigns
+//! found, the distance cap and the mapping demo.
+
+mod closed_loop;
+mod common;
+mod demo;
+mod distance_cap;
+mod experiments;
+mod found;
+mod localization;
+mod overhead;
+mod permanence;
