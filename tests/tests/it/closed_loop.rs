@@ -231,13 +231,13 @@ fn a_run_is_identical_for_the_same_seed() {
 fn every_shipped_scenario_is_run_by_a_test() {
     let here = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let sources: String = [
-        "tests/closed_loop.rs",
-        "tests/experiments.rs",
-        "tests/overhead.rs",
-        "tests/permanence.rs",
+        "closed_loop.rs",
+        "experiments.rs",
+        "overhead.rs",
+        "permanence.rs",
     ]
     .iter()
-    .map(|f| std::fs::read_to_string(here.join(f)).unwrap())
+    .map(|f| std::fs::read_to_string(here.join("tests/it").join(f)).unwrap())
     .collect();
     let mut shipped = Vec::new();
     for entry in std::fs::read_dir(here.join("../scenarios")).unwrap() {
