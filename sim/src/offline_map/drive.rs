@@ -119,7 +119,9 @@ pub fn map_drive(
     Ok(manifest)
 }
 
-/// Writes each level over the blocks' extent as a ROS map and a PNG; returns occupied cells per level.
+/// Writes each level over the blocks' extent as a ROS map and a PNG; returns occupied cells per
+/// level. One level's image is held at a time (its blocks read again for each level), so the
+/// exports' memory is one level's extent, not every level's.
 fn export_levels(
     store: &BlockStore,
     levels: &Levels,
@@ -143,18 +145,20 @@ fn export_levels(
     );
     let origin = Point2::new(x0 as f64 * spec.side_m(), y0 as f64 * spec.side_m());
     let geometry = GridGeometry::new(origin, spec.resolution_m, w, h)?;
-    let mut grids: Vec<Grid<f32>> = (0..levels.count())
-        .map(|_| Grid::filled(geometry, -1.0))
-        .collect();
-    for index in indices {
-        let Some(block) = store.load(index)? else {
-            continue;
-        };
-        let (ox, oy) = (
-            ((index.x - x0) as usize) * side,
-            ((index.y - y0) as usize) * side,
-        );
-        for (grid, level) in grids.iter_mut().zip(&block.levels) {
+    let mut occupied = Vec::new();
+    for k in 0..levels.count() {
+        let mut grid = Grid::filled(geometry, -1.0f32);
+        for &index in &indices {
+            let Some(block) = store.load(index)? else {
+                continue;
+            };
+            let Some(level) = block.levels.get(k) else {
+                continue;
+            };
+            let (ox, oy) = (
+                ((index.x - x0) as usize) * side,
+                ((index.y - y0) as usize) * side,
+            );
             let data = grid.data_mut();
             for r in 0..side {
                 for c in 0..side {
@@ -167,16 +171,13 @@ fn export_levels(
                 }
             }
         }
-    }
-    let mut occupied = Vec::new();
-    for (k, grid) in grids.iter().enumerate() {
         write_ros_map_as(
-            grid,
+            &grid,
             &out.join(format!("level{k}.yaml")),
             TrinaryThresholds::default(),
             RosImage::Png,
         )?;
-        write_occupancy_png(grid, &out.join(format!("level{k}.png")))?;
+        write_occupancy_png(&grid, &out.join(format!("level{k}.png")))?;
         occupied.push(grid.data().iter().filter(|&&p| p > 0.5).count());
     }
     Ok(occupied)
