@@ -1,14 +1,14 @@
 //! Map blocks on disk: the documented binary format, atomic writes, and a directory store.
 //!
 //! A map is tiled into square blocks (70 m, 350 x 350 cells by default). Each block file holds
-//! every level's log-odds and the remission statistics of its cells, the body compressed
-//! losslessly with Zstandard (most cells are unknown, saturated free or never hit: a 2.4 MB body
-//! is typically 0.1-0.3 MB on disk). Format version 2, all numbers little-endian:
+//! every level's log-odds and the remission statistics of its cells, the body compressed with
+//! Zstandard (most cells are unknown, saturated free or never hit). Format version 3, all
+//! numbers little-endian:
 //!
 //! | offset | size | field |
 //! | --- | --- | --- |
 //! | 0 | 8 | magic `TAXIBLK\0` |
-//! | 8 | 4 | format version (u32, = 1) |
+//! | 8 | 4 | format version (u32, = 3) |
 //! | 12 | 4 | number of levels N (u32) |
 //! | 16 | 4 | level mode (u32: 0 cumulative, 1 banded) |
 //! | 20 | 4 | cells per block side S (u32) |
@@ -20,38 +20,47 @@
 //! | 52+8N | C | the body as one Zstandard frame (below) |
 //! | end-4 | 4 | CRC-32 (IEEE) of every byte before it |
 //!
-//! The body, `4*S*S*N + 12*S*S` bytes once decompressed:
+//! The body, `4*S*S*N + 6*S*S` bytes once decompressed, each a plane of S*S cells, row 0 =
+//! lowest y:
 //!
 //! | size | field |
 //! | --- | --- |
-//! | 4*S*S*N | log-odds of every cell, level after level, row 0 = lowest y (f32; NaN = unknown) |
-//! | 12*S*S | remission per cell: sum (f32), sum of squares (f32), count (u32) |
+//! | 4*S*S*N | log-odds of every cell, level after level (f32, exact; NaN = unknown) |
+//! | S*S | remission mean, in steps of 1/255 over 0..1 (u8) |
+//! | S*S | remission spread (standard deviation), in steps of 1/510 over 0..0.5 (u8) |
+//! | 4*S*S | remission samples (u32, exact) |
 //!
-//! Version 1 (before compression) was the header and the body uncompressed, without the length;
-//! it is refused with a message saying to rebuild the map.
+//! The remission is stored quantized ([`crate::remission::QuantizedRemission`]): read back, a
+//! cell's mean is within 0.002 and its spread within 0.001 of what was written, its count exact;
+//! the log-odds are stored as they are. Versions 1 (uncompressed) and 2 (the remission as float
+//! sums, which made a textured pavement's blocks 2.4 times larger) are refused with a message
+//! saying to rebuild the map.
 //!
 //! A file is written to a temporary file in the same directory and renamed over the target, so
 //! a reader never sees half a block. Reading checks the size, magic, version, that the header
 //! matches the map being loaded into, the checksum, that the body decompresses to its exact size
-//! (never more: a hostile frame cannot make it allocate beyond a block), and that every value is one the map can hold
-//! (a valid checksum only says the bytes are the ones written): a log-odds is NaN (unknown) or
-//! within the map's clamp `+-l_max` (so never infinite); a remission sum and sum of squares are
-//! finite, the sum of squares is not negative, and a cell without samples has zero sums. Any
-//! mismatch is an error naming the file and the field (with the level and cell of a bad value).
+//! (never more: a hostile frame cannot make it allocate beyond a block), and that every value is
+//! one the map can hold (a valid checksum only says the bytes are the ones written): a log-odds
+//! is NaN (unknown) or within the map's clamp `+-l_max` (so never infinite); a remission cell
+//! without samples has a zero mean and spread. Any mismatch is an error naming the file and the
+//! field (with the level and cell of a bad value).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::error::{MapError, Result};
 use crate::levels::{LevelMode, Levels};
-use crate::remission::RemissionCell;
+use crate::remission::{QuantizedRemission, RemissionCell};
 
 const MAGIC: &[u8; 8] = b"TAXIBLK\0";
 /// Version of the block format this crate writes and reads.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 /// Zstandard level of the body: 1, the fastest (level 3 saves 12 % more and costs a third more
 /// time to write).
 const ZSTD_LEVEL: i32 = 1;
+
+/// Bytes of a cell's remission in the body: mean (u8), spread (u8), count (u32).
+const REMISSION_BYTES: usize = 6;
 
 /// Index of a block in the world's tiling.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -85,7 +94,7 @@ impl BlockSpec {
     }
     fn body_len(&self) -> usize {
         let cells = self.side * self.side;
-        4 * cells * self.levels.count() + 12 * cells
+        4 * cells * self.levels.count() + REMISSION_BYTES * cells
     }
 }
 
@@ -117,10 +126,16 @@ impl Block {
     }
 }
 
-/// Serialises a block (format above) into bytes. Fails only if the compressor cannot allocate.
+/// Serialises a block (format above) into bytes. Fails when a remission cell is not the
+/// statistics of intensities in 0..1 (naming the cell), or if the compressor cannot allocate.
 pub fn encode_block(spec: &BlockSpec, block: &Block) -> Result<Vec<u8>> {
-    let body = encode_body(spec, block);
-    let packed = zstd::bulk::compress(&body, ZSTD_LEVEL)
+    frame_body(spec, block.index, &encode_body(spec, block)?)
+}
+
+/// A block file (format above) around `body`, an uncompressed body of [`encode_body`]'s layout:
+/// public so that tests can write bodies no map writes.
+pub fn frame_body(spec: &BlockSpec, index: BlockIndex, body: &[u8]) -> Result<Vec<u8>> {
+    let packed = zstd::bulk::compress(body, ZSTD_LEVEL)
         .map_err(|e| MapError::invalid("block", format!("zstd could not compress it: {e}")))?;
     let mut out = Vec::with_capacity(spec.header_len() + 8 + packed.len());
     out.extend_from_slice(MAGIC);
@@ -129,8 +144,8 @@ pub fn encode_block(spec: &BlockSpec, block: &Block) -> Result<Vec<u8>> {
     out.extend_from_slice(&mode_code(spec.levels.mode()).to_le_bytes());
     out.extend_from_slice(&(spec.side as u32).to_le_bytes());
     out.extend_from_slice(&spec.resolution_m.to_le_bytes());
-    out.extend_from_slice(&block.index.x.to_le_bytes());
-    out.extend_from_slice(&block.index.y.to_le_bytes());
+    out.extend_from_slice(&index.x.to_le_bytes());
+    out.extend_from_slice(&index.y.to_le_bytes());
     for h in spec.levels.heights_m() {
         out.extend_from_slice(&h.to_le_bytes());
     }
@@ -141,21 +156,48 @@ pub fn encode_block(spec: &BlockSpec, block: &Block) -> Result<Vec<u8>> {
     Ok(out)
 }
 
-/// A block's body, uncompressed (the format's table above). Public for benchmarks against the
-/// uncompressed format 1, whose body this was.
-pub fn encode_body(spec: &BlockSpec, block: &Block) -> Vec<u8> {
+/// A block's body, uncompressed (the format's table above); an error names the first remission
+/// cell that is not the statistics of intensities in 0..1. Public for benchmarks against the
+/// uncompressed format 1.
+pub fn encode_body(spec: &BlockSpec, block: &Block) -> Result<Vec<u8>> {
+    let cells = spec.side * spec.side;
     let mut body = Vec::with_capacity(spec.body_len());
     for level in &block.levels {
         for v in level {
             body.extend_from_slice(&v.to_le_bytes());
         }
     }
-    for r in &block.remission {
-        body.extend_from_slice(&r.sum.to_le_bytes());
-        body.extend_from_slice(&r.sum_sq.to_le_bytes());
-        body.extend_from_slice(&r.count.to_le_bytes());
+    let quantized = block
+        .remission
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            r.quantized().map_err(|why| {
+                MapError::invalid(
+                    "remission",
+                    format!(
+                        "block {:?}, {}: {why}",
+                        block.index,
+                        cell_name(spec.side, i)
+                    ),
+                )
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    body.extend(quantized.iter().map(|q| q.mean));
+    body.extend(quantized.iter().map(|q| q.spread));
+    for q in &quantized {
+        body.extend_from_slice(&q.count.to_le_bytes());
     }
-    body
+    debug_assert_eq!(
+        body.len(),
+        4 * cells * block.levels.len() + REMISSION_BYTES * cells
+    );
+    Ok(body)
+}
+
+fn cell_name(side: usize, i: usize) -> String {
+    format!("cell {i} (row {}, column {})", i / side, i % side)
 }
 
 fn mode_code(mode: LevelMode) -> u32 {
@@ -182,10 +224,15 @@ pub fn decode_block(spec: &BlockSpec, bytes: &[u8], path: &Path) -> Result<Block
         u64::from_le_bytes(b)
     };
     let version = u32_at(8);
-    if version == 1 {
+    let older = match version {
+        1 => Some("uncompressed blocks, before taxi-sim compressed them"),
+        2 => Some("the remission as float sums, before taxi-sim quantized it"),
+        _ => None,
+    };
+    if let Some(what) = older {
         return Err(bad(format!(
-            "format version 1 (uncompressed blocks, before taxi-sim compressed them), this \
-             build reads version {FORMAT_VERSION}: rebuild the map with `taxi-sim map`"
+            "format version {version} ({what}), this build reads version {FORMAT_VERSION}: \
+             rebuild the map with `taxi-sim map`"
         )));
     }
     if version != FORMAT_VERSION {
@@ -263,8 +310,9 @@ pub fn decode_block(spec: &BlockSpec, bytes: &[u8], path: &Path) -> Result<Block
     }
 }
 
-/// Decompresses a body straight into the cell arrays of block `index` (no intermediate copy):
-/// exactly the body's size, never more (a hostile frame cannot make it allocate beyond a block).
+/// Decompresses a body straight into the log-odds arrays of block `index` (no intermediate
+/// copy) and its remission planes into one buffer: exactly the body's size, never more (a
+/// hostile frame cannot make it allocate beyond a block).
 fn decompress_body(
     spec: &BlockSpec,
     packed: &[u8],
@@ -273,24 +321,19 @@ fn decompress_body(
     use std::io::Read as _;
     let cells = spec.side * spec.side;
     // Zeroed (calloc'd) arrays: every byte is overwritten below.
-    let mut block = Block {
-        index,
-        levels: (0..spec.levels.count())
-            .map(|_| bytemuck::zeroed_vec(cells))
-            .collect(),
-        remission: bytemuck::zeroed_vec(cells),
-    };
+    let mut levels: Vec<Vec<f32>> = (0..spec.levels.count())
+        .map(|_| bytemuck::zeroed_vec(cells))
+        .collect();
+    let mut remission = vec![0u8; REMISSION_BYTES * cells];
     let mut decoder = zstd::stream::read::Decoder::with_buffer(packed)
         .map_err(|e| format!("cannot be read: {e}"))?;
     let short = |e: std::io::Error| format!("does not decompress to a block: {e}");
-    for level in &mut block.levels {
+    for level in &mut levels {
         decoder
             .read_exact(bytemuck::cast_slice_mut(&mut level[..]))
             .map_err(short)?;
     }
-    decoder
-        .read_exact(bytemuck::cast_slice_mut(&mut block.remission[..]))
-        .map_err(short)?;
+    decoder.read_exact(&mut remission).map_err(short)?;
     let mut more = [0u8; 1];
     if decoder.read(&mut more).map_err(short)? != 0 {
         return Err(format!(
@@ -300,16 +343,46 @@ fn decompress_body(
     }
     // The file is little-endian; the arrays were filled with its bytes as they are.
     if cfg!(target_endian = "big") {
-        for v in block.levels.iter_mut().flatten() {
+        for v in levels.iter_mut().flatten() {
             *v = f32::from_bits(u32::from_le(v.to_bits()));
         }
-        for r in &mut block.remission {
-            r.sum = f32::from_bits(u32::from_le(r.sum.to_bits()));
-            r.sum_sq = f32::from_bits(u32::from_le(r.sum_sq.to_bits()));
-            r.count = u32::from_le(r.count);
-        }
     }
-    Ok(block)
+    let remission = remission_cells(spec.side, &remission)?;
+    Ok(Block {
+        index,
+        levels,
+        remission,
+    })
+}
+
+/// The remission cells of a body's three remission planes (`REMISSION_BYTES * side^2` bytes);
+/// an error names the first cell without samples whose mean or spread is not zero.
+fn remission_cells(side: usize, planes: &[u8]) -> std::result::Result<Vec<RemissionCell>, String> {
+    let cells = side * side;
+    let (means, rest) = planes.split_at(cells);
+    let (spreads, counts) = rest.split_at(cells);
+    means
+        .iter()
+        .zip(spreads)
+        .zip(counts.chunks_exact(4))
+        .enumerate()
+        .map(|(i, ((&mean, &spread), count))| {
+            let count = u32::from_le_bytes([count[0], count[1], count[2], count[3]]);
+            if count == 0 && (mean != 0 || spread != 0) {
+                return Err(format!(
+                    "field `remission.count`, {}: 0 samples but mean {mean} and spread {spread} \
+                     (steps; a cell without samples stores zeros)",
+                    cell_name(side, i)
+                ));
+            }
+            Ok(QuantizedRemission {
+                mean,
+                spread,
+                count,
+            }
+            .cell())
+        })
+        .collect()
 }
 
 /// Block `index` from its uncompressed body, checked value by value (the error says which);
@@ -326,30 +399,21 @@ pub fn decode_body(
             spec.body_len()
         ));
     }
-    let (n, cells) = (spec.levels.count(), spec.side * spec.side);
-    let bytes = body;
-    let mut o = 0;
-    let mut levels = Vec::with_capacity(n);
-    for _ in 0..n {
-        let level: Vec<f32> = bytes[o..o + 4 * cells]
-            .chunks_exact(4)
-            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .collect();
-        o += 4 * cells;
-        levels.push(level);
-    }
-    let remission = bytes[o..o + 12 * cells]
-        .chunks_exact(12)
-        .map(|b| RemissionCell {
-            sum: f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
-            sum_sq: f32::from_le_bytes([b[4], b[5], b[6], b[7]]),
-            count: u32::from_le_bytes([b[8], b[9], b[10], b[11]]),
+    let cells = spec.side * spec.side;
+    let (level_bytes, remission) = body.split_at(4 * cells * spec.levels.count());
+    let levels = level_bytes
+        .chunks_exact(4 * cells)
+        .map(|level| {
+            level
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect()
         })
         .collect();
     let block = Block {
         index,
         levels,
-        remission,
+        remission: remission_cells(spec.side, remission)?,
     };
     match bad_value(spec, &block) {
         Some(why) => Err(why),
@@ -357,19 +421,15 @@ pub fn decode_body(
     }
 }
 
-/// The first value of a block no map of `spec` can hold, described with its field, level and
+/// The first log-odds of a block no map of `spec` can hold, described with its field, level and
 /// cell; `None` when every value is possible.
 ///
 /// A log-odds is NaN (unknown, by design) or within `+-spec.l_max`: insertion clamps every update
 /// to it, free-space walks stop at `-l_max`, forgetting moves a cell toward its prior, and only
-/// live cells are saved, so an infinite or larger value was never written by a map. A remission
-/// cell is a sum and a sum of squares of finite intensities and their count
-/// ([`RemissionCell::add`]): the sums are finite, the sum of squares is not negative, and both
-/// are zero when the count is (a count cannot be negative: it is a `u32`). The sum itself may be
-/// negative: scans require finite intensities only, 0..1 is a convention.
+/// live cells are saved, so an infinite or larger value was never written by a map. (Remission
+/// cells are checked as they are read: every quantized value is possible but a mean or spread
+/// without samples.)
 fn bad_value(spec: &BlockSpec, block: &Block) -> Option<String> {
-    let side = spec.side;
-    let at = |i: usize| format!("cell {i} (row {}, column {})", i / side, i % side);
     for (k, level) in block.levels.iter().enumerate() {
         // NaN fails the comparison but is legitimate; test the fast common case first.
         let bad = level
@@ -385,32 +445,10 @@ fn bad_value(spec: &BlockSpec, block: &Block) -> Option<String> {
             return Some(format!(
                 "field `log_odds` of level {k}, {}: {v} is {what} (a cell is NaN = unknown or \
                  within +-{} = occupancy.l_max): no map with this clamp writes it",
-                at(i),
+                cell_name(spec.side, i),
                 spec.l_max
             ));
         }
-    }
-    for (i, r) in block.remission.iter().enumerate() {
-        let why = if !r.sum.is_finite() {
-            format!("field `remission.sum`, {}: {} is not finite", at(i), r.sum)
-        } else if !r.sum_sq.is_finite() || r.sum_sq < 0.0 {
-            format!(
-                "field `remission.sum_sq`, {}: {} is not a sum of squares (finite, >= 0)",
-                at(i),
-                r.sum_sq
-            )
-        } else if r.count == 0 && (r.sum != 0.0 || r.sum_sq != 0.0) {
-            format!(
-                "field `remission.count`, {}: 0 samples but sum {} and sum of squares {} \
-                 (a cell without samples has zero sums)",
-                at(i),
-                r.sum,
-                r.sum_sq
-            )
-        } else {
-            continue;
-        };
-        return Some(why);
     }
     None
 }
@@ -418,6 +456,15 @@ fn bad_value(spec: &BlockSpec, block: &Block) -> Option<String> {
 /// Writes `bytes` to `path` atomically: a temporary file in the same directory, synced, then renamed.
 /// The directory is created if it does not exist.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    let mut tmp = temp_beside(path)?;
+    tmp.write_all(bytes)
+        .map_err(|e| MapError::io(tmp.path(), e))?;
+    persist_synced(tmp, path)
+}
+
+/// A temporary file in `path`'s directory (created if missing), readable by others (0644), for
+/// [`persist_synced`] to rename over `path`.
+pub(crate) fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -428,9 +475,11 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     let mut builder = tempfile::Builder::new();
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
-    let mut tmp = builder.tempfile_in(dir).map_err(|e| MapError::io(dir, e))?;
-    tmp.write_all(bytes)
-        .map_err(|e| MapError::io(tmp.path(), e))?;
+    builder.tempfile_in(dir).map_err(|e| MapError::io(dir, e))
+}
+
+/// Syncs a finished temporary file and renames it over `path`.
+pub(crate) fn persist_synced(tmp: tempfile::NamedTempFile, path: &Path) -> Result<()> {
     tmp.as_file()
         .sync_all()
         .map_err(|e| MapError::io(tmp.path(), e))?;

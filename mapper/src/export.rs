@@ -5,7 +5,8 @@
 //! the YAML's `origin` is the world position of the lower-left pixel, and its thresholds are
 //! map_saver's (0.65 / 0.196) so 205 reads back as unknown. `.npy` arrays are float32,
 //! shape (rows, columns), row 0 = lowest y (so `array[iy, ix]` matches the grid's cells).
-//! Every file is written atomically.
+//! Every file is written atomically. A picture larger than memory should hold (a whole route's
+//! level) is written row by row with [`PngRows`], never held whole.
 
 use std::path::{Path, PathBuf};
 
@@ -13,7 +14,7 @@ use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
 use image::{ExtendedColorType, ImageEncoder};
 use serde::{Deserialize, Serialize};
 
-use crate::blocks::write_atomically;
+use crate::blocks::{persist_synced, temp_beside, write_atomically};
 use crate::error::{MapError, Result};
 use crate::grid::{Grid, GridGeometry};
 use crate::odm::DistanceMap;
@@ -55,6 +56,10 @@ impl Default for TrinaryThresholds {
 }
 
 impl TrinaryThresholds {
+    /// The ROS map pixel of a probability (negative = unknown).
+    pub fn pixel(&self, p: f32) -> u8 {
+        pixel(self.classify(p))
+    }
     /// Classifies a probability (negative = unknown, CARMEN's -1).
     pub fn classify(&self, p: f32) -> Trinary {
         if p.is_nan() || p < 0.0 {
@@ -144,21 +149,8 @@ pub fn write_ros_map_as(
 ) -> Result<PathBuf> {
     let g = probabilities.geometry();
     let (w, h) = dims(g)?;
-    let pgm_path = match format {
-        RosImage::Pgm => yaml_path.with_extension("pgm"),
-        RosImage::Png => yaml_path.with_extension("ros.png"),
-    };
-    let image_name = pgm_path
-        .file_name()
-        .and_then(|n| n.to_str())
-        .ok_or_else(|| {
-            MapError::invalid(
-                "map path",
-                format!("{} has no usable file name", yaml_path.display()),
-            )
-        })?
-        .to_string();
-    let pixels = image_rows(probabilities, |p| pixel(thresholds.classify(*p)));
+    let pgm_path = ros_image_path(yaml_path, format);
+    let pixels = image_rows(probabilities, |p| thresholds.pixel(*p));
     match format {
         RosImage::Pgm => {
             let mut pgm = Vec::new();
@@ -170,10 +162,41 @@ pub fn write_ros_map_as(
         }
         RosImage::Png => write_png_l8(&pixels, g, &pgm_path)?,
     }
+    write_ros_map_yaml(yaml_path, g, format)?;
+    Ok(pgm_path)
+}
+
+/// The image file a ROS map's YAML names: `<stem>.pgm` or `<stem>.ros.png`.
+pub fn ros_image_path(yaml_path: &Path, format: RosImage) -> PathBuf {
+    match format {
+        RosImage::Pgm => yaml_path.with_extension("pgm"),
+        RosImage::Png => yaml_path.with_extension("ros.png"),
+    }
+}
+
+/// Writes the YAML of a ROS map whose trinary image (written apart, e.g. with [`PngRows`] and
+/// [`TrinaryThresholds::pixel`]) covers `geometry`, top row first.
+pub fn write_ros_map_yaml(
+    yaml_path: &Path,
+    geometry: &GridGeometry,
+    format: RosImage,
+) -> Result<()> {
+    dims(geometry)?;
+    let image = ros_image_path(yaml_path, format);
+    let image_name = image
+        .file_name()
+        .and_then(|n| n.to_str())
+        .ok_or_else(|| {
+            MapError::invalid(
+                "map path",
+                format!("{} has no usable file name", yaml_path.display()),
+            )
+        })?
+        .to_string();
     let yaml = RosMapYaml {
         image: image_name,
-        resolution: g.resolution_m(),
-        origin: [g.origin_m().x, g.origin_m().y, 0.0],
+        resolution: geometry.resolution_m(),
+        origin: [geometry.origin_m().x, geometry.origin_m().y, 0.0],
         negate: 0,
         // The thresholds the *reader* applies to pixels (map_saver's): 254 -> 0.004 free,
         // 0 -> 1.0 occupied, 205 -> 0.196, not below 0.196, so unknown. A 0.25 here would
@@ -184,8 +207,7 @@ pub fn write_ros_map_as(
     };
     let text = serde_yaml_ng::to_string(&yaml)
         .map_err(|e| MapError::bad_file(yaml_path, e.to_string()))?;
-    write_atomically(yaml_path, text.as_bytes())?;
-    Ok(pgm_path)
+    write_atomically(yaml_path, text.as_bytes())
 }
 
 /// Reads a ROS map (YAML + image) into a trinary grid, as `map_server` interprets it.
@@ -236,16 +258,100 @@ pub fn read_ros_map(yaml_path: &Path) -> Result<Grid<Trinary>> {
     Grid::from_vec(geometry, data)
 }
 
+/// The picture's pixel of a probability: white free, black occupied, grey (205) unknown.
+pub fn occupancy_pixel(p: f32) -> u8 {
+    if p < 0.0 || p.is_nan() {
+        ROS_UNKNOWN
+    } else {
+        ((1.0 - p) * 255.0).round() as u8
+    }
+}
+
 /// Writes a level's probabilities as a PNG (white free, black occupied, grey unknown; north up).
 pub fn write_occupancy_png(probabilities: &Grid<f32>, path: &Path) -> Result<()> {
-    let pixels = image_rows(probabilities, |p| {
-        if *p < 0.0 || p.is_nan() {
-            ROS_UNKNOWN
-        } else {
-            ((1.0 - p) * 255.0).round() as u8
-        }
-    });
+    let pixels = image_rows(probabilities, |p| occupancy_pixel(*p));
     write_png_l8(&pixels, probabilities.geometry(), path)
+}
+
+/// An 8-bit grey PNG written row by row, top row first, so a picture is never held whole: the
+/// rows go through the encoder into a temporary file beside `path`, renamed over it by
+/// [`PngRows::finish`] (a picture left unfinished is never seen at `path`). The same pixels as
+/// [`write_png_l8`] would write, compressed the same way.
+pub struct PngRows {
+    path: PathBuf,
+    tmp: tempfile::NamedTempFile,
+    stream: png::StreamWriter<'static, std::fs::File>,
+    width: usize,
+    rows_left: usize,
+}
+
+impl PngRows {
+    /// Starts a `width` x `height` picture at `path`.
+    pub fn create(path: &Path, width: usize, height: usize) -> Result<Self> {
+        let too_large = |what| MapError::invalid(what, "too large for an image");
+        let w = u32::try_from(width).map_err(|_| too_large("picture width"))?;
+        let h = u32::try_from(height).map_err(|_| too_large("picture height"))?;
+        let tmp = temp_beside(path)?;
+        let file = tmp
+            .as_file()
+            .try_clone()
+            .map_err(|e| MapError::io(tmp.path(), e))?;
+        let png_err = |e: png::EncodingError| MapError::bad_file(path, e.to_string());
+        let mut encoder = png::Encoder::new(file, w, h);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_compression(png::Compression::Fast);
+        encoder.set_filter(png::Filter::Adaptive);
+        let stream = encoder
+            .write_header()
+            .and_then(png::Writer::into_stream_writer)
+            .map_err(png_err)?;
+        Ok(PngRows {
+            path: path.to_path_buf(),
+            tmp,
+            stream,
+            width,
+            rows_left: height,
+        })
+    }
+    /// Appends the next row (the top one first); it must hold `width` pixels.
+    pub fn write_row(&mut self, row: &[u8]) -> Result<()> {
+        if row.len() != self.width || self.rows_left == 0 {
+            return Err(MapError::invalid(
+                "picture row",
+                format!(
+                    "{}: a row of {} pixels with {} rows left, the picture is {} wide",
+                    self.path.display(),
+                    row.len(),
+                    self.rows_left,
+                    self.width
+                ),
+            ));
+        }
+        use std::io::Write as _;
+        self.stream
+            .write_all(row)
+            .map_err(|e| MapError::io(&self.path, e))?;
+        self.rows_left -= 1;
+        Ok(())
+    }
+    /// Ends the picture (every row written) and puts it at its path.
+    pub fn finish(self) -> Result<()> {
+        if self.rows_left != 0 {
+            return Err(MapError::invalid(
+                "picture",
+                format!(
+                    "{}: {} rows never written",
+                    self.path.display(),
+                    self.rows_left
+                ),
+            ));
+        }
+        self.stream
+            .finish()
+            .map_err(|e| MapError::bad_file(&self.path, e.to_string()))?;
+        persist_synced(self.tmp, &self.path)
+    }
 }
 
 /// Writes a distance map as a PNG (black at obstacles, white at the cap; north up).

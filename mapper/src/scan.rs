@@ -17,7 +17,8 @@ pub struct Return {
     pub point_in_world: Point3<f64>,
     /// Range along the beam, metres.
     pub range_m: f32,
-    /// Calibrated intensity (remission), 0..1 by convention.
+    /// Calibrated intensity (remission), 0..1 (a scan with another is refused: the map's
+    /// remission layer stores 0..1 in fixed steps).
     pub intensity: f32,
 }
 
@@ -43,7 +44,7 @@ pub const MAX_BEAMS: usize = 4096;
 
 impl Scan {
     /// A scan of `columns.len()` columns of `beams` returns each (`returns[column * beams + beam]`,
-    /// beam 0 lowest). Every number must be finite and ranges >= 0.
+    /// beam 0 lowest). Every number must be finite, ranges >= 0, intensities within 0..1.
     pub fn new(
         beams: usize,
         columns: Vec<ScanColumn>,
@@ -90,7 +91,7 @@ impl Scan {
                 r.point_in_world.iter().all(|x| x.is_finite())
                     && r.range_m.is_finite()
                     && r.range_m >= 0.0
-                    && r.intensity.is_finite()
+                    && (0.0..=1.0).contains(&r.intensity)
             })
         };
         let all_valid = returns
@@ -105,7 +106,8 @@ impl Scan {
             return Err(MapError::invalid(
                 "scan return",
                 format!(
-                    "column {} beam {}: {r:?} has a non-finite value or a negative range",
+                    "column {} beam {}: {r:?} has a non-finite value, a negative range or an \
+                     intensity outside 0..1 (a calibrated remission; divide a sensor's 0-255 by 255)",
                     i / beams,
                     i % beams
                 ),

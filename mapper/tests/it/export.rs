@@ -1,8 +1,8 @@
 //! ROS map, PNG and .npy exports read back to the same cells.
 
 use mapper::export::{
-    Trinary, TrinaryThresholds, read_npy, read_ros_map, write_distance_png, write_npy,
-    write_occupancy_png, write_ros_map,
+    PngRows, Trinary, TrinaryThresholds, occupancy_pixel, read_npy, read_ros_map,
+    write_distance_png, write_npy, write_occupancy_png, write_ros_map,
 };
 use mapper::synthetic::{Lidar, Scene, Solid, car_sensor_mount};
 use mapper::{Levels, MapConfig, MultiHeightMap};
@@ -198,4 +198,44 @@ fn a_bad_ros_yaml_names_the_file_and_field() {
         err.contains("bad.yaml") && err.contains("resolution"),
         "{err}"
     );
+}
+
+/// A picture written row by row is the picture written whole, pixel for pixel, and appears at
+/// its path only when finished; a row of the wrong width or a row missing is an error naming it.
+#[test]
+fn a_picture_streamed_by_rows_is_the_picture_written_whole() {
+    let grid = mapped().probability_grid(0).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole.png");
+    write_occupancy_png(&grid, &whole).unwrap();
+    let (w, h) = (grid.geometry().width(), grid.geometry().height());
+    let streamed = dir.path().join("streamed.png");
+    let mut rows = PngRows::create(&streamed, w, h).unwrap();
+    for y in (0..h).rev() {
+        let row: Vec<u8> = grid.data()[y * w..(y + 1) * w]
+            .iter()
+            .map(|p| occupancy_pixel(*p))
+            .collect();
+        rows.write_row(&row).unwrap();
+        assert!(!streamed.exists(), "a picture appears only when finished");
+    }
+    rows.finish().unwrap();
+    let (a, b) = (
+        image::open(&whole).unwrap().to_luma8(),
+        image::open(&streamed).unwrap().to_luma8(),
+    );
+    assert_eq!(a.dimensions(), b.dimensions());
+    assert!(a.as_raw() == b.as_raw(), "the pixels differ");
+    assert!(a.as_raw().iter().any(|&p| p < 100) && a.as_raw().iter().any(|&p| p > 250));
+
+    let mut rows = PngRows::create(&dir.path().join("bad.png"), 4, 2).unwrap();
+    let e = rows.write_row(&[0; 3]).unwrap_err().to_string();
+    assert!(e.contains("bad.png") && e.contains("3 pixels"), "{e}");
+    rows.write_row(&[0; 4]).unwrap();
+    let e = rows.finish().unwrap_err().to_string();
+    assert!(
+        e.contains("bad.png") && e.contains("1 rows never written"),
+        "{e}"
+    );
+    assert!(!dir.path().join("bad.png").exists());
 }

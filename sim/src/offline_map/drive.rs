@@ -10,8 +10,11 @@
 use std::path::Path;
 
 use autonomy::RoutePath;
-use mapper::export::{RosImage, TrinaryThresholds, write_occupancy_png, write_ros_map_as};
-use mapper::{BlockStore, Grid, GridGeometry, Levels, MultiHeightMap};
+use mapper::export::{
+    PngRows, ROS_UNKNOWN, RosImage, TrinaryThresholds, occupancy_pixel, ros_image_path,
+    write_ros_map_yaml,
+};
+use mapper::{BlockIndex, BlockStore, GridGeometry, Levels, MultiHeightMap};
 use nalgebra::{Isometry2, Point2};
 
 use super::manifest::{MapManifest, fingerprint};
@@ -102,7 +105,7 @@ pub fn map_drive(
     map.flush()?;
     let store = BlockStore::open(&blocks_dir, map.block_spec().clone())?;
     let blocks = store.list()?.len();
-    let occupied_cells = export_levels(&store, &levels, &route, out)?;
+    let occupied_cells = export_levels(&store, &levels, out)?;
     let manifest = MapManifest {
         fingerprint: fingerprint(scenario, config)?,
         scenario: scenario.name.clone(),
@@ -119,14 +122,25 @@ pub fn map_drive(
     Ok(manifest)
 }
 
+/// Pixels the exports hold at once (both pictures of a level): a strip of pixel rows across the
+/// extent, as many rows as fit (at least one, at most a block's).
+const EXPORT_BUFFER_PIXELS: usize = 8 << 20;
+
 /// Writes each level over the blocks' extent as a ROS map and a PNG; returns occupied cells per
-/// level. One level's image is held at a time (its blocks read again for each level), so the
-/// exports' memory is one level's extent, not every level's.
-fn export_levels(
+/// level. The pictures are streamed top row first in strips of pixel rows across the extent, each
+/// strip's blocks read for it: memory holds one strip (8 MiB of pixels, while a row of 4 million
+/// pixels fits), whatever the route's length and extent. A block is read once per strip across it
+/// (twice per level on the aerodrome).
+fn export_levels(store: &BlockStore, levels: &Levels, out: &Path) -> Result<Vec<usize>> {
+    export_levels_in(store, levels, out, EXPORT_BUFFER_PIXELS)
+}
+
+/// [`export_levels`] holding at most `buffer_pixels` pixels (tests make strips of a few rows).
+fn export_levels_in(
     store: &BlockStore,
     levels: &Levels,
-    _route: &RoutePath,
     out: &Path,
+    buffer_pixels: usize,
 ) -> Result<Vec<usize>> {
     let spec = store.spec().clone();
     let indices = store.list()?;
@@ -145,40 +159,175 @@ fn export_levels(
     );
     let origin = Point2::new(x0 as f64 * spec.side_m(), y0 as f64 * spec.side_m());
     let geometry = GridGeometry::new(origin, spec.resolution_m, w, h)?;
+    let strip = (buffer_pixels / 2 / w).clamp(1, side);
     let mut occupied = Vec::new();
     for k in 0..levels.count() {
-        let mut grid = Grid::filled(geometry, -1.0f32);
-        for &index in &indices {
-            let Some(block) = store.load(index)? else {
-                continue;
-            };
-            let Some(level) = block.levels.get(k) else {
-                continue;
-            };
-            let (ox, oy) = (
-                ((index.x - x0) as usize) * side,
-                ((index.y - y0) as usize) * side,
-            );
-            let data = grid.data_mut();
-            for r in 0..side {
-                for c in 0..side {
-                    let l = level[r * side + c];
-                    data[(oy + r) * w + ox + c] = if l.is_nan() {
-                        -1.0
-                    } else {
-                        mapper::occupancy::probability(l)
-                    };
+        let yaml = out.join(format!("level{k}.yaml"));
+        let mut ros = PngRows::create(&ros_image_path(&yaml, RosImage::Png), w, h)?;
+        let mut picture = PngRows::create(&out.join(format!("level{k}.png")), w, h)?;
+        let (mut ros_row, mut picture_row) = (vec![0u8; w], vec![0u8; w]);
+        let mut count = 0;
+        for by in (y0..=y1).rev() {
+            // Block rows top first; in each, strips of pixel rows top first.
+            for top in (0..side).rev().step_by(strip) {
+                let rows = top.saturating_sub(strip - 1)..top + 1;
+                let blocks = (x0..=x1)
+                    .map(|x| level_pixels(store, BlockIndex { x, y: by }, k, rows.clone()))
+                    .collect::<Result<Vec<_>>>()?;
+                count += blocks.iter().flatten().map(|b| b.occupied).sum::<usize>();
+                for r in rows.clone().rev() {
+                    let cells = (r - rows.start) * side..(r - rows.start + 1) * side;
+                    for (bx, block) in blocks.iter().enumerate() {
+                        let at = bx * side..(bx + 1) * side;
+                        match block {
+                            Some(b) => {
+                                ros_row[at.clone()].copy_from_slice(&b.ros[cells.clone()]);
+                                picture_row[at].copy_from_slice(&b.picture[cells.clone()]);
+                            }
+                            None => {
+                                ros_row[at.clone()].fill(ROS_UNKNOWN);
+                                picture_row[at].fill(ROS_UNKNOWN);
+                            }
+                        }
+                    }
+                    ros.write_row(&ros_row)?;
+                    picture.write_row(&picture_row)?;
                 }
             }
         }
-        write_ros_map_as(
-            &grid,
-            &out.join(format!("level{k}.yaml")),
-            TrinaryThresholds::default(),
-            RosImage::Png,
-        )?;
-        write_occupancy_png(&grid, &out.join(format!("level{k}.png")))?;
-        occupied.push(grid.data().iter().filter(|&&p| p > 0.5).count());
+        ros.finish()?;
+        picture.finish()?;
+        write_ros_map_yaml(&yaml, &geometry, RosImage::Png)?;
+        occupied.push(count);
     }
     Ok(occupied)
+}
+
+/// Rows of one block's level as the exports' pixels (in the block's order, lowest y first).
+struct BlockPixels {
+    /// ROS map_server's trinary pixels.
+    ros: Vec<u8>,
+    /// The picture's grey levels.
+    picture: Vec<u8>,
+    /// Cells of these rows with p > 0.5.
+    occupied: usize,
+}
+
+/// Cell rows `rows` of level `k` of block `index` as pixels, `None` if the block was never saved.
+fn level_pixels(
+    store: &BlockStore,
+    index: BlockIndex,
+    k: usize,
+    rows: std::ops::Range<usize>,
+) -> Result<Option<BlockPixels>> {
+    let side = store.spec().side;
+    let Some(block) = store.load(index)? else {
+        return Ok(None);
+    };
+    let Some(level) = block.levels.get(k) else {
+        return Ok(None);
+    };
+    let level = &level[rows.start * side..rows.end * side];
+    let thresholds = TrinaryThresholds::default();
+    let probability = |l: f32| {
+        if l.is_nan() {
+            -1.0
+        } else {
+            mapper::occupancy::probability(l)
+        }
+    };
+    Ok(Some(BlockPixels {
+        ros: level
+            .iter()
+            .map(|&l| thresholds.pixel(probability(l)))
+            .collect(),
+        picture: level
+            .iter()
+            .map(|&l| occupancy_pixel(probability(l)))
+            .collect(),
+        occupied: level.iter().filter(|&&l| probability(l) > 0.5).count(),
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mapper::{Block, BlockSpec};
+
+    /// The exports of blocks laid out with a gap (a block never saved) are, pixel for pixel, the
+    /// levels' probabilities north up, whatever the strips: one strip per block row, strips of 7
+    /// rows (not dividing the block), one row at a time.
+    #[test]
+    fn streamed_exports_are_the_levels_north_up_whatever_the_strips() {
+        let levels = Levels::cumulative(vec![0.0, 0.7]).unwrap();
+        let spec = BlockSpec {
+            side: 20,
+            resolution_m: 0.5,
+            levels: levels.clone(),
+            l_max: 3.5,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let store = BlockStore::open(dir.path().join("blocks"), spec.clone()).unwrap();
+        // Blocks (0,0), (1,0), (0,1) and (2,1); (1,1) and (2,0) never saved. Cell values from
+        // their world position, so a misplaced pixel shows.
+        let value = |k: usize, x: i64, y: i64| match (x * 7 + y * 13 + k as i64 * 5) % 9 {
+            0 | 1 => f32::NAN,
+            v => (v as f32 - 5.0) * 0.8,
+        };
+        for (bx, by) in [(0i64, 0i64), (1, 0), (0, 1), (2, 1)] {
+            let mut block = Block::unknown(&spec, BlockIndex { x: bx, y: by });
+            for (k, level) in block.levels.iter_mut().enumerate() {
+                for (i, l) in level.iter_mut().enumerate() {
+                    let (x, y) = (bx * 20 + (i % 20) as i64, by * 20 + (i / 20) as i64);
+                    *l = value(k, x, y);
+                }
+            }
+            store.save(&block).unwrap();
+        }
+        let (w, h) = (60usize, 40usize);
+        let saved = |x: i64, y: i64| [(0, 0), (1, 0), (0, 1), (2, 1)].contains(&(x / 20, y / 20));
+        for buffer in [1 << 20, 2 * w * 7, 1] {
+            let out = dir.path().join(format!("out{buffer}"));
+            let occupied = export_levels_in(&store, &levels, &out, buffer).unwrap();
+            for (k, &occupied) in occupied.iter().enumerate() {
+                let ros = image::open(out.join(format!("level{k}.ros.png")))
+                    .unwrap()
+                    .to_luma8();
+                let pic = image::open(out.join(format!("level{k}.png")))
+                    .unwrap()
+                    .to_luma8();
+                assert_eq!(ros.dimensions(), (w as u32, h as u32));
+                let mut count = 0;
+                for (x, y) in (0..w as i64).flat_map(|x| (0..h as i64).map(move |y| (x, y))) {
+                    let p = if saved(x, y) {
+                        let l = value(k, x, y);
+                        if l.is_nan() {
+                            -1.0
+                        } else {
+                            mapper::occupancy::probability(l)
+                        }
+                    } else {
+                        -1.0
+                    };
+                    count += usize::from(p > 0.5);
+                    let row = (h as i64 - 1 - y) as u32; // north up
+                    let thresholds = TrinaryThresholds::default();
+                    assert_eq!(
+                        ros.get_pixel(x as u32, row).0[0],
+                        thresholds.pixel(p),
+                        "{x} {y}"
+                    );
+                    assert_eq!(
+                        pic.get_pixel(x as u32, row).0[0],
+                        occupancy_pixel(p),
+                        "{x} {y}"
+                    );
+                }
+                assert_eq!(occupied, count);
+                assert!(count > 100);
+            }
+            let yaml = std::fs::read_to_string(out.join("level0.yaml")).unwrap();
+            assert!(yaml.contains("origin:") && yaml.contains("- 0.0"), "{yaml}");
+        }
+    }
 }

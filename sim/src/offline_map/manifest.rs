@@ -9,8 +9,8 @@ use crate::error::{Error, ManifestError, Result};
 use crate::scenario::{RunConfig, Scenario};
 
 /// Bumped when the mapping drive changes what it builds (2: the vehicle's ceiling; 3: compressed
-/// blocks; 4: the ROS image a PNG).
-pub(crate) const MAP_FORMAT: u32 = 4;
+/// blocks; 4: the ROS image a PNG; 5: blocks with the remission quantized).
+pub(crate) const MAP_FORMAT: u32 = 5;
 
 /// What a mapping drive did.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]

@@ -14,7 +14,7 @@ use crate::emit;
 pub struct BenchArgs {
     /// What to measure.
     pub what: BenchTarget,
-    /// One JSON object per figure on stdout instead of a table.
+    /// One JSON object per figure on stdout instead of a table (`bench figures`: one object).
     #[arg(long)]
     pub json: bool,
     /// Timed batches per figure, the median reported (default 15; `bench loop`: runs of each
@@ -39,6 +39,18 @@ pub struct BenchArgs {
     /// `bench campaign`: runs at a time, both ways (default: the cores).
     #[arg(long)]
     pub jobs: Option<usize>,
+    /// `bench figures`: the working directory, for the maps built and each run's report and
+    /// output (default: a new directory under the system's temporary directory, deleted at the
+    /// end unless `--keep`).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// `bench figures`: keep the offline maps built (default: deleted once measured).
+    #[arg(long)]
+    pub keep: bool,
+    /// `bench figures`: also write the JSON object to this file (atomically), for
+    /// `.ci/check_figures`.
+    #[arg(long, value_name = "FILE")]
+    pub json_out: Option<PathBuf>,
 }
 
 /// What `taxi-sim bench` measures.
@@ -59,10 +71,22 @@ pub enum BenchTarget {
     /// The particle filter on `--scenario`'s offline map (built if missing): one revolution's
     /// update, the weighing's tables against the straightforward way (one thread each).
     Localization,
+    /// The README's deterministic figures of a first and a later run (offline map on disk,
+    /// blocks, occupied cells, peak memory), from `taxi-sim run` child processes on the
+    /// aerodrome and the parking lot; run from the repository's root (a few minutes).
+    Figures,
 }
 
 /// Runs `taxi-sim bench`.
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    if let BenchTarget::Figures = args.what {
+        return super::figures::run(&super::figures::FiguresOptions {
+            json: args.json,
+            out: args.out.as_deref(),
+            keep: args.keep,
+            json_out: args.json_out.as_deref(),
+        });
+    }
     let campaign = sim::bench::campaign::CampaignBench {
         campaign: &args.campaign,
         variants: args.variants,
@@ -101,6 +125,7 @@ fn bench(
         BenchTarget::Localization => {
             sim::bench::localization::figures_for(scenario, samples.unwrap_or(15), &mut report)?
         }
+        BenchTarget::Figures => unreachable!("dispatched in run"),
     };
     progress.finish_and_clear();
     let mut t = String::new();

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod campaign;
 pub mod check;
 pub mod demo;
+pub mod figures;
 pub mod map;
 pub mod model;
 pub mod run;

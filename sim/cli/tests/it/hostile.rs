@@ -389,7 +389,7 @@ fn every_malformed_file_is_refused_with_code_2_naming_its_place() {
 /// manifest is beside the blocks' folder), and what the error must say besides the file's name.
 type Corruption = (&'static str, fn(&Path), &'static [&'static str]);
 
-fn corruptions() -> [Corruption; 7] {
+fn corruptions() -> [Corruption; 8] {
     [
         (
             "truncated block",
@@ -435,6 +435,15 @@ fn corruptions() -> [Corruption; 7] {
                 std::fs::write(p, b).unwrap();
             },
             &["format version 1", "rebuild the map with `taxi-sim map`"],
+        ),
+        (
+            "block of format 2 (float remission sums)",
+            |p| {
+                let mut b = std::fs::read(p).unwrap();
+                b[8..12].copy_from_slice(&2u32.to_le_bytes());
+                std::fs::write(p, b).unwrap();
+            },
+            &["format version 2", "rebuild the map with `taxi-sim map`"],
         ),
         (
             "garbage manifest",
