@@ -154,11 +154,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
 
 /// Two records of one variant agree on everything but the wall time.
 fn same_run(a: &RunRecord, b: &RunRecord) -> bool {
-    let timeless = |r: &RunRecord| RunRecord {
-        wall_time_s: 0.0,
-        ..r.clone()
-    };
-    timeless(a) == timeless(b)
+    a.timeless() == b.timeless()
 }
 
 #[cfg(test)]

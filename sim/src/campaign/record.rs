@@ -93,6 +93,16 @@ pub struct RunRecord {
     pub faults: crate::world::FaultCounts,
 }
 
+impl RunRecord {
+    /// The record with its wall time zeroed: what two runs of one variant agree on.
+    pub fn timeless(&self) -> RunRecord {
+        RunRecord {
+            wall_time_s: 0.0,
+            ..self.clone()
+        }
+    }
+}
+
 fn finite(x: f64) -> Option<f64> {
     x.is_finite().then_some(x)
 }

@@ -122,17 +122,23 @@ pub fn map_drive(
     Ok(manifest)
 }
 
-/// Pixels the exports hold at once (both pictures of a level): a strip of pixel rows across the
-/// extent, as many rows as fit (at least one, at most a block's).
+/// Pixels the exports hold at once (both pictures of every level): a strip of pixel rows across
+/// the extent, as many rows as fit (at least one, at most a block's).
 const EXPORT_BUFFER_PIXELS: usize = 8 << 20;
 
 /// Writes each level over the blocks' extent as a ROS map and a PNG; returns occupied cells per
 /// level. The pictures are streamed top row first in strips of pixel rows across the extent, each
-/// strip's blocks read for it: memory holds one strip (8 MiB of pixels, while a row of 4 million
-/// pixels fits), whatever the route's length and extent. A block is read once per strip across it
-/// (twice per level on the aerodrome).
+/// strip's blocks read once for every level: memory holds one strip (8 MiB of pixels, while a row
+/// of 2 million pixels fits), whatever the route's length and extent. A block is read once per
+/// strip across it (three times on the aerodrome, for both levels).
 fn export_levels(store: &BlockStore, levels: &Levels, out: &Path) -> Result<Vec<usize>> {
     export_levels_in(store, levels, out, EXPORT_BUFFER_PIXELS)
+}
+
+/// A level's two pictures, written row by row.
+struct LevelPictures {
+    ros: PngRows,
+    picture: PngRows,
 }
 
 /// [`export_levels`] holding at most `buffer_pixels` pixels (tests make strips of a few rows).
@@ -159,30 +165,40 @@ fn export_levels_in(
     );
     let origin = Point2::new(x0 as f64 * spec.side_m(), y0 as f64 * spec.side_m());
     let geometry = GridGeometry::new(origin, spec.resolution_m, w, h)?;
-    let strip = (buffer_pixels / 2 / w).clamp(1, side);
-    let mut occupied = Vec::new();
-    for k in 0..levels.count() {
-        let yaml = out.join(format!("level{k}.yaml"));
-        let mut ros = PngRows::create(&ros_image_path(&yaml, RosImage::Png), w, h)?;
-        let mut picture = PngRows::create(&out.join(format!("level{k}.png")), w, h)?;
-        let (mut ros_row, mut picture_row) = (vec![0u8; w], vec![0u8; w]);
-        let mut count = 0;
-        for by in (y0..=y1).rev() {
-            // Block rows top first; in each, strips of pixel rows top first.
-            for top in (0..side).rev().step_by(strip) {
-                let rows = top.saturating_sub(strip - 1)..top + 1;
-                let blocks = (x0..=x1)
-                    .map(|x| level_pixels(store, BlockIndex { x, y: by }, k, rows.clone()))
-                    .collect::<Result<Vec<_>>>()?;
-                count += blocks.iter().flatten().map(|b| b.occupied).sum::<usize>();
+    let strip = (buffer_pixels / (2 * levels.count() * w)).clamp(1, side);
+    let yaml = |k: usize| out.join(format!("level{k}.yaml"));
+    let mut pictures = (0..levels.count())
+        .map(|k| {
+            Ok(LevelPictures {
+                ros: PngRows::create(&ros_image_path(&yaml(k), RosImage::Png), w, h)?,
+                picture: PngRows::create(&out.join(format!("level{k}.png")), w, h)?,
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let (mut ros_row, mut picture_row) = (vec![0u8; w], vec![0u8; w]);
+    let mut occupied = vec![0; levels.count()];
+    for by in (y0..=y1).rev() {
+        // Block rows top first; in each, strips of pixel rows top first.
+        for top in (0..side).rev().step_by(strip) {
+            let rows = top.saturating_sub(strip - 1)..top + 1;
+            // Per block of the row, per level: the strip's pixels (None: no block saved).
+            let blocks = (x0..=x1)
+                .map(|x| block_pixels(store, BlockIndex { x, y: by }, levels, rows.clone()))
+                .collect::<Result<Vec<_>>>()?;
+            for (k, level) in pictures.iter_mut().enumerate() {
+                occupied[k] += blocks
+                    .iter()
+                    .flatten()
+                    .map(|b| b[k].occupied)
+                    .sum::<usize>();
                 for r in rows.clone().rev() {
                     let cells = (r - rows.start) * side..(r - rows.start + 1) * side;
                     for (bx, block) in blocks.iter().enumerate() {
                         let at = bx * side..(bx + 1) * side;
                         match block {
                             Some(b) => {
-                                ros_row[at.clone()].copy_from_slice(&b.ros[cells.clone()]);
-                                picture_row[at].copy_from_slice(&b.picture[cells.clone()]);
+                                ros_row[at.clone()].copy_from_slice(&b[k].ros[cells.clone()]);
+                                picture_row[at].copy_from_slice(&b[k].picture[cells.clone()]);
                             }
                             None => {
                                 ros_row[at.clone()].fill(ROS_UNKNOWN);
@@ -190,15 +206,16 @@ fn export_levels_in(
                             }
                         }
                     }
-                    ros.write_row(&ros_row)?;
-                    picture.write_row(&picture_row)?;
+                    level.ros.write_row(&ros_row)?;
+                    level.picture.write_row(&picture_row)?;
                 }
             }
         }
-        ros.finish()?;
-        picture.finish()?;
-        write_ros_map_yaml(&yaml, &geometry, RosImage::Png)?;
-        occupied.push(count);
+    }
+    for (k, level) in pictures.into_iter().enumerate() {
+        level.ros.finish()?;
+        level.picture.finish()?;
+        write_ros_map_yaml(&yaml(k), &geometry, RosImage::Png)?;
     }
     Ok(occupied)
 }
@@ -213,21 +230,18 @@ struct BlockPixels {
     occupied: usize,
 }
 
-/// Cell rows `rows` of level `k` of block `index` as pixels, `None` if the block was never saved.
-fn level_pixels(
+/// Cell rows `rows` of every level of block `index` as pixels, `None` if the block was never
+/// saved.
+fn block_pixels(
     store: &BlockStore,
     index: BlockIndex,
-    k: usize,
+    levels: &Levels,
     rows: std::ops::Range<usize>,
-) -> Result<Option<BlockPixels>> {
+) -> Result<Option<Vec<BlockPixels>>> {
     let side = store.spec().side;
     let Some(block) = store.load(index)? else {
         return Ok(None);
     };
-    let Some(level) = block.levels.get(k) else {
-        return Ok(None);
-    };
-    let level = &level[rows.start * side..rows.end * side];
     let thresholds = TrinaryThresholds::default();
     let probability = |l: f32| {
         if l.is_nan() {
@@ -236,17 +250,27 @@ fn level_pixels(
             mapper::occupancy::probability(l)
         }
     };
-    Ok(Some(BlockPixels {
-        ros: level
-            .iter()
-            .map(|&l| thresholds.pixel(probability(l)))
-            .collect(),
-        picture: level
-            .iter()
-            .map(|&l| occupancy_pixel(probability(l)))
-            .collect(),
-        occupied: level.iter().filter(|&&l| probability(l) > 0.5).count(),
-    }))
+    // The store checked the block's levels against the map's: one array per level.
+    debug_assert_eq!(block.levels.len(), levels.count());
+    let pixels = block
+        .levels
+        .iter()
+        .map(|level| {
+            let level = &level[rows.start * side..rows.end * side];
+            BlockPixels {
+                ros: level
+                    .iter()
+                    .map(|&l| thresholds.pixel(probability(l)))
+                    .collect(),
+                picture: level
+                    .iter()
+                    .map(|&l| occupancy_pixel(probability(l)))
+                    .collect(),
+                occupied: level.iter().filter(|&&l| probability(l) > 0.5).count(),
+            }
+        })
+        .collect();
+    Ok(Some(pixels))
 }
 
 #[cfg(test)]
@@ -286,7 +310,7 @@ mod tests {
         }
         let (w, h) = (60usize, 40usize);
         let saved = |x: i64, y: i64| [(0, 0), (1, 0), (0, 1), (2, 1)].contains(&(x / 20, y / 20));
-        for buffer in [1 << 20, 2 * w * 7, 1] {
+        for buffer in [1 << 20, 2 * 2 * w * 7, 1] {
             let out = dir.path().join(format!("out{buffer}"));
             let occupied = export_levels_in(&store, &levels, &out, buffer).unwrap();
             for (k, &occupied) in occupied.iter().enumerate() {

@@ -6,55 +6,11 @@
 //! (reproducing failure files with `taxi-sim run`, merging shards) is tested in the `taxi-sim`
 //! package (`sim/cli/tests/it/campaign.rs`).
 
-use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use sim::campaign::{Campaign, RunOptions, RunRecord, Shard, read_results, run_campaign, variant};
+use sim::campaign::{Campaign, RunOptions, Shard, read_results, run_campaign, variant};
 
-fn smoke_path() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/campaigns/smoke.toml")
-}
-
-fn smoke() -> Campaign {
-    Campaign::from_file(&smoke_path()).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn run(campaign: &Campaign, out: &Path, jobs: usize, runs: Option<u64>) -> Vec<RunRecord> {
-    let stop = AtomicBool::new(false);
-    run_campaign(
-        campaign,
-        &RunOptions {
-            shard: None,
-            maps_dir: None,
-            out: out.to_path_buf(),
-            jobs,
-            runs,
-            stop: &stop,
-            progress: &|_| {},
-        },
-    )
-    .unwrap_or_else(|e| panic!("{e}"))
-    .records
-}
-
-/// A record without its wall time (the one field identical runs differ in).
-fn timeless(r: &RunRecord) -> RunRecord {
-    RunRecord {
-        wall_time_s: 0.0,
-        ..r.clone()
-    }
-}
-
-/// The whole smoke campaign on two workers, once for every test of this file.
-fn full() -> &'static (tempfile::TempDir, Vec<RunRecord>) {
-    static FULL: OnceLock<(tempfile::TempDir, Vec<RunRecord>)> = OnceLock::new();
-    FULL.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        let records = run(&smoke(), dir.path(), 2, None);
-        (dir, records)
-    })
-}
+use crate::smoke_campaign::{full, run, smoke, smoke_path};
 
 #[test]
 fn the_smoke_campaign_runs_every_variant_under_every_setting() {
@@ -111,7 +67,7 @@ fn results_are_the_same_whatever_jobs() {
     let one = run(&smoke(), dir.path(), 1, Some(8));
     assert_eq!(one.len(), 8);
     for (a, b) in one.iter().zip(records) {
-        assert_eq!(timeless(a), timeless(b));
+        assert_eq!(a.timeless(), b.timeless());
     }
 }
 
@@ -144,7 +100,7 @@ fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
     assert_eq!(outcome.ran, 2, "variants 3 and 4 only");
     assert_eq!(outcome.records.len(), 5);
     for (a, b) in outcome.records.iter().zip(records) {
-        assert_eq!(timeless(a), timeless(b));
+        assert_eq!(a.timeless(), b.timeless());
     }
     // Another campaign's results are never mixed in.
     let other = dir.path().join("other.toml");
@@ -215,7 +171,7 @@ fn a_stop_keeps_only_whole_runs_and_the_rest_runs_later() {
     let rest = run(&campaign, dir.path(), 2, Some(4));
     assert_eq!(rest.len(), 4);
     for (a, b) in rest.iter().zip(records) {
-        assert_eq!(timeless(a), timeless(b));
+        assert_eq!(a.timeless(), b.timeless());
     }
 }
 

@@ -11,4 +11,5 @@ mod replay;
 mod scenario;
 mod short_obstacles;
 mod small_obstacles;
+mod smoke_campaign;
 mod world_lidar;

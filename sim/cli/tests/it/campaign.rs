@@ -5,54 +5,11 @@
 //! campaign's library behaviour is tested in `sim/tests/it/campaign.rs`.
 
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 use std::sync::atomic::AtomicBool;
 
 use sim::campaign::{Campaign, RunOptions, RunRecord, Shard, read_results, run_campaign, variant};
 
-fn smoke_path() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/campaigns/smoke.toml")
-}
-
-fn smoke() -> Campaign {
-    Campaign::from_file(&smoke_path()).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn run(campaign: &Campaign, out: &Path, jobs: usize, runs: Option<u64>) -> Vec<RunRecord> {
-    let stop = AtomicBool::new(false);
-    run_campaign(
-        campaign,
-        &RunOptions {
-            shard: None,
-            maps_dir: None,
-            out: out.to_path_buf(),
-            jobs,
-            runs,
-            stop: &stop,
-            progress: &|_| {},
-        },
-    )
-    .unwrap_or_else(|e| panic!("{e}"))
-    .records
-}
-
-/// A record without its wall time (the one field identical runs differ in).
-fn timeless(r: &RunRecord) -> RunRecord {
-    RunRecord {
-        wall_time_s: 0.0,
-        ..r.clone()
-    }
-}
-
-/// The whole smoke campaign on two workers, once for every test of this file.
-fn full() -> &'static (tempfile::TempDir, Vec<RunRecord>) {
-    static FULL: OnceLock<(tempfile::TempDir, Vec<RunRecord>)> = OnceLock::new();
-    FULL.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        let records = run(&smoke(), dir.path(), 2, None);
-        (dir, records)
-    })
-}
+use crate::smoke_campaign::{full, smoke, smoke_path};
 
 /// `taxi-sim run FILE --report`: the report's JSON.
 fn taxi_sim_run(file: &Path, work: &Path) -> serde_json::Value {
@@ -200,7 +157,7 @@ fn shards_merged_equal_the_single_machine_run_and_a_lost_shard_is_named_and_reru
     let all = read_results(&merged).unwrap();
     assert_eq!(all.len(), records.len());
     for (a, b) in all.iter().zip(records) {
-        assert_eq!(timeless(a), timeless(b), "variant {}", b.index);
+        assert_eq!(a.timeless(), b.timeless(), "variant {}", b.index);
     }
     // The same failure files as the single-machine run.
     for r in records.iter().filter(|r| r.failed) {

@@ -24,4 +24,6 @@ mod cli;
 mod figures;
 mod hostile;
 mod replay;
+#[path = "../../../tests/it/smoke_campaign.rs"]
+mod smoke_campaign;
 mod tune;
