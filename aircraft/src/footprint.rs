@@ -203,7 +203,8 @@ impl ConvexPolygon {
     }
 }
 
-fn segment_distance(p: &Point2<f64>, a: &Point2<f64>, b: &Point2<f64>) -> f64 {
+/// Distance from `p` to the segment `a`-`b`.
+pub fn segment_distance(p: &Point2<f64>, a: &Point2<f64>, b: &Point2<f64>) -> f64 {
     let ab = b - a;
     let len2 = ab.norm_squared();
     let t = if len2 > 0.0 {
@@ -212,6 +213,25 @@ fn segment_distance(p: &Point2<f64>, a: &Point2<f64>, b: &Point2<f64>) -> f64 {
         0.0
     };
     (p - (a + ab * t)).norm()
+}
+
+/// Distance between the segments `a`-`b` and `c`-`d` (0 when they cross).
+pub fn segments_distance(
+    a: &Point2<f64>,
+    b: &Point2<f64>,
+    c: &Point2<f64>,
+    d: &Point2<f64>,
+) -> f64 {
+    let (ab, cd) = (b - a, d - c);
+    let (d1, d2) = (cross(&ab, &(c - a)), cross(&ab, &(d - a)));
+    let (d3, d4) = (cross(&cd, &(a - c)), cross(&cd, &(b - c)));
+    if d1 * d2 < 0.0 && d3 * d4 < 0.0 {
+        return 0.0;
+    }
+    segment_distance(a, c, d)
+        .min(segment_distance(b, c, d))
+        .min(segment_distance(c, a, b))
+        .min(segment_distance(d, a, b))
 }
 
 /// Signed area of the intersection of the disc (origin, r) with the triangle (origin, a, b).

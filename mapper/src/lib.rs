@@ -49,4 +49,4 @@ pub use odm::{DistanceMap, DistanceMaps};
 pub use remission::RemissionCell;
 pub use scan::{Return, Scan, ScanColumn};
 pub use self_hits::SelfHitFilter;
-pub use tracking::{MovingObject, Tracker, TrackerConfig};
+pub use tracking::{MovingObject, TrackState, Tracker, TrackerConfig};

@@ -80,6 +80,47 @@ impl MultiHeightMap {
         all
     }
 
+    /// The cells the last revolution hit as obstacles, each with the levels it was hit in (bit
+    /// `l` set: level `l`), in world-lattice order. Empty after a re-centre until the next
+    /// insertion. Levels beyond 32 are not told apart (bit 31 stands for them all).
+    pub fn last_scan_hits_by_level(&self) -> Vec<(WorldCell, u32)> {
+        let width = self.geometry.width();
+        let (x0, y0) = self.window_cell0();
+        let mut all: Vec<(WorldCell, u32)> = self
+            .last_hits
+            .iter()
+            .enumerate()
+            .flat_map(|(level, hits)| {
+                let bit = 1u32 << level.min(31);
+                hits.iter().map(move |&i| {
+                    let i = i as usize;
+                    (((i % width) as i64 + x0, (i / width) as i64 + y0), bit)
+                })
+            })
+            .collect();
+        all.sort_unstable();
+        all.dedup_by(|later, first| {
+            if later.0 == first.0 {
+                first.1 |= later.1;
+                true
+            } else {
+                false
+            }
+        });
+        all
+    }
+
+    /// Whether a world-lattice cell is an obstacle of level `level` in the prior (the offline
+    /// map) alone; false outside the window.
+    pub fn is_prior_obstacle(&self, level: usize, cell: WorldCell) -> bool {
+        let (Some(i), Some(prior)) = (self.window_index(cell), self.prior.get(level)) else {
+            return false;
+        };
+        let t = self.config.obstacle_threshold;
+        let l = prior.data()[i];
+        !l.is_nan() && l > (t / (1.0 - t)).ln()
+    }
+
     /// Whether a world-lattice cell is an obstacle of level `level` (live merged with prior above
     /// the obstacle threshold); false outside the window.
     pub fn is_obstacle(&self, level: usize, cell: WorldCell) -> bool {

@@ -12,6 +12,7 @@
 //! - [`online_map`]: the offline map merged with live LiDAR data around the estimate.
 //! - [`planner`]: candidates, the avoider, the behaviour, pure pursuit.
 //! - [`route`]: route geometry and Frenet projection.
+//! - [`traffic`]: movers predicted over the horizon, the space-time check of the path.
 //! - [`stack`]: the [`Driver`], which ties them together and tracks its own route progress.
 
 pub mod localizer;
@@ -20,12 +21,14 @@ pub mod online_map;
 pub mod planner;
 pub mod route;
 pub mod stack;
+pub mod traffic;
 
 pub use messages::{Command, LidarRevolution, Odometry, PoseEstimate};
 pub use online_map::{ForgettingConfig, ForgettingRule, OnlineMap};
 pub use planner::{AutonomyConfig, Behaviour, Candidate, Plan, avoid, plan, pure_pursuit};
 pub use route::{RoutePath, wrap_angle};
 pub use stack::{Driver, DriverStatus, PlanTimes, VehicleModel};
+pub use traffic::{Conflict, Prediction, TrafficConfig};
 
 impl Behaviour {
     /// The behaviour the thesis gives a vehicle by how it steers: a car (front wheels) deviates,

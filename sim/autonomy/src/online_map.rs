@@ -96,8 +96,8 @@ impl OnlineMap {
         }
         self.map
             .insert_scan(&revolution.scan, Some(&self.self_filter))?;
-        let hits = self.map.last_scan_hits();
-        let clear = self.tracker.update(revolution.t_s, &hits);
+        let hits = self.map.last_scan_hits_by_level();
+        let clear = self.tracker.update_with_levels(revolution.t_s, &hits);
         self.map.clear_live(&clear);
         self.revolutions += 1;
         if self.revolutions.is_multiple_of(50) {
@@ -113,6 +113,22 @@ impl OnlineMap {
     /// since the window last held it - an offline-map obstacle, or never seen).
     pub fn last_hit_s(&self, cell: WorldCell) -> Option<f64> {
         self.tracker.last_hit_s(cell)
+    }
+
+    /// The tracked objects whose motion can be predicted, as of the last revolution - but not
+    /// those whose hits lie on an obstacle of the offline map (of any level): a static object
+    /// the map holds, whose visible part slid as the vehicle drove by, or whose hits a track
+    /// took over from another, never moved.
+    pub fn movers(&self) -> Vec<mapper::TrackState> {
+        let levels = self.map.levels().count();
+        let mut movers = self.tracker.movers();
+        movers.retain(|t| {
+            let ((x0, y0), (x1, y1)) = t.bbox;
+            !(x0..=x1).any(|x| {
+                (y0..=y1).any(|y| (0..levels).any(|l| self.map.is_prior_obstacle(l, (x, y))))
+            })
+        });
+        movers
     }
 
     /// The multi-height map (occupancy and distance maps per level).

@@ -42,8 +42,13 @@ pub struct AutonomyConfig {
     pub max_offset_m: f64,
     /// Spacing of the candidate offsets, metres. Default 0.25.
     pub offset_step_m: f64,
-    /// How far ahead candidates are checked, metres. Default 30.
+    /// How far ahead candidates are checked at least, metres. Default 30. The horizon grows
+    /// with speed to the stopping distance (reaction, braking, buffer) plus a step, up to
+    /// `max_horizon_m`.
     pub horizon_m: f64,
+    /// The longest horizon, metres: the vehicle never drives faster than it can stop within it
+    /// (the route's speed is lowered, and the report says so). Default 60.
+    pub max_horizon_m: f64,
     /// Length over which a candidate moves to its offset, metres. Default 12.
     pub transition_m: f64,
     /// Spacing of the checked poses along a candidate, metres. Default 0.5.
@@ -87,6 +92,8 @@ pub struct AutonomyConfig {
     /// deviations of the estimate's lateral uncertainty at the vehicle's farthest point
     /// (`PoseEstimate::lateral_sigma_at_m`). Default 2.
     pub uncertainty_sigmas: f64,
+    /// Movers: prediction and the space-time check (`[autonomy.traffic]`).
+    pub traffic: crate::traffic::TrafficConfig,
     /// Above this lateral standard deviation the wanted speed falls linearly ... Default 0.15 m.
     pub uncertainty_slow_m: f64,
     /// ... to a stop at this one, metres. Default 0.5.
@@ -121,6 +128,7 @@ impl Default for AutonomyConfig {
             max_offset_m: 3.0,
             offset_step_m: 0.25,
             horizon_m: 30.0,
+            max_horizon_m: 60.0,
             transition_m: 12.0,
             step_m: 0.5,
             planner_safety_m: 0.6,
@@ -139,6 +147,7 @@ impl Default for AutonomyConfig {
             uncertainty_sigmas: 2.0,
             uncertainty_slow_m: 0.15,
             uncertainty_stop_m: 0.5,
+            traffic: crate::traffic::TrafficConfig::default(),
         }
     }
 }
@@ -288,32 +297,71 @@ fn frenet_pose(
     Isometry2::new(q.coords, wrap_angle(heading + slope.atan()))
 }
 
-/// The fastest speed from which the vehicle stops within `cfg.detection_range_m` (reaction
-/// time, braking at `deceleration_m_s2` and the stop buffer included); infinite without one.
-pub fn sight_speed_m_s(deceleration_m_s2: f64, cfg: &AutonomyConfig) -> f64 {
-    let Some(range) = cfg.detection_range_m else {
-        return f64::INFINITY;
-    };
+/// Distance to stop from `v` m/s: reaction, braking at `deceleration_m_s2`, the stop buffer.
+pub fn stopping_distance_m(v: f64, deceleration_m_s2: f64, cfg: &AutonomyConfig) -> f64 {
+    v * cfg.reaction_s + v * v / (2.0 * deceleration_m_s2) + cfg.stop_buffer_m
+}
+
+/// The fastest speed from which the vehicle stops within `range_m` (reaction time, braking at
+/// `deceleration_m_s2` and the stop buffer included).
+fn speed_to_stop_within(range_m: f64, deceleration_m_s2: f64, cfg: &AutonomyConfig) -> f64 {
     // v t + v^2 / 2a + buffer = range, for v >= 0.
     let (a, t) = (deceleration_m_s2, cfg.reaction_s);
-    let room = (range - cfg.stop_buffer_m).max(0.0);
+    let room = (range_m - cfg.stop_buffer_m).max(0.0);
     a * (-t + (t * t + 2.0 * room / a).sqrt())
 }
 
-/// The avoider: the speed to command on the chosen candidate (never above what the detection
-/// range allows), and how many 0.95 scalings it took.
+/// The fastest speed from which the vehicle stops within `cfg.detection_range_m`; infinite
+/// without one.
+pub fn sight_speed_m_s(deceleration_m_s2: f64, cfg: &AutonomyConfig) -> f64 {
+    cfg.detection_range_m.map_or(f64::INFINITY, |r| {
+        speed_to_stop_within(r, deceleration_m_s2, cfg)
+    })
+}
+
+/// Why the vehicle may go no faster than it does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpeedLimit {
+    /// It could not stop within the longest horizon (`max_horizon_m`) from faster.
+    Horizon,
+    /// It could not stop within the detection range (`detection_range_m`) from faster.
+    DetectionRange,
+}
+
+/// The fastest the vehicle may go, and what limits it: it stops within both the longest horizon
+/// and the detection range.
+pub fn speed_cap_m_s(deceleration_m_s2: f64, cfg: &AutonomyConfig) -> (f64, SpeedLimit) {
+    let horizon = speed_to_stop_within(cfg.max_horizon_m, deceleration_m_s2, cfg);
+    let sight = sight_speed_m_s(deceleration_m_s2, cfg);
+    if sight < horizon {
+        (sight, SpeedLimit::DetectionRange)
+    } else {
+        (horizon, SpeedLimit::Horizon)
+    }
+}
+
+/// The horizon checked at `speed_m_s`: the stopping distance plus a step, at least `horizon_m`,
+/// at most `max_horizon_m`.
+pub fn horizon_for_m(speed_m_s: f64, deceleration_m_s2: f64, cfg: &AutonomyConfig) -> f64 {
+    (stopping_distance_m(speed_m_s, deceleration_m_s2, cfg) + cfg.step_m)
+        .min(cfg.max_horizon_m)
+        .max(cfg.horizon_m)
+}
+
+/// The avoider: the speed to command on the chosen candidate (never above [`speed_cap_m_s`]),
+/// and how many 0.95 scalings it took.
 pub fn avoid(
     candidate: &Candidate,
     wanted_m_s: f64,
     deceleration_m_s2: f64,
     cfg: &AutonomyConfig,
 ) -> (f64, u32) {
-    let wanted_m_s = wanted_m_s.min(sight_speed_m_s(deceleration_m_s2, cfg));
+    let wanted_m_s = wanted_m_s.min(speed_cap_m_s(deceleration_m_s2, cfg).0);
     let Some(at) = candidate.collision_at_m else {
         return (wanted_m_s, 0);
     };
-    let stopping =
-        |v: f64| v * cfg.reaction_s + v * v / (2.0 * deceleration_m_s2) + cfg.stop_buffer_m;
+    let stopping = |v: f64| stopping_distance_m(v, deceleration_m_s2, cfg);
     let mut v = wanted_m_s;
     let mut scalings = 0;
     while stopping(v) >= at && v > 0.05 && scalings < 500 {
@@ -411,6 +459,28 @@ mod tests {
             5.0,
             "slower than the cap: unchanged"
         );
-        assert_eq!(avoid(&free, 20.0, 3.0, &AutonomyConfig::default()).0, 20.0);
+        // Without a detection range the longest horizon (60 m) caps it.
+        let (v, _) = avoid(&free, 20.0, 3.0, &AutonomyConfig::default());
+        let stopping = v * 0.5 + v * v / 6.0 + 3.0;
+        assert!(
+            (stopping - 60.0).abs() < 1e-9,
+            "{v} m/s stops in {stopping} m"
+        );
+        assert_eq!(
+            speed_cap_m_s(3.0, &cfg).1,
+            SpeedLimit::DetectionRange,
+            "the nearer limit"
+        );
+    }
+
+    /// The horizon grows with speed to the stopping distance plus a step: the jet (1.5 m/s^2)
+    /// at 10 m/s needs 0.5 x 10 + 100 / 3 + 3 = 41.3 m, beyond the 30 m it checked before.
+    #[test]
+    fn the_horizon_grows_with_speed() {
+        let cfg = AutonomyConfig::default();
+        assert_eq!(horizon_for_m(3.0, 1.5, &cfg), 30.0);
+        let h = horizon_for_m(10.0, 1.5, &cfg);
+        assert!((h - (5.0 + 100.0 / 3.0 + 3.0 + 0.5)).abs() < 1e-9, "{h}");
+        assert_eq!(horizon_for_m(30.0, 1.5, &cfg), 60.0);
     }
 }

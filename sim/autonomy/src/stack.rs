@@ -7,8 +7,12 @@ use nalgebra::{Isometry2, Point2, Vector2};
 
 use crate::messages::{Command, Odometry, PoseEstimate};
 use crate::online_map::OnlineMap;
-use crate::planner::{AutonomyConfig, Behaviour, Plan, avoid, plan, pure_pursuit};
+use crate::planner::{
+    AutonomyConfig, Behaviour, Plan, SpeedLimit, avoid, horizon_for_m, plan, pure_pursuit,
+    speed_cap_m_s, stopping_distance_m,
+};
 use crate::route::{RoutePath, wrap_angle};
+use crate::traffic::{Conflict, Prediction, SpeedProfile, TimedPath, first_conflict, predict};
 
 /// Half length of the stretch of route searched around the last progress when the estimate is
 /// projected onto it, metres (so a circuit that passes near itself is followed in order).
@@ -23,6 +27,8 @@ pub struct VehicleModel {
     pub wheelbase_m: f64,
     /// Braking the avoider counts on, m/s^2.
     pub deceleration_m_s2: f64,
+    /// Acceleration the space-time check expects of it, m/s^2.
+    pub acceleration_m_s2: f64,
     /// What the vehicle does about an obstacle in its way.
     pub behaviour: Behaviour,
 }
@@ -60,6 +66,14 @@ pub enum DriverStatus {
         /// When the wait began, seconds.
         since_s: f64,
     },
+    /// Stopped short of where a mover is predicted to cross its path: it drives on once the
+    /// mover is predicted clear.
+    Yielding {
+        /// The mover's track id.
+        track_id: u32,
+        /// Where the mover is predicted to be when the vehicle would meet it, metres.
+        mover_at: Point2<f64>,
+    },
 }
 
 /// Planner, avoider, behaviour and follower over a route.
@@ -83,6 +97,10 @@ pub struct Driver {
     /// The farthest any circle of the collision model reaches from the vehicle's origin, metres
     /// (where a heading error moves the vehicle most).
     reach_m: f64,
+    /// The movers predicted at the last plan.
+    predictions: Vec<Prediction>,
+    /// The conflict with a mover the last plan found on the chosen path.
+    conflict: Option<Conflict>,
 }
 
 impl Driver {
@@ -115,6 +133,8 @@ impl Driver {
             speed_command_m_s: 0.0,
             status: DriverStatus::Driving,
             last_revolution_s: None,
+            predictions: Vec::new(),
+            conflict: None,
         }
     }
 
@@ -187,10 +207,15 @@ impl Driver {
         self.route_s_m = Some(s);
         let checker = self.vehicle.collision.checker(map.map().distance_maps())?;
         let previous = self.plan.as_ref().map_or(0.0, |p| p.chosen().offset_m);
-        // A less certain estimate: wider margins, a lower speed.
+        // A less certain estimate: wider margins, a lower speed; never faster than it can stop
+        // within the longest horizon and the detection range, and the horizon long enough to
+        // stop within at the speed it wants.
         let sigma_m = estimate.lateral_sigma_at_m(self.reach_m);
-        let (config, speed_factor) = self.config.under_uncertainty(sigma_m);
-        let p = plan(
+        let (mut config, speed_factor) = self.config.under_uncertainty(sigma_m);
+        let decel = self.vehicle.deceleration_m_s2;
+        let wanted = (self.wanted_speed_m_s * speed_factor).min(speed_cap_m_s(decel, &config).0);
+        config.horizon_m = horizon_for_m(wanted, decel, &config);
+        let mut p = plan(
             &checker,
             &self.route,
             s,
@@ -199,23 +224,104 @@ impl Driver {
             self.vehicle.behaviour,
             &config,
         );
-        let (v, _) = avoid(
-            p.chosen(),
-            self.wanted_speed_m_s * speed_factor,
-            self.vehicle.deceleration_m_s2,
-            &config,
-        );
+        let mut conflict = self.traffic_conflict(&p, map, wanted, estimate.t_s, &config, false);
+        let v0 = self.last_odometry.map_or(0.0, |o| o.speed_m_s.max(0.0));
+        if conflict.is_some_and(|c| stopping_distance_m(v0, decel, &config) >= c.zone_m) {
+            // Too late to stop short of the mover's path: standing in it is the worst choice.
+            // Drive on if the vehicle clears the mover with the tighter committed margin.
+            let committed = self.traffic_conflict(&p, map, wanted, estimate.t_s, &config, true);
+            if committed.is_none() {
+                conflict = None;
+            }
+        }
+        let mut chosen = p.chosen().clone();
+        if let Some(c) = &conflict {
+            // Stop before the conflict zone when it can; before the conflict itself otherwise.
+            let short_of_zone = stopping_distance_m(v0, decel, &config) < c.zone_m;
+            let stop_at = if short_of_zone { c.zone_m } else { c.at_m };
+            chosen.collision_at_m = Some(chosen.collision_at_m.map_or(stop_at, |s| s.min(stop_at)));
+        }
+        let (v, _) = avoid(&chosen, wanted, decel, &config);
         self.speed_command_m_s = v;
-        self.status = if v > 0.0 {
-            DriverStatus::Driving
-        } else {
-            self.stopped_status(&p, map, estimate.t_s)
+        self.status = match conflict {
+            _ if v > 0.0 => DriverStatus::Driving,
+            Some(c) if chosen.collision_at_m != p.chosen().collision_at_m => {
+                DriverStatus::Yielding {
+                    track_id: c.track_id,
+                    mover_at: c.mover_at,
+                }
+            }
+            _ => self.stopped_status(&p, map, estimate.t_s),
         };
+        self.conflict = conflict;
+        if let Some(c) = &conflict {
+            // The plan shows where the vehicle stops for the mover.
+            let k = p.chosen;
+            p.candidates[k].collision_at_m = chosen.collision_at_m.or(Some(c.at_m));
+        }
         self.plan = Some(p);
         Ok(PlanTimes {
             distance_maps_s: (t1 - t0).as_secs_f64(),
             planning_s: t1.elapsed().as_secs_f64(),
         })
+    }
+
+    /// The movers predicted from `map`'s tracker, and the first conflict on `p`'s chosen path
+    /// for a vehicle going from its speed now to `wanted` m/s (`None` with traffic off);
+    /// `committed`: with the time margin of a vehicle that can no longer stop short.
+    fn traffic_conflict(
+        &mut self,
+        p: &Plan,
+        map: &OnlineMap,
+        wanted: f64,
+        now_s: f64,
+        config: &AutonomyConfig,
+        committed: bool,
+    ) -> Option<Conflict> {
+        let mut traffic = config.traffic.clone();
+        if committed {
+            traffic.time_margin_s = traffic.committed_margin_s;
+            traffic.resume_margin_s = 0.0;
+        }
+        let traffic = &traffic;
+        if !traffic.enabled {
+            self.predictions.clear();
+            return None;
+        }
+        self.predictions = predict(&map.movers(), now_s, traffic);
+        if self.predictions.is_empty() {
+            return None;
+        }
+        let profile = SpeedProfile {
+            speed_m_s: self.last_odometry.map_or(0.0, |o| o.speed_m_s.max(0.0)),
+            target_m_s: wanted,
+            acceleration_m_s2: self.vehicle.acceleration_m_s2,
+        };
+        let path = TimedPath {
+            poses: &p.chosen().poses,
+            step_m: config.step_m,
+            profile,
+            now_s,
+            yielding: matches!(self.status, DriverStatus::Yielding { .. }),
+        };
+        first_conflict(&path, &self.vehicle.collision, &self.predictions, traffic)
+    }
+
+    /// The fastest the driver will go on this route, and why, when it is below the route's
+    /// speed (`None`: the route's speed is allowed).
+    pub fn route_speed_lowered(&self) -> Option<(f64, SpeedLimit)> {
+        let (cap, why) = speed_cap_m_s(self.vehicle.deceleration_m_s2, &self.config);
+        (cap < self.wanted_speed_m_s).then_some((cap, why))
+    }
+
+    /// The movers predicted at the last plan, with their discs over the horizon.
+    pub fn predictions(&self) -> &[Prediction] {
+        &self.predictions
+    }
+
+    /// The conflict with a mover found on the chosen path at the last plan.
+    pub fn conflict(&self) -> Option<&Conflict> {
+        self.conflict.as_ref()
     }
 
     /// Why the vehicle is stopped by the chosen candidate's first colliding pose: the obstacle
@@ -345,6 +451,7 @@ mod tests {
                 collision,
                 wheelbase_m: 2.5,
                 deceleration_m_s2: 3.0,
+                acceleration_m_s2: 1.0,
                 behaviour: Behaviour::Deviate,
             },
             AutonomyConfig::default(),

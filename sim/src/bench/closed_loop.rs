@@ -97,5 +97,81 @@ pub fn loop_figures(
     ] {
         out.push(figure(&name(what), per_scan(seconds), "ms", None));
     }
+    progress("traffic: prediction and the space-time check");
+    out.extend(traffic_figures(samples.max(5)));
     Ok(out)
+}
+
+/// Prediction and the space-time check of one revolution: 20 movers around the 62-circle jet's
+/// 41.5 m path (its horizon at 10 m/s, 84 poses), none in conflict so every pose is checked for
+/// every mover - the worst case - against the same check of every circle at every pose, one
+/// thread each, in alternation.
+fn traffic_figures(samples: usize) -> Vec<Figure> {
+    use autonomy::traffic::{
+        SpeedProfile, TimedPath, TrafficConfig, first_conflict, first_conflict_straightforward,
+        predict,
+    };
+    use nalgebra::{Isometry2, Matrix4, Point2, Vector2, Vector4};
+    let model = mapper::workloads::jet_62_circles();
+    let poses: Vec<Isometry2<f64>> = (0..84)
+        .map(|k| Isometry2::new(Vector2::new(k as f64 * 0.5, 0.0), 0.0))
+        .collect();
+    // Movers 15-40 m either side, driving along the road: always near, never in conflict.
+    let tracks: Vec<mapper::TrackState> = (0..20)
+        .map(|i| {
+            let side = if i % 2 == 0 { 1.0 } else { -1.0 };
+            mapper::TrackState {
+                id: i,
+                t_s: 0.0,
+                position: Point2::new(2.0 * i as f64, side * (15.0 + i as f64)),
+                velocity: Vector2::new(if i % 3 == 0 { -3.0 } else { 2.0 }, 0.0),
+                covariance: Matrix4::from_diagonal(&Vector4::new(0.02, 0.02, 0.05, 0.05)),
+                extent_m: 4.9,
+                levels: 0b11,
+                confirmed: true,
+                bbox: ((0, 0), (22, 8)),
+                size_m: [4.6, 1.8],
+            }
+        })
+        .collect();
+    let cfg = TrafficConfig::default();
+    let path = TimedPath {
+        poses: &poses,
+        step_m: 0.5,
+        profile: SpeedProfile {
+            speed_m_s: 10.0,
+            target_m_s: 10.0,
+            acceleration_m_s2: 0.5,
+        },
+        now_s: 0.0,
+        yielding: false,
+    };
+    let (mut found, mut plain_found) = (None, None);
+    let (fast, plain) = super::timing::alternating(
+        samples,
+        20,
+        || {
+            let p = predict(&tracks, 0.0, &cfg);
+            found = std::hint::black_box(first_conflict(&path, &model, &p, &cfg));
+        },
+        || {
+            let p = predict(&tracks, 0.0, &cfg);
+            plain_found =
+                std::hint::black_box(first_conflict_straightforward(&path, &model, &p, &cfg));
+        },
+    );
+    debug_assert_eq!(found, plain_found);
+    let plain = figure(
+        "traffic/predict_and_check/20_movers/jet_62_circles/every_circle",
+        plain,
+        "ms",
+        None,
+    );
+    let fast = figure(
+        "traffic/predict_and_check/20_movers/jet_62_circles",
+        fast,
+        "ms",
+        Some("< 0.5 ms a revolution"),
+    );
+    vec![super::timing::against(fast, &plain), plain]
 }

@@ -489,7 +489,8 @@ const SHAPE_KEYS: [&str; 3] = ["size_m", "radius_m", "height_m"];
 /// Merges a drawn obstacle into the document: into the base obstacle of its id, or as a new
 /// one; `with` merges a drawn table in; `along_m` / `offset_m` place it from the route
 /// (`yaw_rad` then relative to the route's heading), `crossing_m = [from, to]` makes it cross
-/// the route at `along_m` between those lateral offsets.
+/// the route at `along_m` between those offsets along a line at `crossing_angle_deg` (default
+/// 90) from the route's heading, reaching the route at `arrives_s` when given.
 fn put_obstacle(doc: &mut Table, mut o: Table, route: &RoutePath) {
     if let Some(Value::Table(with)) = o.remove("with") {
         for (k, v) in with {
@@ -509,7 +510,28 @@ fn put_obstacle(doc: &mut Table, mut o: Table, route: &RoutePath) {
                 num(c.first().cloned()).unwrap_or(-5.0),
                 num(c.get(1).cloned()).unwrap_or(5.0),
             );
-            let path = [at(d + a), at(d + b)].map(|q| {
+            // The crossing line through the crossing point, at `crossing_angle_deg` from the
+            // route's heading (90: square across it, left-bound from `a < 0`).
+            let angle = num(o.remove("crossing_angle_deg")).map_or(90.0, f64::to_radians);
+            let dir = nalgebra::Vector2::new((heading + angle).cos(), (heading + angle).sin());
+            let cross = at(d);
+            let mut from = cross + dir * a;
+            // `arrives_s`: the mover reaches the crossing point then (at its speed), so it
+            // appears that much earlier - or, when that would be before the start, appears at
+            // the start that much nearer.
+            if let (Some(arrives), Some(speed)) =
+                (num(o.remove("arrives_s")), num(o.get("speed_m_s").cloned()))
+            {
+                let lead = (cross - from).norm();
+                let appears = arrives - lead / speed.max(1e-9);
+                if appears >= 0.0 {
+                    o.insert("appears_s".into(), Value::Float(round_mm(appears)));
+                } else {
+                    from = cross - dir * (speed * arrives.max(0.0)).min(lead);
+                    o.insert("appears_s".into(), Value::Float(0.0));
+                }
+            }
+            let path = [from, cross + dir * b].map(|q| {
                 Value::Array(vec![
                     Value::Float(round_mm(q.x)),
                     Value::Float(round_mm(q.y)),

@@ -1,5 +1,6 @@
 //! A run's record in a campaign's `results.jsonl` ([`RunRecord`], one JSON line per run: the
-//! sampled values, the setting, contacts, clearances, passes, the end, the wall time), made from
+//! sampled values, the setting, contacts and who was at fault, clearances, passes, the movers'
+//! traffic-conflict figures, the end, the wall time), made from
 //! a run's report ([`record`]) or for a variant that is not a valid scenario ([`INVALID`]), and
 //! read back ([`read_results`], which drops a last line cut short).
 
@@ -29,6 +30,13 @@ pub struct ObstacleOutcome {
     pub met: bool,
     /// Smallest ground-truth clearance per level over its passes, metres.
     pub min_clearance_m: Vec<Option<f64>>,
+    /// A mover's smallest time to collision, seconds (`None`: never on a collision course, or
+    /// not a mover).
+    #[serde(default)]
+    pub min_ttc_s: Option<f64>,
+    /// A mover's post-encroachment time, seconds (`None`: no conflict area, or not a mover).
+    #[serde(default)]
+    pub pet_s: Option<f64>,
 }
 
 /// One line of `results.jsonl`.
@@ -52,7 +60,8 @@ pub struct RunRecord {
     pub end: String,
     /// Whether every expectation held.
     pub expectations_met: bool,
-    /// A contact, or an unmet expectation.
+    /// A contact (with `[expectations] no_contact_at_fault`: a contact at fault), or an unmet
+    /// expectation.
     pub failed: bool,
     /// What failed, one line each.
     pub failures: Vec<String>,
@@ -63,6 +72,19 @@ pub struct RunRecord {
     /// Contacts that began while the vehicle stood still (something ran into it).
     #[serde(default)]
     pub contacts_while_stopped: usize,
+    /// Contacts that began while the vehicle moved (|true speed| > 0.05 m/s): the stack's fault.
+    #[serde(default)]
+    pub contacts_at_fault: usize,
+    /// Contacts that began while the vehicle stood: struck by a mover.
+    #[serde(default)]
+    pub contacts_struck: usize,
+    /// Smallest time to collision with any mover, seconds (`None`: never on a collision course,
+    /// or no mover).
+    #[serde(default)]
+    pub min_ttc_s: Option<f64>,
+    /// Smallest post-encroachment time with any mover, seconds (`None`: no conflict area).
+    #[serde(default)]
+    pub min_pet_s: Option<f64>,
     /// Per run-time obstacle.
     pub obstacles: Vec<ObstacleOutcome>,
     /// Smallest ground-truth clearance per level to any object, metres.
@@ -126,26 +148,42 @@ fn as_json<'a>(
         .collect()
 }
 
-/// The record of a run of variant `v`.
-pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunReport) -> RunRecord {
-    let mut failures = Vec::new();
-    let mut contacts_with: Vec<String> = r.contacts.iter().map(|c| c.object.clone()).collect();
-    contacts_with.dedup();
+/// One failure line per contact that counts (with `no_contact_at_fault`, a contact struck while
+/// standing does not); returns how many contacts began during a stop.
+fn contact_failures(scenario: &Scenario, r: &RunReport, failures: &mut Vec<String>) -> usize {
     let standing = |t: f64| {
         r.stops
             .iter()
             .any(|s| s.start_s <= t && s.end_s.is_none_or(|e| t <= e))
     };
     let mut contacts_while_stopped = 0;
-    for c in &r.contacts {
+    for (k, c) in r.contacts.iter().enumerate() {
         let still = standing(c.time_s);
         contacts_while_stopped += usize::from(still);
-        let how = if still { " (standing)" } else { "" };
+        let at_fault = r.contacts_judged.get(k).is_none_or(|j| j.at_fault);
+        if scenario.no_contact_at_fault && !at_fault {
+            // Struck while standing: not a failure by this scenario's rule.
+            continue;
+        }
+        let how = match (still, at_fault) {
+            (_, false) => " (struck)",
+            (true, true) => " (standing)",
+            (false, true) => "",
+        };
         failures.push(format!(
             "contact{how}: {} with {} at {:.1} s",
             c.part, c.object, c.time_s
         ));
     }
+    contacts_while_stopped
+}
+
+/// The record of a run of variant `v`.
+pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunReport) -> RunRecord {
+    let mut failures = Vec::new();
+    let mut contacts_with: Vec<String> = r.contacts.iter().map(|c| c.object.clone()).collect();
+    contacts_with.dedup();
+    let contacts_while_stopped = contact_failures(scenario, r, &mut failures);
     let (mut false_stops, mut needless, mut deviations) = (0, 0, 0);
     let mut obstacles = Vec::new();
     let mut obstacle_clearance = f64::INFINITY;
@@ -189,6 +227,8 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
                 .map_or("not_passed".into(), |p| p.as_str().into()),
             met: o.passes.iter().all(|p| p.met),
             min_clearance_m: per_level.into_iter().map(finite).collect(),
+            min_ttc_s: o.min_ttc_s,
+            pet_s: o.pet_s,
         });
     }
     let end = serde_json::to_value(r.end)
@@ -207,7 +247,13 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
     if !r.expectations_met && failures.is_empty() {
         failures.push("an expectation was not met".into());
     }
-    let failed = !r.contacts.is_empty() || !r.expectations_met;
+    let counted_contacts = if scenario.no_contact_at_fault {
+        r.contacts_at_fault
+    } else {
+        r.contacts.len()
+    };
+    let failed = counted_contacts > 0 || !r.expectations_met;
+    let min_of = |xs: &mut dyn Iterator<Item = f64>| xs.reduce(f64::min);
     let clearance = finite(obstacle_clearance);
     let score = clearance.unwrap_or(10.0).min(10.0)
         - if failed { 1.0 } else { 0.0 }
@@ -227,6 +273,10 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
         contacts: r.contacts.len(),
         contacts_with,
         contacts_while_stopped,
+        contacts_at_fault: r.contacts_at_fault,
+        contacts_struck: r.contacts_struck,
+        min_ttc_s: min_of(&mut r.obstacles.iter().filter_map(|o| o.min_ttc_s)),
+        min_pet_s: min_of(&mut r.obstacles.iter().filter_map(|o| o.pet_s)),
         obstacles,
         min_clearance_m: r.min_clearance_m.iter().copied().map(finite).collect(),
         obstacle_clearance_m: clearance,
@@ -264,6 +314,10 @@ pub(super) fn invalid(campaign: &Campaign, v: &Variant, why: &str) -> RunRecord 
         contacts: 0,
         contacts_with: Vec::new(),
         contacts_while_stopped: 0,
+        contacts_at_fault: 0,
+        contacts_struck: 0,
+        min_ttc_s: None,
+        min_pet_s: None,
         obstacles: Vec::new(),
         min_clearance_m: Vec::new(),
         obstacle_clearance_m: None,

@@ -1,5 +1,5 @@
 //! A campaign directory's `summary.md`, from its `results.jsonl`: per parameter setting the
-//! runs, failures, contacts, unmet expectations, false stops and needless deviations, clearance
+//! runs, failures, contacts (standing; at fault / struck), unmet expectations, false stops and needless deviations, clearance
 //! percentiles and lap times; for the falsifier, the generations; the error table of the
 //! failing variants. `taxi-sim campaign show DIR` prints it.
 
@@ -80,7 +80,7 @@ pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
         1000.0 * failed.len() as f64 / records.len().max(1) as f64,
         first.map_or("none yet".into(), |n| n.to_string())
     );
-    s += "## Per parameter setting\n\n| setting | runs | failed | runs with contact | contacts (standing) | unmet expectations | false stops | needless deviations | obstacle clearance p0 / p5 / p50 (m) | lap time p50 / max (s) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    s += "## Per parameter setting\n\n| setting | runs | failed | runs with contact | contacts (standing) | at fault / struck | unmet expectations | false stops | needless deviations | obstacle clearance p0 / p5 / p50 (m) | mover TTC / PET p0 (s) | lap time p50 / max (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     let mut by_setting: BTreeMap<usize, Vec<&RunRecord>> = BTreeMap::new();
     for r in records {
         by_setting.entry(r.setting).or_default().push(r);
@@ -94,9 +94,13 @@ pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
             .collect();
         laps.sort_by(f64::total_cmp);
         let standing: usize = rs.iter().map(|r| r.contacts_while_stopped).sum();
+        let at_fault: usize = rs.iter().map(|r| r.contacts_at_fault).sum();
+        let struck: usize = rs.iter().map(|r| r.contacts_struck).sum();
+        let ttc = rs.iter().filter_map(|r| r.min_ttc_s).reduce(f64::min);
+        let pet = rs.iter().filter_map(|r| r.min_pet_s).reduce(f64::min);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} ({standing}) | {} | {} | {} | {} / {} / {} | {} / {} |",
+            "| {} | {} | {} | {} | {} ({standing}) | {at_fault} / {struck} | {} | {} | {} | {} / {} / {} | {} / {} | {} / {} |",
             setting_label(rs[0]),
             rs.len(),
             rs.iter().filter(|r| r.failed).count(),
@@ -108,6 +112,8 @@ pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
             m(quantile(&clear, 0.0)),
             m(quantile(&clear, 0.05)),
             m(quantile(&clear, 0.5)),
+            m(ttc),
+            m(pet),
             m(quantile(&laps, 0.5)),
             m(laps.last().copied()),
         );

@@ -238,21 +238,27 @@ impl Rig<'_> {
             world: &self.world,
             particles: self.pose_source.particles(),
             pose_estimate: self.driver.estimate().copied(),
+            predictions: self.driver.predictions(),
+            conflict: self.driver.conflict().copied(),
         })
     }
 
-    /// Run-time obstacles appear, move and go as the scenario says.
+    /// Run-time obstacles appear, move and go as the scenario says: the traffic steps to now
+    /// around the vehicle's true pose (drivers that yield react to it), then each obstacle's
+    /// collider is shown, placed or hidden.
     fn move_obstacles(&mut self) {
+        self.traffic
+            .step(self.t_s, &self.state.world_from_vehicle());
         let first = self.scenario.objects.len();
         for (k, o) in self.scenario.obstacles.iter().enumerate() {
             let i = first + k;
-            match o.pose_at(self.t_s) {
-                Some((x, y, yaw)) => {
+            match self.traffic.state(k) {
+                Some(m) => {
                     if !self.world.object_active(i) {
                         self.world.set_object_active(i, true);
                     }
                     if o.motion.is_some() {
-                        self.world.set_object_pose(i, x, y, yaw);
+                        self.world.set_object_pose(i, m.x_m, m.y_m, m.yaw_rad);
                     }
                 }
                 None if self.world.object_active(i) => self.world.set_object_active(i, false),

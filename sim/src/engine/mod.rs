@@ -1,12 +1,16 @@
 //! One closed-loop run: the rig that builds its parts and drives the loop ([`run`],
 //! [`run_with`]), the schedule that maps and plans each revolution ([`Scheduler`]), the pose
 //! sources ([`PoseSource`]: truth, noisy truth, the particle filter), the pose-error log
-//! ([`ErrorLog`]), the judge ([`Judge`]: ground truth, passes, stops, laps, verdicts), the
-//! observer hook ([`Observer`]) and the report ([`RunReport`]). The vocabulary of a run's outcome
-//! ([`Event`], [`PassOutcome`], [`EndReason`], [`Stop`], ...) is the leaf `outcome`, which the
-//! judge, the observer and the report all point down at.
+//! ([`ErrorLog`]), the judge ([`Judge`]: ground truth, passes, stops, laps, contacts and who was at
+//! fault, traffic conflicts with movers - `conflict`: time to collision, post-encroachment time -,
+//! verdicts), the
+//! observer hook ([`Observer`]), the report ([`RunReport`]) and the run-time traffic
+//! ([`Traffic`]: each obstacle's pose and speed each step, drivers that yield to the vehicle).
+//! The vocabulary of a run's outcome ([`Event`], [`PassOutcome`], [`EndReason`], [`Stop`], ...)
+//! is the leaf `outcome`, which the judge, the observer and the report all point down at.
 
 mod closed_loop;
+mod conflict;
 mod judge;
 mod observer;
 mod outcome;
@@ -15,12 +19,16 @@ mod pose_source;
 mod report;
 mod rig;
 mod schedule;
+mod traffic;
 
 pub use judge::{DEVIATION_M, Judge, StepVerdict, Verdict};
 pub use observer::{NoObserver, Observer, RevolutionFrame, RunStart, StepFrame};
-pub use outcome::{EndReason, Event, ObstacleReport, Pass, PassOutcome, Stop};
+pub use outcome::{
+    AT_FAULT_SPEED_M_S, EndReason, Event, JudgedContact, ObstacleReport, Pass, PassOutcome, Stop,
+};
 pub use pose_error::{ErrorLog, ErrorStats, LocalizationErrors, LocalizationReport};
 pub use pose_source::{LocalizationContext, Localizer, NoisyTruth, PoseSource, Truth, from_config};
 pub use report::{HiddenObstacle, Progress, RunReport, TimeSplit};
 pub use rig::{RunHandles, RunSetup, distance_cap_m, distance_map_half_size_m, run, run_with};
 pub use schedule::{Planned, Scheduler};
+pub use traffic::Traffic;

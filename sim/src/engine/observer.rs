@@ -92,6 +92,10 @@ pub struct RevolutionFrame<'a> {
     pub particles: Option<&'a [autonomy::localizer::Particle]>,
     /// The stack's current pose estimate with its covariance.
     pub pose_estimate: Option<autonomy::PoseEstimate>,
+    /// The movers the stack predicted, with their footprints over the horizon.
+    pub predictions: &'a [autonomy::Prediction],
+    /// The conflict with a mover on the chosen path that the stack slowed or stopped for.
+    pub conflict: Option<autonomy::Conflict>,
 }
 
 /// One physics step, given to [`Observer::step`].

@@ -1,6 +1,7 @@
 //! The vocabulary of a run's outcome: what happened ([`Event`]), what the vehicle did at each
-//! pass by an obstacle ([`PassOutcome`], [`Pass`], [`ObstacleReport`]), its stops ([`Stop`]) and
-//! why the run ended ([`EndReason`]). The leaf of the engine: the judge, the observer and the
+//! pass by an obstacle ([`PassOutcome`], [`Pass`], [`ObstacleReport`]), its contacts and who was
+//! at fault ([`JudgedContact`]), its stops ([`Stop`]) and why the run ended ([`EndReason`]).
+//! The leaf of the engine: the judge, the observer and the
 //! report all point down at it.
 
 use serde::Serialize;
@@ -33,13 +34,18 @@ impl PassOutcome {
         }
     }
 
-    /// Whether this outcome is what `expect` asks for (contact and clearance aside).
+    /// Whether this outcome is what `expect` asks for (contact and clearance aside). For
+    /// `yield` the outcome is necessary, not sufficient: no outcome says who went first, so the
+    /// judge adds its yield rule (the mover crossed the route before the vehicle's front reached
+    /// it, with a positive post-encroachment time, and the vehicle drove on).
     pub fn meets(self, expect: Expectation) -> bool {
         match expect {
             Expectation::PassUnder => self == PassOutcome::Passed,
             Expectation::Deviate => self == PassOutcome::Deviated,
             Expectation::Stop => self == PassOutcome::Stopped,
             Expectation::NoContact => true,
+            // Stopped, or slowed and passed or deviated: the judge's yield rule decides.
+            Expectation::Yield => self != PassOutcome::Collided,
         }
     }
 }
@@ -92,6 +98,47 @@ pub struct ObstacleReport {
     pub expected: Expectation,
     /// Every pass.
     pub passes: Vec<Pass>,
+    /// A mover's smallest time to collision over the run, seconds (both extrapolated at
+    /// constant velocity, the vehicle along its arc, 10 s ahead; only the vehicle parts whose
+    /// heights overlap the mover's count). `None`: never on a collision course, or not a mover.
+    pub min_ttc_s: Option<f64>,
+    /// A mover's post-encroachment time, seconds: between the first of the two leaving the
+    /// area where their swept footprints overlap and the second entering it (0: in it together;
+    /// the smallest over the run's encounters). `None`: the swept footprints never overlap, or
+    /// not a mover.
+    pub pet_s: Option<f64>,
+    /// At that encounter, whether the mover went through first (`None`: together, no conflict
+    /// or not a mover).
+    pub pet_mover_first: Option<bool>,
+}
+
+/// A ground-truth contact and who was at fault: the vehicle moving when it began (the stack's
+/// fault) or standing (struck by a mover).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct JudgedContact {
+    /// The contact.
+    #[serde(flatten)]
+    pub contact: Contact,
+    /// The vehicle's true speed at the step the contact began, m/s (signed along its heading).
+    pub vehicle_speed_m_s: f64,
+    /// True when the vehicle was moving then (|speed| > 0.05 m/s): the stack's fault; false:
+    /// it stood and was struck.
+    pub at_fault: bool,
+}
+
+/// Above this true speed (m/s) the vehicle was moving when a contact began: the contact was the
+/// stack's fault.
+pub const AT_FAULT_SPEED_M_S: f64 = 0.05;
+
+impl JudgedContact {
+    /// `contact`, which began while the vehicle's true speed was `vehicle_speed_m_s`.
+    pub fn new(contact: Contact, vehicle_speed_m_s: f64) -> Self {
+        JudgedContact {
+            contact,
+            vehicle_speed_m_s,
+            at_fault: vehicle_speed_m_s.abs() > AT_FAULT_SPEED_M_S,
+        }
+    }
 }
 
 /// A stop of the vehicle.
@@ -126,8 +173,8 @@ pub enum Event {
     },
     /// The planner came back to the route.
     BackOnRoute,
-    /// A ground-truth contact began.
-    Contact(Contact),
+    /// A ground-truth contact began (with the vehicle's speed and whether it was at fault).
+    Contact(JudgedContact),
     /// A lap ended.
     Lap {
         /// Lap number (1-based).
@@ -148,5 +195,13 @@ pub enum Event {
         outcome: PassOutcome,
         /// Whether the scenario's expectation held.
         met: bool,
+    },
+    /// A mover's time to collision with the vehicle dropped under 3 s (once per encounter: again
+    /// only after it rose above 5 s or the two were no longer on a collision course).
+    Conflict {
+        /// The mover's id.
+        id: String,
+        /// The time to collision, seconds.
+        ttc_s: f64,
     },
 }

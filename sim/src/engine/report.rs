@@ -1,9 +1,10 @@
-//! A run's report: the judge's verdicts, the configuration it ran with, why it ended, and where
+//! A run's report: the judge's verdicts (contacts with who was at fault, passes, each mover's
+//! traffic-conflict figures), the configuration it ran with, why it ended, and where
 //! the wall time went.
 
 use serde::Serialize;
 
-use super::outcome::{EndReason, ObstacleReport, Stop};
+use super::outcome::{EndReason, JudgedContact, ObstacleReport, Stop};
 use crate::scenario::RunConfig;
 use crate::world::Contact;
 
@@ -29,6 +30,13 @@ pub struct RunReport {
     pub lap_times_s: Vec<f64>,
     /// Ground-truth contacts.
     pub contacts: Vec<Contact>,
+    /// The same contacts in the same order, each with the vehicle's true speed when it began and
+    /// whether the vehicle was at fault (moving, |speed| > 0.05 m/s) or struck (standing).
+    pub contacts_judged: Vec<JudgedContact>,
+    /// Contacts that began while the vehicle moved: the stack's fault.
+    pub contacts_at_fault: usize,
+    /// Contacts that began while the vehicle stood: struck by a mover.
+    pub contacts_struck: usize,
     /// Per run-time obstacle.
     pub obstacles: Vec<ObstacleReport>,
     /// Stops.

@@ -148,6 +148,8 @@ pub(super) struct Rig<'a> {
     pub(super) driver: Driver,
     pub(super) scheduler: Scheduler,
     pub(super) judge: Judge,
+    /// The run-time obstacles, moved each step (`Rig::move_obstacles`).
+    pub(super) traffic: super::traffic::Traffic,
     pub(super) state: VehicleState,
     pub(super) t_s: f64,
     pub(super) step: u64,
@@ -259,6 +261,7 @@ impl<'a> Rig<'a> {
             driver,
             scheduler: Scheduler::new(config.schedule, online),
             judge,
+            traffic: super::traffic::Traffic::new(&scenario.obstacles, vehicle),
             state,
             t_s: 0.0,
             step: 0,
@@ -301,7 +304,7 @@ impl<'a> Rig<'a> {
             EndReason::TimedOut | EndReason::WaitingForHiddenObstacle
         ) {
             // The vehicle may stand before an obstacle: its pass closes as it stands.
-            self.judge.close_open_passes(self.t_s, &self.world);
+            self.judge.close_open_passes(self.t_s, end);
         }
         let waiting_for = match (end, self.driver.status()) {
             (
@@ -332,6 +335,9 @@ impl<'a> Rig<'a> {
             laps_completed: verdict.laps_completed,
             lap_times_s: verdict.lap_times_s,
             contacts,
+            contacts_judged: verdict.contacts,
+            contacts_at_fault: verdict.contacts_at_fault,
+            contacts_struck: verdict.contacts_struck,
             obstacles: verdict.obstacles,
             stops: verdict.stops,
             min_clearance_m: verdict.min_clearance_m,
@@ -404,6 +410,7 @@ fn driver(
             collision: model.clone(),
             wheelbase_m: vehicle.spec.motion.wheelbase_m,
             deceleration_m_s2: vehicle.spec.motion.max_deceleration_m_s2,
+            acceleration_m_s2: vehicle.spec.motion.max_acceleration_m_s2,
             behaviour: Behaviour::for_steering(vehicle.spec.motion.steering),
         },
         config.autonomy.clone(),

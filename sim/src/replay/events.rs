@@ -27,9 +27,24 @@ pub(super) fn event_line(event: &Event) -> (String, &'static str) {
             "watchdog: revolutions are back".to_string(),
             TextLogLevel::INFO,
         ),
-        Event::Contact(c) => (
-            format!("contact: {} ({:?}) touched by {}", c.object, c.kind, c.part),
-            TextLogLevel::ERROR,
+        Event::Contact(j) => {
+            let c = &j.contact;
+            let fault = if j.at_fault {
+                format!("at fault, moving at {:.2} m/s", j.vehicle_speed_m_s)
+            } else {
+                "struck while standing".to_string()
+            };
+            (
+                format!(
+                    "contact: {} ({:?}) touched by {} ({fault})",
+                    c.object, c.kind, c.part
+                ),
+                TextLogLevel::ERROR,
+            )
+        }
+        Event::Conflict { id, ttc_s } => (
+            format!("conflict: {id}, time to collision {ttc_s:.1} s"),
+            TextLogLevel::WARN,
         ),
         Event::Lap { lap, time_s } => (format!("lap {lap} in {time_s:.1} s"), TextLogLevel::INFO),
         Event::Pass { id, outcome, met } => (
@@ -49,10 +64,12 @@ pub(super) fn event_line(event: &Event) -> (String, &'static str) {
 /// The run's last line: laps, contacts and whether every expectation held; and its level.
 pub(super) fn end_line(report: &RunReport) -> (String, &'static str) {
     let text = format!(
-        "end: {}/{} laps, {} contacts, {}{}",
+        "end: {}/{} laps, {} contacts ({} at fault, {} struck), {}{}",
         report.laps_completed,
         report.laps,
         report.contacts.len(),
+        report.contacts_at_fault,
+        report.contacts_struck,
         if report.expectations_met {
             "every expectation held"
         } else {

@@ -209,4 +209,68 @@ impl Replay {
         )?;
         Ok(())
     }
+
+    /// Each predicted mover's footprints over the horizon (capsules, from green now to red at
+    /// the horizon) and the conflict the vehicle slowed or stopped for (a red ring where the
+    /// mover would be).
+    pub(super) fn log_traffic(&mut self, frame: &RevolutionFrame<'_>) -> Result<()> {
+        let mut strips = Vec::new();
+        let mut colors = Vec::new();
+        for p in frame.predictions {
+            let horizon = p.discs.last().map_or(1.0, |d| d.dt_s.max(1e-9));
+            for d in &p.discs {
+                strips.push(capsule(d));
+                let u = (d.dt_s / horizon).clamp(0.0, 1.0);
+                colors.push(Rgba32::from_unmultiplied_rgba(
+                    (60.0 + 195.0 * u) as u8,
+                    (220.0 * (1.0 - u)) as u8,
+                    60,
+                    200,
+                ));
+            }
+        }
+        self.rec.log(
+            "world/traffic/predicted",
+            &rerun::LineStrips3D::new(strips)
+                .with_radii([0.03])
+                .with_colors(colors),
+        )?;
+        let ring: Vec<Vec<[f32; 3]>> = frame
+            .conflict
+            .iter()
+            .map(|c| {
+                (0..=24)
+                    .map(|k| {
+                        let a = k as f64 * std::f64::consts::TAU / 24.0;
+                        let q = c.mover_at + nalgebra::Vector2::new(a.cos(), a.sin()) * 1.5;
+                        [q.x as f32, q.y as f32, 0.1]
+                    })
+                    .collect()
+            })
+            .collect();
+        self.rec.log(
+            "world/traffic/conflict",
+            &rerun::LineStrips3D::new(ring)
+                .with_radii([0.08])
+                .with_colors([Rgba32::from_rgb(255, 30, 30)]),
+        )?;
+        Ok(())
+    }
+}
+
+/// The outline of a predicted footprint: a capsule along the mover's heading.
+fn capsule(d: &autonomy::traffic::PredictedDisc) -> Vec<[f32; 3]> {
+    let (r, h) = (d.radius_m, d.half_length_m);
+    let u = nalgebra::Vector2::new(d.heading_rad.cos(), d.heading_rad.sin());
+    let n = nalgebra::Vector2::new(-u.y, u.x);
+    let mut out = Vec::with_capacity(26);
+    for (end, sign) in [(h, 1.0), (-h, -1.0)] {
+        for k in 0..=12 {
+            let a = -std::f64::consts::FRAC_PI_2 + k as f64 * std::f64::consts::PI / 12.0;
+            let q = d.center + u * end + (u * a.cos() + n * a.sin()) * (r * sign);
+            out.push([q.x as f32, q.y as f32, 0.08]);
+        }
+    }
+    out.push(out[0]);
+    out
 }

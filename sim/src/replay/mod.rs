@@ -239,6 +239,7 @@ impl Observer for Replay {
         }
         self.log_localization(frame, full)?;
         self.log_plan(frame, full)?;
+        self.log_traffic(frame)?;
         self.rec.log(
             "plots/speed_scale",
             &rerun::Scalars::single(frame.speed_scale),

@@ -39,6 +39,9 @@ pub(super) fn kind_color(kind: ObjectKind) -> Rgba32 {
         ObjectKind::Vehicle => Rgba32::from_rgb(220, 40, 40),
         ObjectKind::Debris => Rgba32::from_rgb(200, 0, 160),
         ObjectKind::Box | ObjectKind::Cylinder => Rgba32::from_rgb(140, 120, 90),
+        ObjectKind::Person => Rgba32::from_rgb(255, 160, 200),
+        ObjectKind::Tug | ObjectKind::FuelTruck => Rgba32::from_rgb(240, 180, 0),
+        ObjectKind::BaggageCart => Rgba32::from_rgb(60, 110, 200),
     }
 }
 

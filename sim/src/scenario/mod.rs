@@ -21,14 +21,18 @@ mod resolve;
 mod run_config;
 mod spec;
 
-pub use model::{Ground, Obstacle, ObstacleMotion, Route, Scenario, ScenarioVehicle};
-pub use numbers::{Finite, Laps, NonNegative, Positive, Remission};
+pub use model::{
+    Ground, MotionStop, MoverState, Obstacle, ObstacleMotion, REACTIVE_ACCELERATION_M_S2, Route,
+    Scenario, ScenarioVehicle, TrainLink,
+};
+pub use numbers::{Count, Finite, Laps, NonNegative, Positive, Remission};
 pub use overlap::start_overlap;
 pub use run_config::{
     CollisionModelConfig, MappingConfig, NoisyTruthConfig, OBSTACLE_HEIGHT_M, PoseSourceConfig,
     RunConfig, SAFE_HEIGHT_FROM_GROUND_M, Schedule,
 };
 pub use spec::{
-    Expectation, ExpectationsSpec, ExpectedEnd, MAX_ROW_OBJECTS, ObjectSpec, ObstacleSpec,
-    PatchSpec, RouteSpec, RowLine, RowSpec, ScenarioFile, StartPose, VehicleEntry, WorldSpec,
+    Expectation, ExpectationsSpec, ExpectedEnd, MAX_ROW_OBJECTS, MAX_TRAIN_CARS, ObjectSpec,
+    ObstacleSpec, PatchSpec, RouteSpec, RowLine, RowSpec, ScenarioFile, StartPose, StopSpec,
+    TrainSpec, VehicleEntry, WorldSpec,
 };

@@ -1,6 +1,6 @@
 //! The validating numbers of a scenario file: newtypes checked while toml reads them, so a bad
 //! value's error points at the value ([`Finite`], [`Positive`], [`NonNegative`], [`Remission`],
-//! [`Laps`]).
+//! [`Laps`], [`Count`]).
 
 use serde::Deserialize;
 
@@ -85,6 +85,21 @@ impl TryFrom<i64> for Laps {
         match u32::try_from(v) {
             Ok(n) if n >= 1 => Ok(Laps(n)),
             _ => Err(format!("laps must be an integer >= 1, got {v}")),
+        }
+    }
+}
+
+/// A count of things, an integer >= 1 (a train's cars).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(try_from = "i64")]
+pub struct Count(pub u32);
+
+impl TryFrom<i64> for Count {
+    type Error = String;
+    fn try_from(v: i64) -> Result<Self, String> {
+        match u32::try_from(v) {
+            Ok(n) if n >= 1 => Ok(Count(n)),
+            _ => Err(format!("must be an integer >= 1, got {v}")),
         }
     }
 }

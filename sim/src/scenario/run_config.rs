@@ -322,6 +322,19 @@ impl RunConfig {
         }
         let a = &self.autonomy;
         positive("autonomy.horizon_m", a.horizon_m)?;
+        if a.max_horizon_m.partial_cmp(&a.horizon_m) == Some(std::cmp::Ordering::Less)
+            || !a.max_horizon_m.is_finite()
+        {
+            return Err(format!(
+                "autonomy.max_horizon_m = {} must be finite and at least autonomy.horizon_m = {}",
+                a.max_horizon_m, a.horizon_m
+            ));
+        }
+        if let Some((field, v)) = a.traffic.invalid_field() {
+            return Err(format!(
+                "autonomy.traffic.{field} = {v}: out of range (see `taxi-sim config`)"
+            ));
+        }
         positive("autonomy.step_m", a.step_m)?;
         positive("autonomy.offset_step_m", a.offset_step_m)?;
         positive("autonomy.transition_m", a.transition_m)?;
@@ -467,6 +480,18 @@ mod tests {
                 "pose_source.white_sigma_m",
             ),
             ("[autonomy]\nstep_m = 0.0\n", "autonomy.step_m"),
+            (
+                "[autonomy]\nmax_horizon_m = 20.0\n",
+                "autonomy.max_horizon_m",
+            ),
+            (
+                "[autonomy.traffic]\nhorizon_s = 0.0\n",
+                "autonomy.traffic.horizon_s",
+            ),
+            (
+                "[autonomy.traffic]\nsigmas = -1.0\n",
+                "autonomy.traffic.sigmas",
+            ),
             (
                 "[lidar]\natmosphere_attenuation_rate = nan\n",
                 "lidar.atmosphere_attenuation_rate",

@@ -7,7 +7,7 @@
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::numbers::{Finite, Laps, NonNegative, Positive, Remission};
+use super::numbers::{Count, Finite, Laps, NonNegative, Positive, Remission};
 use crate::world::ObjectKind;
 
 fn default_seed() -> u64 {
@@ -80,6 +80,11 @@ pub struct ExpectationsSpec {
     /// contacts and the obstacles' expectations count, and an obstacle never passed counts for
     /// nothing: a campaign's randomized obstacles, which may block the way or appear late).
     pub end: Option<ExpectedEnd>,
+    /// True: a contact while the vehicle was moving (the stack's fault) fails the run, whatever
+    /// the obstacles' `expect`; a contact while it stood (struck by a mover) does not by this
+    /// rule. Default false.
+    #[serde(default)]
+    pub no_contact_at_fault: bool,
 }
 
 /// How a scenario's run must end (`[expectations] end`).
@@ -158,8 +163,9 @@ pub struct RouteSpec {
 }
 
 /// `[[objects]]`: a static object. Shape fields depend on the kind:
-/// round kinds (`cone`, `marker`, `lamp_post`, `cylinder`) take `radius_m` and `height_m`,
-/// the others (`container`, `parked_car`, `vehicle`, `debris`, `building`, `box`) take `size_m`.
+/// round kinds (`cone`, `marker`, `lamp_post`, `cylinder`, `person`) take `radius_m` and
+/// `height_m`, the others (`container`, `parked_car`, `vehicle`, `debris`, `building`, `box`,
+/// `tug`, `baggage_cart`, `fuel_truck`) take `size_m`.
 ///
 /// | kind | shape | default size | default remission |
 /// | --- | --- | --- | --- |
@@ -172,6 +178,10 @@ pub struct RouteSpec {
 /// | debris | box | 0.3 x 0.3 x 0.15 | 0.2 |
 /// | building | box | required | 0.2 |
 /// | box | box | required | 0.3 |
+/// | person | cylinder | radius 0.25, height 1.75 | 0.3 |
+/// | tug | box | 3.0 x 1.8 x 1.5 | 0.3 |
+/// | baggage_cart | box | 2.6 x 1.4 x 1.0 (under a business jet's 1.1 m wing) | 0.4 |
+/// | fuel_truck | box | 9.0 x 2.5 x 3.2 | 0.3 |
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectSpec {
@@ -289,6 +299,9 @@ pub enum Expectation {
     Stop,
     /// Anything, as long as nothing touches it.
     NoContact,
+    /// A mover crossing the route: stop or slow so that it passes first, without contact, then
+    /// drive on.
+    Yield,
 }
 
 impl std::fmt::Display for Expectation {
@@ -305,6 +318,7 @@ impl Expectation {
             Expectation::Deviate => "deviate",
             Expectation::Stop => "stop",
             Expectation::NoContact => "no_contact",
+            Expectation::Yield => "yield",
         }
     }
 }
@@ -337,7 +351,8 @@ pub struct ObstacleSpec {
     pub height_m: Option<Spanned<Positive>>,
     /// LiDAR remission in [0, 1]. Default per kind.
     pub remission: Option<Remission>,
-    /// What the vehicle must do: `pass_under`, `deviate`, `stop` or `no_contact`. Required.
+    /// What the vehicle must do: `pass_under`, `deviate`, `stop`, `no_contact` or (a mover)
+    /// `yield`. Required.
     pub expect: Expectation,
     /// When it appears, seconds from the start, >= 0. Default 0 (there from the start).
     pub appears_s: Option<Spanned<NonNegative>>,
@@ -348,4 +363,49 @@ pub struct ObstacleSpec {
     pub path_m: Option<Spanned<Vec<[Finite; 2]>>>,
     /// Its speed along `path_m`, m/s, > 0. Required with `path_m`, not allowed without.
     pub speed_m_s: Option<Spanned<Positive>>,
+    /// How fast it speeds up and brakes, m/s^2, > 0. Only with `path_m`. Default none: speed
+    /// changes are instant (it moves at `speed_m_s` from its appearance and stands at once at a
+    /// stop or at the path's end), except for a driver that yields (`yields_to_vehicle_m`), whose
+    /// every speed change is at 2.0 m/s^2 then.
+    pub acceleration_m_s2: Option<Spanned<Positive>>,
+    /// Where it stops along `path_m` and how long it waits there,
+    /// `[{ at_m = 20.0, wait_s = 4.0 }, ...]`: arc lengths increasing, within the path's length.
+    /// Only with `path_m`. Default none.
+    pub stops: Option<Spanned<Vec<StopSpec>>>,
+    /// A driver that yields to the vehicle, metres, > 0: while any part of the vehicle comes
+    /// within this distance of the stretch of its path ahead of its front (its braking distance
+    /// plus its own length), it brakes to a stop and waits; it drives on once the stretch is
+    /// clear. Only with `path_m`. Default none: it does not react.
+    pub yields_to_vehicle_m: Option<Spanned<Positive>>,
+    /// A towed train: this mover is the lead (a tug) and `cars` cars follow it along `path_m`,
+    /// each an obstacle `<id>_car1`, `<id>_car2`, ... Only with `path_m`. Default none.
+    pub train: Option<Spanned<TrainSpec>>,
 }
+
+/// One stop of a moving obstacle, `{ at_m = .., wait_s = .. }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StopSpec {
+    /// Where it stands, the arc length along `path_m` (of its centre), metres, >= 0; greater
+    /// than the previous stop's, at most the path's length. Required.
+    pub at_m: Spanned<NonNegative>,
+    /// How long it waits there, seconds, > 0. Required.
+    pub wait_s: Positive,
+}
+
+/// `train = { cars = .., kind = .., gap_m = .. }`: the cars a moving obstacle tows.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrainSpec {
+    /// How many cars, an integer from 1 to [`MAX_TRAIN_CARS`]. Required.
+    pub cars: Spanned<Count>,
+    /// What each car is (snake_case [`ObjectKind`], at the kind's default size and remission;
+    /// `building`, `box` and `cylinder`, which have none, are refused). Default `baggage_cart`.
+    pub kind: Option<Spanned<ObjectKind>>,
+    /// Free distance between consecutive vehicles of the train (the lead and the first car, a
+    /// car and the next), measured along the path, metres, >= 0. Default 1.0.
+    pub gap_m: Option<NonNegative>,
+}
+
+/// The most cars one train may tow.
+pub const MAX_TRAIN_CARS: u32 = 50;

@@ -36,6 +36,16 @@ impl SolidShape {
             SolidShape::Cylinder { height_m, .. } | SolidShape::Cone { height_m, .. } => height_m,
         }
     }
+    /// Extent along the object's heading, metres (a box's x size, a round shape's diameter): a
+    /// train car's length.
+    pub fn length_m(&self) -> f64 {
+        match *self {
+            SolidShape::Box { size_m } => size_m[0],
+            SolidShape::Cylinder { radius_m, .. } | SolidShape::Cone { radius_m, .. } => {
+                2.0 * radius_m
+            }
+        }
+    }
     /// Radius of the smallest vertical cylinder around the shape's axis holding it, metres.
     pub fn footprint_radius_m(&self) -> f64 {
         match *self {
@@ -69,6 +79,14 @@ pub enum ObjectKind {
     Box,
     /// A plain cylinder.
     Cylinder,
+    /// A person walking on the ramp (a cylinder).
+    Person,
+    /// An aircraft tug or baggage tractor (a box); a train's lead.
+    Tug,
+    /// A baggage cart, lower than a business jet's wing (a box); a train's car.
+    BaggageCart,
+    /// A fuel truck (a box).
+    FuelTruck,
 }
 
 impl ObjectKind {
@@ -85,6 +103,47 @@ impl ObjectKind {
             ObjectKind::Debris => "debris",
             ObjectKind::Box => "box",
             ObjectKind::Cylinder => "cylinder",
+            ObjectKind::Person => "person",
+            ObjectKind::Tug => "tug",
+            ObjectKind::BaggageCart => "baggage_cart",
+            ObjectKind::FuelTruck => "fuel_truck",
+        }
+    }
+
+    /// True for the kinds shaped as a vertical cylinder or cone (`radius_m` and `height_m` in
+    /// files), false for the box kinds (`size_m`).
+    pub fn is_round(self) -> bool {
+        matches!(
+            self,
+            ObjectKind::Cone
+                | ObjectKind::Marker
+                | ObjectKind::LampPost
+                | ObjectKind::Cylinder
+                | ObjectKind::Person
+        )
+    }
+
+    /// The kind's shape when a file gives no size (`None`: `building`, `box` and `cylinder`
+    /// need theirs). Metres: a box's full extents x (along its heading), y, z; a round kind's
+    /// radius and height.
+    pub fn default_shape(self) -> Option<SolidShape> {
+        let cylinder = |radius_m, height_m| Some(SolidShape::Cylinder { radius_m, height_m });
+        let cuboid = |x, y, z| Some(SolidShape::Box { size_m: [x, y, z] });
+        match self {
+            ObjectKind::Cone => Some(SolidShape::Cone {
+                radius_m: 0.18,
+                height_m: 0.45,
+            }),
+            ObjectKind::Marker => cylinder(0.10, 0.35),
+            ObjectKind::LampPost => cylinder(0.12, 6.0),
+            ObjectKind::Person => cylinder(0.25, 1.75),
+            ObjectKind::Container => cuboid(0.8, 0.6, 1.1),
+            ObjectKind::ParkedCar | ObjectKind::Vehicle => cuboid(4.5, 1.8, 1.5),
+            ObjectKind::Debris => cuboid(0.3, 0.3, 0.15),
+            ObjectKind::Tug => cuboid(3.0, 1.8, 1.5),
+            ObjectKind::BaggageCart => cuboid(2.6, 1.4, 1.0),
+            ObjectKind::FuelTruck => cuboid(9.0, 2.5, 3.2),
+            ObjectKind::Building | ObjectKind::Box | ObjectKind::Cylinder => None,
         }
     }
 
@@ -93,13 +152,16 @@ impl ObjectKind {
         match self {
             ObjectKind::Cone => 0.5,
             ObjectKind::Marker => 0.7,
-            ObjectKind::Container => 0.4,
+            ObjectKind::Container | ObjectKind::BaggageCart => 0.4,
             ObjectKind::Debris | ObjectKind::Building => 0.2,
             ObjectKind::LampPost
             | ObjectKind::ParkedCar
             | ObjectKind::Vehicle
             | ObjectKind::Box
-            | ObjectKind::Cylinder => 0.3,
+            | ObjectKind::Cylinder
+            | ObjectKind::Person
+            | ObjectKind::Tug
+            | ObjectKind::FuelTruck => 0.3,
         }
     }
 }

@@ -34,24 +34,49 @@ fn found(name: &str) -> Scenario {
     Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// FIXME (README, Known problems: no prediction of movers): a van crossing the taxiway at
-/// 2.8 m/s from 35 m right of it reaches the centreline as the Praetor-like jet's nose does; the
-/// jet, which plans against where things are now, is still moving when its nose meets the van's
-/// side (34.5 s) and stops only after (35.8 s). Found by the jet campaign (variant 7).
+/// Fixed by issue 36 (prediction of movers): a van crossing the taxiway at 2.8 m/s from 35 m
+/// right of it reaches the centreline as the Praetor-like jet's nose does. Before, the jet
+/// planned against where things were and met the van's side while still moving (34.5 s); now
+/// it yields: no contact, the van first.
 #[test]
-fn fixme_the_jet_drives_into_a_van_crossing_its_path() {
+fn the_jet_yields_to_a_van_crossing_its_path() {
     let s = found("jet_meets_crossing_vehicle");
     let r = run_found(&s);
-    let first = r
-        .contacts
-        .first()
-        .expect("FIXME: the jet still meets the van");
-    assert_eq!(first.object, "crossing_vehicle_1");
-    assert_eq!(first.part, "nose");
-    assert!((34.0..35.0).contains(&first.time_s), "{first:?}");
-    // Moving when it met the van: its first stop began after the contact.
-    let stop = r.stops.first().expect("it stops after the contact");
-    assert!(stop.start_s > first.time_s, "{:?}", r.stops);
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
+    let van = r
+        .obstacles
+        .iter()
+        .find(|o| o.id == "crossing_vehicle_1")
+        .unwrap();
+    assert_eq!(van.pet_mover_first, Some(true), "{van:?}");
+    // The jet stood before the van crossed: its first stop began before the van's nearest
+    // approach (the TTC was never under a second).
+    assert!(van.min_ttc_s.is_none_or(|t| t > 1.0), "{van:?}");
+}
+
+/// FIXME (README, Known problems): on a 320 m road with the particle filter, the first
+/// revolution, taken before the filter settled, leaves an obstacle (81.9, -2.7) m that no later
+/// beam clears; the jet stops for it 14 m short and calls a pilot. Found writing the traffic
+/// scenarios (`scenarios/traffic_parked_car_at_speed.toml` at 5 m/s); with the true pose the
+/// lap completes.
+#[test]
+fn fixme_a_phantom_from_the_first_revolution_calls_a_pilot() {
+    let s = found("phantom_from_the_first_revolution");
+    let dir = tempfile::tempdir().unwrap();
+    let config = RunConfig::for_scenario(&s, None).unwrap();
+    sim::offline_map::map_drive(&s, &config, dir.path(), &mut |_, _| {}).unwrap();
+    let setup = RunSetup {
+        config,
+        ..RunSetup::new(dir.path().to_path_buf())
+    };
+    let r = run(&s, &setup).unwrap();
+    assert_eq!(r.end, sim::engine::EndReason::WaitingForHiddenObstacle);
+    let w = r.waiting_for.expect("waiting for the phantom");
+    assert!(
+        (w.x_m - 81.9).abs() < 1.0 && (w.y_m + 2.7).abs() < 1.0,
+        "{w:?}"
+    );
+    assert!(w.last_seen_s.is_some_and(|t| t < 0.5), "{w:?}");
 }
 
 /// FIXME (README, Known problems): a 0.104 m piece of debris 0.39 m left of the car's

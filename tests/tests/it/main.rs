@@ -1,7 +1,7 @@
 //! End-to-end and regression tests of the workspace, one test binary (`cargo test -p tests --test
 //! it`): the closed loop on the small scenarios, the thesis' experiments against their goldens,
 //! localization, overhead structures, permanence of what is unseen, the failures the campaigns
-//! found, the distance cap and the mapping demo.
+//! found, traffic, the distance cap and the mapping demo.
 
 mod closed_loop;
 mod common;
@@ -12,3 +12,4 @@ mod found;
 mod localization;
 mod overhead;
 mod permanence;
+mod traffic;

@@ -237,7 +237,7 @@ pub fn table(r: &RunReport) -> String {
     );
     let _ = writeln!(
         t,
-        "laps {}/{}  lap times {:?} s  stops {}  contacts {}{}",
+        "laps {}/{}  lap times {:?} s  stops {}  contacts {}{}{}",
         r.laps_completed,
         r.laps,
         r.lap_times_s
@@ -246,6 +246,14 @@ pub fn table(r: &RunReport) -> String {
             .collect::<Vec<_>>(),
         r.stops.len(),
         r.contacts.len(),
+        if r.contacts.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " ({} at fault, {} struck)",
+                r.contacts_at_fault, r.contacts_struck
+            )
+        },
         match r.end {
             EndReason::Completed => "",
             EndReason::TimedOut => "  (timed out)",
@@ -298,10 +306,17 @@ pub fn table(r: &RunReport) -> String {
         );
     }
     obstacle_rows(&mut t, r);
-    for c in &r.contacts {
+    for (k, c) in r.contacts.iter().enumerate() {
+        let fault = r.contacts_judged.get(k).map_or(String::new(), |j| {
+            if j.at_fault {
+                format!(" (at fault: moving at {:.2} m/s)", j.vehicle_speed_m_s)
+            } else {
+                " (struck while standing)".to_string()
+            }
+        });
         let _ = writeln!(
             t,
-            "contact at {:.2} s: {} ({:?}) touched by {}",
+            "contact at {:.2} s: {} ({:?}) touched by {}{fault}",
             c.time_s, c.object, c.kind, c.part
         );
     }
@@ -336,6 +351,21 @@ fn obstacle_rows(t: &mut String, r: &RunReport) {
                 t,
                 "{:<22} {:<10} {:<11} {:>4} {:<9}",
                 o.id, o.kind, o.expected, "-", "not passed"
+            );
+        }
+        if o.min_ttc_s.is_some() || o.pet_s.is_some() {
+            let first = match o.pet_mover_first {
+                Some(true) => " (mover first)",
+                Some(false) => " (vehicle first)",
+                None => "",
+            };
+            let s = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.1} s"));
+            let _ = writeln!(
+                t,
+                "{:<22} traffic: min time to collision {}, post-encroachment time {}{first}",
+                o.id,
+                s(o.min_ttc_s),
+                s(o.pet_s)
             );
         }
         for p in &o.passes {

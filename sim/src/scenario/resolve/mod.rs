@@ -5,6 +5,7 @@
 //! the field, with the offending line quoted. This file holds the entry ([`Resolver::resolve`])
 //! and the helpers the parts share: ids, the world and its bounds, polylines, the start overlap.
 
+mod motion;
 mod objects;
 mod route;
 mod rows;
@@ -66,6 +67,7 @@ impl Resolver<'_> {
             obstacles,
             danger_distance_m: spec.expectations.danger_distance_m.map(|d| d.0),
             expected_end: spec.expectations.end.unwrap_or_default(),
+            no_contact_at_fault: spec.expectations.no_contact_at_fault,
             config: spec.config.map(Spanned::into_inner),
         })
     }

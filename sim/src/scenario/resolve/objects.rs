@@ -9,7 +9,7 @@ use nalgebra::Point2;
 use toml::Spanned;
 
 use super::Resolver;
-use crate::scenario::model::{Ground, Obstacle, ObstacleMotion, ScenarioVehicle};
+use crate::scenario::model::{Ground, Obstacle, ScenarioVehicle};
 use crate::scenario::numbers::Positive;
 use crate::scenario::spec::{ObjectSpec, ObstacleSpec, PatchSpec};
 use crate::toml_file::LocatedError;
@@ -84,8 +84,9 @@ impl Resolver<'_> {
         Ok(patches)
     }
 
-    /// The `[[obstacles]]`, in file order: ids claimed, each (and its path) inside the world,
-    /// and one present at the start clear of the vehicle there.
+    /// The `[[obstacles]]`, in file order, each followed by the cars of its train: ids claimed,
+    /// each (and its path) inside the world, and one present at the start clear of the vehicle
+    /// there.
     pub(super) fn obstacles(
         &self,
         specs: &[Spanned<ObstacleSpec>],
@@ -114,7 +115,18 @@ impl Resolver<'_> {
             if obstacle.appears_s <= 0.0 {
                 self.no_start_overlap(vehicle, &obstacle.solid, &field, id_span)?;
             }
+            let lead_index = obstacles.len();
+            let cars = self.train(
+                o.get_ref(),
+                &field,
+                lead_index,
+                &obstacle,
+                world,
+                vehicle,
+                ids,
+            )?;
             obstacles.push(obstacle);
+            obstacles.extend(cars);
         }
         Ok(obstacles)
     }
@@ -131,6 +143,9 @@ impl Resolver<'_> {
                 &format!("{field}.disappears_s"),
                 format!("{} s is not after appears_s ({appears_s} s)", d.get_ref().0),
             ));
+        }
+        if s.path_m.is_none() {
+            self.no_mover_fields(s, field)?;
         }
         let (x_m, y_m, yaw_rad, motion) = match (&s.path_m, &s.speed_m_s) {
             (Some(path), Some(speed)) => {
@@ -155,11 +170,7 @@ impl Resolver<'_> {
                     "a path",
                 )?;
                 let d = pts[1] - pts[0];
-                let motion = ObstacleMotion {
-                    path_m: pts.clone(),
-                    speed_m_s: speed.get_ref().0,
-                    yaw_offset_rad: s.yaw_rad.0,
-                };
+                let motion = self.motion(s, field, pts.clone(), speed.get_ref())?;
                 (
                     pts[0].x,
                     pts[0].y,
@@ -224,11 +235,8 @@ impl Resolver<'_> {
         height: &Option<Spanned<Positive>>,
     ) -> Result<SolidShape, LocatedError> {
         let name = kind.name();
-        let round = matches!(
-            kind,
-            ObjectKind::Cone | ObjectKind::Marker | ObjectKind::LampPost | ObjectKind::Cylinder
-        );
-        if round {
+        let default = kind.default_shape();
+        if kind.is_round() {
             if let Some(s) = size {
                 return Err(self.err(
                     s.span(),
@@ -236,10 +244,11 @@ impl Resolver<'_> {
                     format!("a {name} is round: give radius_m and height_m, not size_m"),
                 ));
             }
-            let (r0, h0) = match kind {
-                ObjectKind::Cone => (Some(0.18), Some(0.45)),
-                ObjectKind::Marker => (Some(0.10), Some(0.35)),
-                ObjectKind::LampPost => (Some(0.12), Some(6.0)),
+            let (r0, h0) = match default {
+                Some(
+                    SolidShape::Cone { radius_m, height_m }
+                    | SolidShape::Cylinder { radius_m, height_m },
+                ) => (Some(radius_m), Some(height_m)),
                 _ => (None, None),
             };
             let r = radius.as_ref().map(|r| r.get_ref().0).or(r0);
@@ -267,10 +276,8 @@ impl Resolver<'_> {
                     ));
                 }
             }
-            let default = match kind {
-                ObjectKind::Container => Some([0.8, 0.6, 1.1]),
-                ObjectKind::ParkedCar | ObjectKind::Vehicle => Some([4.5, 1.8, 1.5]),
-                ObjectKind::Debris => Some([0.3, 0.3, 0.15]),
+            let default = match default {
+                Some(SolidShape::Box { size_m }) => Some(size_m),
                 _ => None,
             };
             let size_m = size

@@ -1,0 +1,537 @@
+//! Traffic: the movers the tracker follows ([`mapper::TrackState`]), predicted over the planning
+//! horizon, and the space-time check of the planned path against them.
+//!
+//! - **Prediction**: constant velocity from the track's Kalman filter; each mover is a capsule
+//!   along its velocity: half its length along the motion (the box of its hits measured along
+//!   it, at least half its largest extent) and half its width across, each plus `hidden_m`
+//!   (what of it the sensor may not see), widened by `sigmas` standard deviations of its
+//!   predicted position, which grow with time. Over a stretch of time it sweeps a longer
+//!   capsule, since it moves along its own length. A mover occupies the levels it was hit in: a
+//!   baggage cart lower than a wing's level is checked against the gear and fuselage only.
+//! - **Space-time check**: the vehicle's arrival time at each pose of the chosen path (from its
+//!   speed now, accelerating to the speed it wants), and each circle of a level the mover
+//!   occupies against the stretch the mover is predicted to cover from `time_margin_s` before
+//!   to `time_margin_s` after the vehicle is there. The first such pose is the conflict.
+//! - **Where to stop**: before the conflict zone - the first pose of the path that any position
+//!   the mover is predicted to reach within `horizon_s` touches - so a vehicle never stands in
+//!   a mover's predicted path when it can stop short of it; when it cannot (too close, too
+//!   fast), it drives on if it clears the mover by `committed_margin_s`, and stops before the
+//!   conflict itself only if it does not. A mover predicted to pass before the vehicle arrives (or
+//!   after it has gone) is no conflict, so it does not stop the vehicle. While yielding, the
+//!   margin after grows by `resume_margin_s`, so the vehicle does not creep off and stop again.
+//! - Movers slower than `min_speed_m_s`, or than `sigmas` standard deviations of their speed,
+//!   are left to the map (their cells are obstacles there).
+
+use aircraft::footprint::segment_distance;
+use mapper::{CollisionModel, TrackState};
+use nalgebra::{Isometry2, Point2, Vector2};
+use serde::{Deserialize, Serialize};
+
+/// How the stack predicts movers and checks its path against them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TrafficConfig {
+    /// Predict movers and yield to them. Default true; false: the map alone (a mover stops the
+    /// vehicle only once it stands in the path).
+    pub enabled: bool,
+    /// How far ahead movers are predicted, seconds. Default 8.
+    pub horizon_s: f64,
+    /// The vehicle keeps out of where a mover is predicted from this long before it is at a
+    /// pose to this long after, seconds. Default 1.5.
+    pub time_margin_s: f64,
+    /// While yielding, the margin after grows by this much, seconds. Default 1.
+    pub resume_margin_s: f64,
+    /// The margin of a vehicle too close to stop short of a mover's path: it drives on when it
+    /// clears the mover by this much (standing in the path would be worse), seconds. Default 0.5.
+    pub committed_margin_s: f64,
+    /// A mover's disc is widened by this many standard deviations of its predicted position.
+    /// Default 2.
+    pub sigmas: f64,
+    /// Clearance kept from a predicted mover beyond the radii, metres. Default 0.5.
+    pub margin_m: f64,
+    /// What may lie of a mover beyond the box of its hits, along and across its motion (the far
+    /// side of a van seen from one side, its back seen from the front), metres. Default 1.
+    pub hidden_m: f64,
+    /// Movers slower than this are left to the map, m/s. Default 0.3.
+    pub min_speed_m_s: f64,
+}
+
+impl Default for TrafficConfig {
+    fn default() -> Self {
+        TrafficConfig {
+            enabled: true,
+            horizon_s: 8.0,
+            time_margin_s: 1.5,
+            resume_margin_s: 1.0,
+            committed_margin_s: 0.5,
+            sigmas: 2.0,
+            margin_m: 0.5,
+            hidden_m: 1.0,
+            min_speed_m_s: 0.3,
+        }
+    }
+}
+
+impl TrafficConfig {
+    /// The first field out of range, as (name, value).
+    pub fn invalid_field(&self) -> Option<(&'static str, f64)> {
+        let positive = [("horizon_s", self.horizon_s)];
+        let non_negative = [
+            ("time_margin_s", self.time_margin_s),
+            ("resume_margin_s", self.resume_margin_s),
+            ("committed_margin_s", self.committed_margin_s),
+            ("sigmas", self.sigmas),
+            ("margin_m", self.margin_m),
+            ("hidden_m", self.hidden_m),
+            ("min_speed_m_s", self.min_speed_m_s),
+        ];
+        positive
+            .into_iter()
+            .find(|(_, v)| !(v.is_finite() && *v > 0.0))
+            .or_else(|| {
+                non_negative
+                    .into_iter()
+                    .find(|(_, v)| !(v.is_finite() && *v >= 0.0))
+            })
+    }
+}
+
+/// How the vehicle is expected to move along its path: from `speed_m_s` now towards
+/// `target_m_s` at `acceleration_m_s2` (a profile that only speeds up or holds: a slower
+/// vehicle arrives later, which the check sees as it slows).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpeedProfile {
+    /// Speed now, m/s.
+    pub speed_m_s: f64,
+    /// Speed it drives up to, m/s.
+    pub target_m_s: f64,
+    /// Acceleration, m/s^2.
+    pub acceleration_m_s2: f64,
+}
+
+impl SpeedProfile {
+    /// Seconds to cover `s_m` metres (infinite if it never gets there).
+    pub fn time_to(&self, s_m: f64) -> f64 {
+        let (v0, a) = (self.speed_m_s.max(0.0), self.acceleration_m_s2.max(1e-6));
+        let v1 = self.target_m_s.max(v0);
+        if v1 <= 1e-9 {
+            return if s_m <= 0.0 { 0.0 } else { f64::INFINITY };
+        }
+        let ramp_m = (v1 * v1 - v0 * v0) / (2.0 * a);
+        if s_m <= ramp_m {
+            // s = v0 t + a t^2 / 2.
+            (-v0 + (v0 * v0 + 2.0 * a * s_m).sqrt()) / a
+        } else {
+            (v1 - v0) / a + (s_m - ramp_m) / v1
+        }
+    }
+}
+
+/// A mover's predicted footprint at one time: a capsule along its motion.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PredictedDisc {
+    /// Seconds from now.
+    pub dt_s: f64,
+    /// Centre, metres.
+    pub center: Point2<f64>,
+    /// Radius across its motion (half width, hidden part and uncertainty), metres.
+    pub radius_m: f64,
+    /// Half the length of the capsule's axis, along its motion, metres.
+    pub half_length_m: f64,
+    /// Heading of its motion, radians.
+    pub heading_rad: f64,
+}
+
+/// A mover the stack predicts: its track and its discs over the horizon.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prediction {
+    /// The track.
+    pub track: TrackState,
+    /// Its discs every half second over the horizon, from now.
+    pub discs: Vec<PredictedDisc>,
+}
+
+/// What the space-time check found on the path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Conflict {
+    /// The mover's track id.
+    pub track_id: u32,
+    /// Distance along the path to the first pose where the vehicle would meet the mover, metres.
+    pub at_m: f64,
+    /// Distance along the path to the first pose any predicted position of the mover touches
+    /// (the conflict zone's start), metres; at most `at_m`.
+    pub zone_m: f64,
+    /// When the vehicle would be at the conflict, seconds from now.
+    pub in_s: f64,
+    /// Where the mover would be then, metres.
+    pub mover_at: Point2<f64>,
+}
+
+/// The predictable movers of `tracks` seen at `now_s`, with their discs over the horizon.
+pub fn predict(tracks: &[TrackState], now_s: f64, cfg: &TrafficConfig) -> Vec<Prediction> {
+    tracks
+        .iter()
+        .filter(|t| {
+            // Moving, and surely: faster than `sigmas` standard deviations of its speed.
+            let c = &t.covariance;
+            let speed_sigma = c[(2, 2)].max(c[(3, 3)]).max(0.0).sqrt();
+            t.velocity.norm() >= cfg.min_speed_m_s.max(cfg.sigmas * speed_sigma)
+        })
+        .map(|t| {
+            let steps = (cfg.horizon_s / 0.5).ceil() as usize;
+            let discs = (0..=steps)
+                .map(|k| {
+                    let dt_s = k as f64 * 0.5;
+                    let (center, sigma) = t.predict((now_s + dt_s - t.t_s).max(0.0));
+                    let f = Footprint::of(t, cfg);
+                    PredictedDisc {
+                        dt_s,
+                        center,
+                        radius_m: f.half_width_m + cfg.sigmas * sigma,
+                        half_length_m: f.half_length_m,
+                        heading_rad: f.along.y.atan2(f.along.x),
+                    }
+                })
+                .collect();
+            Prediction {
+                track: t.clone(),
+                discs,
+            }
+        })
+        .collect()
+}
+
+/// A mover's shape as the check uses it.
+#[derive(Clone, Copy, Debug)]
+struct Footprint {
+    /// Unit vector of its motion.
+    along: Vector2<f64>,
+    half_length_m: f64,
+    half_width_m: f64,
+}
+
+impl Footprint {
+    fn of(t: &TrackState, cfg: &TrafficConfig) -> Self {
+        let speed = t.velocity.norm();
+        let along = if speed > 1e-9 {
+            t.velocity / speed
+        } else {
+            Vector2::x()
+        };
+        let [dx, dy] = t.size_m;
+        let length = dx * along.x.abs() + dy * along.y.abs();
+        let width = dx * along.y.abs() + dy * along.x.abs();
+        Footprint {
+            along,
+            half_length_m: (0.5 * length).max(0.5 * t.extent_m) + cfg.hidden_m,
+            half_width_m: 0.5 * width + cfg.hidden_m,
+        }
+    }
+}
+
+/// The capsule the mover sweeps from `from_s` to `to_s` (absolute times): its axis' ends and
+/// its radius.
+fn swept(
+    t: &TrackState,
+    from_s: f64,
+    to_s: f64,
+    cfg: &TrafficConfig,
+) -> (Point2<f64>, Point2<f64>, f64) {
+    let f = Footprint::of(t, cfg);
+    let (a, _) = t.predict((from_s - t.t_s).max(0.0));
+    let (b, sigma) = t.predict((to_s - t.t_s).max(0.0));
+    (
+        a - f.along * f.half_length_m,
+        b + f.along * f.half_length_m,
+        f.half_width_m + cfg.sigmas * sigma,
+    )
+}
+
+/// Whether any circle of `model` at `pose` on a level in `levels` comes within `reach_m` (plus
+/// its radius) of the segment `a`-`b`.
+fn touches(
+    model: &CollisionModel,
+    pose: &Isometry2<f64>,
+    levels: u32,
+    a: &Point2<f64>,
+    b: &Point2<f64>,
+    reach_m: f64,
+) -> bool {
+    let bound = model.bounding_circle();
+    if segment_distance(&(pose * bound.center), a, b) > bound.radius_m + reach_m {
+        return false;
+    }
+    touches_every_circle(model, pose, levels, a, b, reach_m)
+}
+
+/// [`touches`] without the bounding circle's early out: every circle of the mover's levels
+/// (the straightforward way, the baseline of `taxi-sim bench loop`).
+fn touches_every_circle(
+    model: &CollisionModel,
+    pose: &Isometry2<f64>,
+    levels: u32,
+    a: &Point2<f64>,
+    b: &Point2<f64>,
+    reach_m: f64,
+) -> bool {
+    model.circles().iter().any(|c| {
+        levels & (1u32 << c.level.min(31)) != 0
+            && segment_distance(&(pose * Point2::new(c.x_m, c.y_m)), a, b) <= c.radius_m + reach_m
+    })
+}
+
+/// The vehicle's path with its timing: what the space-time check checks.
+#[derive(Clone, Copy, Debug)]
+pub struct TimedPath<'a> {
+    /// The poses, `step_m` apart, the first where the vehicle is now.
+    pub poses: &'a [Isometry2<f64>],
+    /// Their spacing, metres.
+    pub step_m: f64,
+    /// How the vehicle is expected to move along them.
+    pub profile: SpeedProfile,
+    /// Now, seconds.
+    pub now_s: f64,
+    /// The vehicle is already stopped for a mover.
+    pub yielding: bool,
+}
+
+/// The first conflict on `path` with the movers `predictions`.
+pub fn first_conflict(
+    path: &TimedPath<'_>,
+    model: &CollisionModel,
+    predictions: &[Prediction],
+    cfg: &TrafficConfig,
+) -> Option<Conflict> {
+    conflict_with(path, model, predictions, cfg, touches)
+}
+
+/// [`first_conflict`] checking every circle at every pose (no bounding-circle early out): the
+/// straightforward way, the same answer (`taxi-sim bench loop` times both).
+pub fn first_conflict_straightforward(
+    path: &TimedPath<'_>,
+    model: &CollisionModel,
+    predictions: &[Prediction],
+    cfg: &TrafficConfig,
+) -> Option<Conflict> {
+    conflict_with(path, model, predictions, cfg, touches_every_circle)
+}
+
+/// How a pose is tested against a swept mover.
+type Touches = fn(&CollisionModel, &Isometry2<f64>, u32, &Point2<f64>, &Point2<f64>, f64) -> bool;
+
+fn conflict_with(
+    path: &TimedPath<'_>,
+    model: &CollisionModel,
+    predictions: &[Prediction],
+    cfg: &TrafficConfig,
+    touches: Touches,
+) -> Option<Conflict> {
+    let TimedPath {
+        poses,
+        step_m,
+        profile,
+        now_s,
+        yielding,
+    } = *path;
+    let after_s = cfg.time_margin_s + if yielding { cfg.resume_margin_s } else { 0.0 };
+    let mut best: Option<Conflict> = None;
+    for p in predictions {
+        let t = &p.track;
+        let horizon_end = now_s + cfg.horizon_s;
+        for (k, pose) in poses.iter().enumerate() {
+            let at_m = k as f64 * step_m;
+            if best.is_some_and(|b| b.at_m <= at_m) {
+                break;
+            }
+            let in_s = profile.time_to(at_m);
+            let (lo, hi) = (
+                now_s + (in_s - cfg.time_margin_s).max(0.0),
+                now_s + in_s + after_s,
+            );
+            if lo > horizon_end {
+                break;
+            }
+            let (a, b, radius) = swept(t, lo, hi.min(horizon_end), cfg);
+            if touches(model, pose, t.levels, &a, &b, radius + cfg.margin_m) {
+                let zone_m = conflict_zone(path, model, t, k, cfg, touches);
+                best = Some(Conflict {
+                    track_id: t.id,
+                    at_m,
+                    zone_m,
+                    in_s,
+                    mover_at: t.predict((now_s + in_s - t.t_s).max(0.0)).0,
+                });
+                break;
+            }
+        }
+    }
+    best
+}
+
+/// The first pose (up to `up_to`) that any position the mover is predicted to reach within the
+/// horizon touches, as a distance along the path.
+fn conflict_zone(
+    path: &TimedPath<'_>,
+    model: &CollisionModel,
+    track: &TrackState,
+    up_to: usize,
+    cfg: &TrafficConfig,
+    touches: Touches,
+) -> f64 {
+    let (a, b, radius) = swept(track, path.now_s, path.now_s + cfg.horizon_s, cfg);
+    path.poses[..up_to]
+        .iter()
+        .position(|pose| touches(model, pose, track.levels, &a, &b, radius + cfg.margin_m))
+        .unwrap_or(up_to) as f64
+        * path.step_m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mapper::Circle;
+    use nalgebra::Matrix4;
+
+    /// A 10 m vehicle on level 0 (gear, fuselage) with a 1 m circle on level 1 far out left
+    /// (a wing tip).
+    fn model() -> CollisionModel {
+        let mut circles: Vec<Circle> = (0..6)
+            .map(|i| Circle {
+                x_m: i as f64 * 2.0,
+                y_m: 0.0,
+                radius_m: 1.0,
+                level: 0,
+            })
+            .collect();
+        circles.push(Circle {
+            x_m: 4.0,
+            y_m: 8.0,
+            radius_m: 1.0,
+            level: 1,
+        });
+        CollisionModel::new(circles, vec![0.0, 1.1]).unwrap()
+    }
+
+    fn straight(n: usize) -> Vec<Isometry2<f64>> {
+        (0..n)
+            .map(|k| Isometry2::new(Vector2::new(k as f64 * 0.5, 0.0), 0.0))
+            .collect()
+    }
+
+    fn mover(x: f64, y: f64, vx: f64, vy: f64, levels: u32) -> TrackState {
+        TrackState {
+            id: 7,
+            t_s: 0.0,
+            position: Point2::new(x, y),
+            velocity: Vector2::new(vx, vy),
+            covariance: Matrix4::from_diagonal(&nalgebra::Vector4::new(0.01, 0.01, 0.01, 0.01)),
+            extent_m: 2.0,
+            levels,
+            confirmed: true,
+            bbox: ((0, 0), (0, 0)),
+            size_m: [1.0, 1.0],
+        }
+    }
+
+    fn at_speed(v: f64) -> SpeedProfile {
+        SpeedProfile {
+            speed_m_s: v,
+            target_m_s: v,
+            acceleration_m_s2: 0.5,
+        }
+    }
+
+    fn check(m: &TrackState, profile: &SpeedProfile, yielding: bool) -> Option<Conflict> {
+        let cfg = TrafficConfig::default();
+        let p = predict(std::slice::from_ref(m), 0.0, &cfg);
+        let poses = straight(121);
+        let path = TimedPath {
+            poses: &poses,
+            step_m: 0.5,
+            profile: *profile,
+            now_s: 0.0,
+            yielding,
+        };
+        first_conflict(&path, &model(), &p, &cfg)
+    }
+
+    #[test]
+    fn the_profile_accelerates_then_holds() {
+        let p = SpeedProfile {
+            speed_m_s: 0.0,
+            target_m_s: 2.0,
+            acceleration_m_s2: 0.5,
+        };
+        // 4 s to reach 2 m/s over 4 m, then 2 m/s.
+        assert!((p.time_to(4.0) - 4.0).abs() < 1e-9);
+        assert!((p.time_to(1.0) - 2.0).abs() < 1e-9);
+        assert!((p.time_to(10.0) - 7.0).abs() < 1e-9);
+        assert_eq!(at_speed(0.0).time_to(1.0), f64::INFINITY);
+    }
+
+    /// A van crossing from the right at 3 m/s, timed to be on the path 30 m ahead when the
+    /// vehicle (5 m/s) gets there in 6 s: a conflict, and the zone starts before it.
+    #[test]
+    fn a_mover_timed_to_meet_the_vehicle_is_a_conflict() {
+        let van = mover(30.0, -18.0, 0.0, 3.0, 1);
+        let c = check(&van, &at_speed(5.0), false).expect("a conflict");
+        assert_eq!(c.track_id, 7);
+        // The nose (x = 10 m ahead of the origin plus 1 m) meets the van's disc (2 m + 0.5 m
+        // margin + 2 sigma) when the van, at 3 m/s, is there: a few metres before 30 - 11.
+        assert!(c.at_m > 10.0 && c.at_m < 19.5, "{c:?}");
+        assert!(c.zone_m <= c.at_m, "{c:?}");
+    }
+
+    /// The same van, 10 s early (gone by the time the vehicle arrives) or 10 s late (the vehicle
+    /// long past), is no conflict; one far off the path's stretch is none either.
+    #[test]
+    fn a_mover_passing_before_or_after_the_vehicle_does_not_stop_it() {
+        assert_eq!(
+            check(&mover(30.0, 12.0, 0.0, 3.0, 1), &at_speed(5.0), false),
+            None
+        );
+        assert_eq!(
+            check(&mover(30.0, -48.0, 0.0, 3.0, 1), &at_speed(5.0), false),
+            None
+        );
+        assert_eq!(
+            check(&mover(30.0, -30.0, 3.0, 0.0, 1), &at_speed(5.0), false),
+            None
+        );
+    }
+
+    /// A baggage cart (level 0 only) crossing under the wing tip's path clears the wing; a
+    /// fuel truck (levels 0 and 1) on the same path does not.
+    #[test]
+    fn a_mover_under_a_wing_level_passes_under_it() {
+        // The wing tip sweeps y = 8 +- 1; the fuselage y = 0 +- 1. A mover moving along x at
+        // y = 8, level 0 only: only the wing tip's level could touch it.
+        let cart = mover(40.0, 8.0, -2.0, 0.0, 0b01);
+        assert_eq!(check(&cart, &at_speed(5.0), false), None);
+        let truck = mover(40.0, 8.0, -2.0, 0.0, 0b11);
+        assert!(check(&truck, &at_speed(5.0), false).is_some());
+    }
+
+    /// A standing vehicle yields to a mover about to cross in front of it, and drives on once
+    /// it has passed: the margin after grows while yielding.
+    #[test]
+    fn a_yielding_vehicle_waits_for_the_mover_to_pass() {
+        let still = SpeedProfile {
+            speed_m_s: 0.0,
+            target_m_s: 5.0,
+            acceleration_m_s2: 0.5,
+        };
+        // 20 m ahead, crossing from the right, 3 s away from the path.
+        assert!(check(&mover(20.0, -9.0, 0.0, 3.0, 1), &still, true).is_some());
+        // Past the path by 12 m: clear.
+        assert_eq!(check(&mover(20.0, 12.0, 0.0, 3.0, 1), &still, true), None);
+    }
+
+    /// A slow mover is left to the map.
+    #[test]
+    fn a_standing_mover_is_not_predicted() {
+        let cfg = TrafficConfig::default();
+        assert!(predict(&[mover(5.0, 0.0, 0.1, 0.0, 1)], 0.0, &cfg).is_empty());
+        assert_eq!(predict(&[mover(5.0, 0.0, 1.0, 0.0, 1)], 0.0, &cfg).len(), 1);
+    }
+}

@@ -1,0 +1,408 @@
+//! Run-time traffic: where each run-time obstacle is, and how fast it goes, at every physics step
+//! ([`Traffic`]). Three kinds of mover:
+//!
+//! - one that does not react (no `yields_to_vehicle_m`), static or moving, with or without a
+//!   speed profile: its closed-form [`Obstacle::state_at`] - so every mover written before
+//!   drivers reacted moves bit for bit as it did;
+//! - a driver that yields (`yields_to_vehicle_m`): stepped each physics step (arc length, speed,
+//!   the stop it heads for, the wait left). **The rule** (the ramp rule: give way to a taxiing
+//!   aircraft): at each step, its *stretch* is the part of its own path from its front (its arc
+//!   length plus half its length) to its front plus its braking distance at its speed
+//!   (`v^2 / 2a`) plus its own length (clamped to the path's end). When any part of the vehicle
+//!   (the exact ground projection of any of its URDF collision primitives,
+//!   [`aircraft::Part::footprint`], the same parts as the world's part colliders, at the
+//!   vehicle's true pose) comes within `yields_to_vehicle_m` of that stretch (measured in plan,
+//!   heights ignored: a driver keeps clear of the wings too), it brakes at `a` this step
+//!   (down to standing, and it waits); otherwise it speeds up at `a` towards `speed_m_s`, as far
+//!   as its next stop or the path's end lets it brake in time. `a` is `acceleration_m_s2`, or
+//!   [`REACTIVE_ACCELERATION_M_S2`] (2.0 m/s^2). It starts from rest at its appearance, waits
+//!   `wait_s` at each stop, and stands at the path's end;
+//! - a train's car: it keeps its place behind its lead (`TrainLink::behind_m` along the path)
+//!   whatever the lead does - profiles, stops, waits for the vehicle.
+
+use aircraft::footprint::{Footprint, segment_distance, segments_distance};
+use nalgebra::{Isometry2, Point2};
+
+use crate::scenario::{MoverState, Obstacle, ObstacleMotion, REACTIVE_ACCELERATION_M_S2};
+
+/// Arc lengths closer than this are the same place, metres.
+const SAME_PLACE_M: f64 = 1e-9;
+
+/// The state a yielding driver carries from step to step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Reactive {
+    /// Arc length of its centre along its path, metres.
+    arc_m: f64,
+    /// Speed, m/s.
+    speed_m_s: f64,
+    /// Index of the stop it heads for (== the number of stops: the path's end).
+    next_stop: usize,
+    /// Time left to wait at the stop it stands at, seconds (0: not waiting there).
+    wait_left_s: f64,
+    /// True once it has appeared (it starts from rest at its path's start).
+    started: bool,
+    /// True while it brakes or stands for the vehicle.
+    yielding: bool,
+}
+
+/// How one obstacle is moved.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Drive {
+    /// Closed form ([`Obstacle::state_at`]).
+    Planned,
+    /// A driver that yields, stepped.
+    Yielding(Reactive),
+    /// A train's car behind obstacle `lead` by `behind_m` along the path.
+    Car { lead: usize, behind_m: f64 },
+}
+
+/// The run-time obstacles of a run, moved step by step.
+#[derive(Clone, Debug)]
+pub struct Traffic {
+    obstacles: Vec<Obstacle>,
+    drives: Vec<Drive>,
+    states: Vec<Option<MoverState>>,
+    /// The vehicle's parts' ground footprints in the vehicle frame.
+    parts: Vec<Footprint>,
+    /// Radius around the vehicle frame's origin holding every footprint, metres.
+    reach_m: f64,
+    /// Time of the last step, seconds.
+    t_s: Option<f64>,
+}
+
+impl Traffic {
+    /// The traffic of `obstacles` (a scenario's, in its order) around `vehicle`.
+    pub fn new(obstacles: &[Obstacle], vehicle: &aircraft::Vehicle) -> Self {
+        let parts: Vec<Footprint> = vehicle
+            .parts
+            .iter()
+            .map(aircraft::Part::footprint)
+            .collect();
+        let reach_m = parts
+            .iter()
+            .map(|f| {
+                let (lo, hi) = f.bounds();
+                [(lo.x, lo.y), (lo.x, hi.y), (hi.x, lo.y), (hi.x, hi.y)]
+                    .iter()
+                    .map(|(x, y)| x.hypot(*y))
+                    .fold(0.0, f64::max)
+            })
+            .fold(0.0, f64::max);
+        let drives = obstacles
+            .iter()
+            .map(|o| match &o.motion {
+                Some(ObstacleMotion {
+                    train: Some(link), ..
+                }) => Drive::Car {
+                    lead: link.lead,
+                    behind_m: link.behind_m,
+                },
+                Some(m) if m.yields_to_vehicle_m.is_some() => Drive::Yielding(Reactive::default()),
+                _ => Drive::Planned,
+            })
+            .collect();
+        Traffic {
+            obstacles: obstacles.to_vec(),
+            drives,
+            states: vec![None; obstacles.len()],
+            parts,
+            reach_m,
+            t_s: None,
+        }
+    }
+
+    /// Moves every obstacle to time `t_s` (the time of the last step plus a physics step; the
+    /// first call starts the clock), the vehicle standing at `world_from_vehicle` (its true
+    /// pose) meanwhile.
+    pub fn step(&mut self, t_s: f64, world_from_vehicle: &Isometry2<f64>) {
+        let dt = self.t_s.map_or(0.0, |last| (t_s - last).max(0.0));
+        self.t_s = Some(t_s);
+        let vehicle_from_world = world_from_vehicle.inverse();
+        for k in 0..self.obstacles.len() {
+            let o = &self.obstacles[k];
+            let state = if !o.present_at(t_s) {
+                None
+            } else {
+                match (&mut self.drives[k], &o.motion) {
+                    (Drive::Yielding(r), Some(m)) => {
+                        let length_m = o.solid.shape.length_m();
+                        let near = |from_m: f64, to_m: f64, within_m: f64| {
+                            near_path(
+                                &self.parts,
+                                self.reach_m,
+                                m,
+                                from_m,
+                                to_m,
+                                within_m,
+                                &vehicle_from_world,
+                            )
+                        };
+                        Some(advance(r, m, length_m, dt, near))
+                    }
+                    (Drive::Car { lead, behind_m }, Some(m)) => {
+                        self.states.get(*lead).copied().flatten().map(|lead| {
+                            m.state_at_arc(lead.arc_m.min(m.length_m()) - *behind_m, lead.speed_m_s)
+                        })
+                    }
+                    _ => o.state_at(t_s),
+                }
+            };
+            self.states[k] = state;
+        }
+    }
+
+    /// Each obstacle's state at the last step, indexed like the scenario's obstacles (`None`:
+    /// absent then).
+    pub fn states(&self) -> &[Option<MoverState>] {
+        &self.states
+    }
+
+    /// Obstacle `k`'s state at the last step (`None`: absent then, or no such obstacle).
+    pub fn state(&self, k: usize) -> Option<MoverState> {
+        self.states.get(k).copied().flatten()
+    }
+
+    /// True when obstacle `k` is a driver that yields and it braked or stood for the vehicle
+    /// at the last step (a train's car: when its lead did).
+    pub fn yielding(&self, k: usize) -> bool {
+        match self.drives.get(k) {
+            Some(Drive::Yielding(r)) => r.yielding,
+            Some(Drive::Car { lead, .. }) => self.yielding(*lead),
+            _ => false,
+        }
+    }
+}
+
+/// One step of `dt` of a yielding driver of `length_m` along `m`; `near(from, to, within)` says
+/// whether the vehicle is within `within` of the stretch of the path between those arc lengths.
+fn advance(
+    r: &mut Reactive,
+    m: &ObstacleMotion,
+    length_m: f64,
+    dt: f64,
+    near: impl Fn(f64, f64, f64) -> bool,
+) -> MoverState {
+    let a = m.acceleration().unwrap_or(REACTIVE_ACCELERATION_M_S2);
+    let path_m = m.length_m();
+    r.yielding = false;
+    if !r.started {
+        // It appears at rest at the start of its path.
+        *r = Reactive {
+            started: true,
+            ..Reactive::default()
+        };
+        return m.state_at_arc(0.0, 0.0);
+    }
+    if r.wait_left_s > 0.0 {
+        r.wait_left_s -= dt;
+        if r.wait_left_s <= 0.0 {
+            r.wait_left_s = 0.0;
+            r.next_stop += 1;
+        }
+        return m.state_at_arc(r.arc_m, 0.0);
+    }
+    let rest_m = m.stops.get(r.next_stop).map_or(path_m, |s| s.at_m);
+    if rest_m - r.arc_m <= SAME_PLACE_M {
+        r.arc_m = rest_m;
+        r.speed_m_s = 0.0;
+        if let Some(stop) = m.stops.get(r.next_stop) {
+            r.wait_left_s = stop.wait_s;
+        }
+        return m.state_at_arc(r.arc_m, 0.0);
+    }
+    let front_m = r.arc_m + 0.5 * length_m;
+    let reach_m = front_m + r.speed_m_s * r.speed_m_s / (2.0 * a) + length_m;
+    let within_m = m.yields_to_vehicle_m.unwrap_or(0.0);
+    r.yielding = front_m < path_m && near(front_m, reach_m.min(path_m), within_m);
+    r.speed_m_s = if r.yielding {
+        (r.speed_m_s - a * dt).max(0.0)
+    } else {
+        let can_stop = (2.0 * a * (rest_m - r.arc_m)).sqrt();
+        (r.speed_m_s + a * dt).min(m.speed_m_s).min(can_stop)
+    };
+    r.arc_m = (r.arc_m + r.speed_m_s * dt).min(rest_m);
+    m.state_at_arc(r.arc_m, r.speed_m_s)
+}
+
+/// True when any of the vehicle's `parts` (footprints in its frame, all within `reach_m` of its
+/// origin) lies within `within_m` of the stretch of `m`'s path between arc lengths `from_m` and
+/// `to_m`, in plan; `vehicle_from_world` places the path in the vehicle's frame.
+fn near_path(
+    parts: &[Footprint],
+    reach_m: f64,
+    m: &ObstacleMotion,
+    from_m: f64,
+    to_m: f64,
+    within_m: f64,
+    vehicle_from_world: &Isometry2<f64>,
+) -> bool {
+    let stretch = stretch(m, from_m, to_m);
+    let local: Vec<Point2<f64>> = stretch.iter().map(|p| vehicle_from_world * p).collect();
+    let origin = Point2::origin();
+    local.windows(2).any(|w| {
+        segment_distance(&origin, &w[0], &w[1]) <= reach_m + within_m
+            && parts
+                .iter()
+                .any(|f| footprint_segment_distance(f, &w[0], &w[1]) < within_m)
+    }) || (local.len() == 1 && parts.iter().any(|f| f.distance(&local[0]) < within_m))
+}
+
+/// The points of `m`'s path between arc lengths `from_m` and `to_m` (>= `from_m`): both ends
+/// and the vertices between.
+fn stretch(m: &ObstacleMotion, from_m: f64, to_m: f64) -> Vec<Point2<f64>> {
+    let at = |s: f64| {
+        let p = m.state_at_arc(s, 0.0);
+        Point2::new(p.x_m, p.y_m)
+    };
+    let mut points = vec![at(from_m)];
+    let mut arc_m = 0.0;
+    for w in m.path_m.windows(2) {
+        arc_m += (w[1] - w[0]).norm();
+        if arc_m > from_m && arc_m < to_m {
+            points.push(w[1]);
+        }
+    }
+    if to_m > from_m {
+        points.push(at(to_m));
+    }
+    points
+}
+
+/// Distance between a footprint and the segment `a`-`b` (0 when they meet).
+fn footprint_segment_distance(f: &Footprint, a: &Point2<f64>, b: &Point2<f64>) -> f64 {
+    match f {
+        Footprint::Disc(disc) => (segment_distance(&disc.center, a, b) - disc.radius_m).max(0.0),
+        Footprint::Polygon(poly) => {
+            if poly.contains(a) || poly.contains(b) {
+                return 0.0;
+            }
+            let v = poly.vertices();
+            (0..v.len())
+                .map(|i| segments_distance(a, b, &v[i], &v[(i + 1) % v.len()]))
+                .fold(f64::INFINITY, f64::min)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::scenario::Scenario;
+
+    /// The fake-wing car at the origin heading +x; a van crossing x = 20 northwards, yielding
+    /// within 5 m.
+    fn scenario(extra: &str) -> Scenario {
+        let text = format!(
+            r#"name = "yield"
+[world]
+min_m = [-50.0, -50.0]
+max_m = [100.0, 50.0]
+[vehicle]
+description = "iara_car_fake_wing"
+[route]
+waypoints_m = [[0.0, 0.0], [90.0, 0.0]]
+speed_m_s = 3.0
+[[obstacles]]
+id = "van"
+kind = "vehicle"
+expect = "yield"
+path_m = [[20.0, -30.0], [20.0, 30.0]]
+speed_m_s = 3.0
+{extra}
+"#
+        );
+        Scenario::from_str(&text, Path::new("yield.toml")).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    fn run(traffic: &mut Traffic, from_s: f64, to_s: f64, pose: &Isometry2<f64>) -> f64 {
+        let dt = 0.01;
+        let mut t = from_s;
+        while t < to_s - 1e-9 {
+            t += dt;
+            traffic.step(t, pose);
+        }
+        t
+    }
+
+    #[test]
+    fn a_yielding_driver_stops_short_of_a_standing_vehicle_and_goes_once_it_is_clear() {
+        let s = scenario("yields_to_vehicle_m = 5.0");
+        let mut traffic = Traffic::new(&s.obstacles, &s.vehicle.vehicle);
+        // The car stands across the van's path, its rear axle on it.
+        let across = Isometry2::new(nalgebra::Vector2::new(20.0, 0.0), 0.0);
+        traffic.step(0.0, &across);
+        let t = run(&mut traffic, 0.0, 30.0, &across);
+        let van = traffic.state(0).expect("present");
+        assert_eq!(van.speed_m_s, 0.0, "stands");
+        assert!(traffic.yielding(0));
+        let front = van.y_m + 2.25;
+        // Across the van's line (x = 20) the car's body reaches y = -0.88 (its wing, 3.3 m
+        // ahead, is farther): the van's stretch (front + its length, 4.5 m, standing) stays
+        // 5 m off it, give or take a step.
+        assert!(
+            (-0.88 - 5.0 - 4.5 - 0.1..-0.88 - 5.0 - 4.5 + 0.3).contains(&front),
+            "front at {front}"
+        );
+        let stood = van.y_m;
+        // Still there 20 s later; then the car drives off and the van goes on to its end.
+        let t = run(&mut traffic, t, t + 20.0, &across);
+        assert_eq!(traffic.state(0).map(|v| v.y_m), Some(stood));
+        let gone = Isometry2::new(nalgebra::Vector2::new(80.0, 0.0), 0.0);
+        let t = run(&mut traffic, t, t + 5.0, &gone);
+        let van = traffic.state(0).expect("present");
+        assert!(!traffic.yielding(0));
+        assert!(van.y_m > stood + 5.0, "moved on to {}", van.y_m);
+        run(&mut traffic, t, t + 30.0, &gone);
+        assert_eq!(traffic.state(0).map(|v| (v.x_m, v.y_m)), Some((20.0, 30.0)));
+    }
+
+    #[test]
+    fn a_yielding_driver_ignores_a_vehicle_far_off_and_a_plain_mover_never_yields() {
+        let s = scenario("yields_to_vehicle_m = 5.0");
+        let mut traffic = Traffic::new(&s.obstacles, &s.vehicle.vehicle);
+        let far = Isometry2::new(nalgebra::Vector2::new(0.0, 0.0), 0.0);
+        traffic.step(0.0, &far);
+        run(&mut traffic, 0.0, 30.0, &far);
+        // From rest at 2 m/s^2 to 3 m/s and braking to its end: 60 m in 21.5 s.
+        assert_eq!(traffic.state(0).map(|v| (v.x_m, v.y_m)), Some((20.0, 30.0)));
+        let plain = scenario("");
+        let mut traffic = Traffic::new(&plain.obstacles, &plain.vehicle.vehicle);
+        let across = Isometry2::new(nalgebra::Vector2::new(20.0, 0.0), 0.0);
+        for k in 0..=1000 {
+            let t = f64::from(k) * 0.01;
+            traffic.step(t, &across);
+            assert_eq!(
+                traffic.state(0).map(|v| (v.x_m, v.y_m, v.yaw_rad)),
+                plain.obstacles[0].pose_at(t)
+            );
+        }
+    }
+
+    #[test]
+    fn distances_between_segments_and_footprints() {
+        let p = |x, y| Point2::new(x, y);
+        assert_eq!(
+            segments_distance(&p(0.0, -1.0), &p(0.0, 1.0), &p(-1.0, 0.0), &p(1.0, 0.0)),
+            0.0
+        );
+        let d = segments_distance(&p(0.0, 0.0), &p(1.0, 0.0), &p(2.0, 1.0), &p(2.0, 3.0));
+        assert!((d - 2f64.sqrt()).abs() < 1e-12);
+        let square = aircraft::footprint::ConvexPolygon::hull(&[
+            p(0.0, 0.0),
+            p(1.0, 0.0),
+            p(1.0, 1.0),
+            p(0.0, 1.0),
+        ])
+        .map(Footprint::Polygon)
+        .expect("a square");
+        // A segment passing through without an end inside.
+        assert_eq!(
+            footprint_segment_distance(&square, &p(-1.0, 0.5), &p(2.0, 0.5)),
+            0.0
+        );
+        let d = footprint_segment_distance(&square, &p(3.0, -1.0), &p(3.0, 2.0));
+        assert!((d - 2.0).abs() < 1e-12);
+    }
+}
