@@ -528,6 +528,37 @@ mod tests {
         assert!(c.speed_m_s == 5.0 && c.steering_rad < 0.0, "{c:?}");
     }
 
+    /// A route faster than the vehicle can stop from within its longest horizon (60 m at
+    /// 3 m/s^2: 17.5 m/s) is lowered, and the driver says so; one within it is not.
+    #[test]
+    fn a_route_too_fast_to_stop_within_the_horizon_is_lowered() {
+        assert_eq!(driver().route_speed_lowered(), None, "5 m/s is allowed");
+        let mut fast = driver();
+        fast.wanted_speed_m_s = 20.0;
+        let (cap, why) = fast.route_speed_lowered().expect("lowered");
+        assert_eq!(why, SpeedLimit::Horizon);
+        let stopping = cap * 0.5 + cap * cap / 6.0 + 3.0;
+        assert!(
+            (stopping - 60.0).abs() < 1e-9,
+            "{cap} m/s stops in {stopping} m"
+        );
+        // Maps wide enough for the 60 m horizon the speed needs (blocks of 60 m).
+        fast.distance_map_half_size_m = 80.0;
+        let config = MapConfig {
+            block_cells: 300,
+            max_distance_m: 5.0,
+            ..MapConfig::default()
+        };
+        let levels = Levels::cumulative(vec![0.0]).unwrap();
+        let wide = MultiHeightMap::new(config, levels, Point2::new(40.0, 0.0)).unwrap();
+        let self_filter = fast.vehicle.collision.clone();
+        let mut map = OnlineMap::new(wide, self_filter, ForgettingConfig::default(), 0.1);
+        fast.on_pose(at(0.0, 10.0, 0.0, 0.0));
+        fast.plan(&mut map).unwrap();
+        let v = fast.speed_command_m_s();
+        assert!((v - cap).abs() < 1e-9, "{v} against {cap}");
+    }
+
     /// An estimate with a lateral standard deviation `sigma_m` (position only).
     fn uncertain(sigma_m: f64) -> PoseEstimate {
         PoseEstimate {

@@ -28,7 +28,10 @@ pub use outcome::{
 };
 pub use pose_error::{ErrorLog, ErrorStats, LocalizationErrors, LocalizationReport};
 pub use pose_source::{LocalizationContext, Localizer, NoisyTruth, PoseSource, Truth, from_config};
-pub use report::{HiddenObstacle, Progress, RunReport, TimeSplit};
-pub use rig::{RunHandles, RunSetup, distance_cap_m, distance_map_half_size_m, run, run_with};
+pub use report::{HiddenObstacle, Progress, RunReport, SpeedLowered, TimeSplit};
+pub use rig::{
+    RunHandles, RunSetup, distance_cap_m, distance_map_half_size_m, longest_horizon_m, run,
+    run_with,
+};
 pub use schedule::{Planned, Scheduler};
 pub use traffic::Traffic;

@@ -61,6 +61,21 @@ pub struct RunReport {
     pub faults: crate::world::FaultCounts,
     /// The pose estimate against the truth (`None` when the pose source is the truth).
     pub localization: Option<super::pose_error::LocalizationReport>,
+    /// The route's speed, lowered: faster, the vehicle could not stop within its longest
+    /// horizon or its detection range (`None`: the route's speed was allowed).
+    pub speed_lowered: Option<SpeedLowered>,
+}
+
+/// The route's speed, lowered by the stack to what it can stop from within what it checks.
+#[derive(Clone, Debug, Serialize)]
+pub struct SpeedLowered {
+    /// The route's speed, m/s.
+    pub route_m_s: f64,
+    /// The fastest the stack drove, m/s.
+    pub cap_m_s: f64,
+    /// What limited it: `horizon` (`autonomy.max_horizon_m`) or `detection_range`
+    /// (`autonomy.detection_range_m`).
+    pub limit: autonomy::planner::SpeedLimit,
 }
 
 /// The obstacle a vehicle waits for without seeing it.

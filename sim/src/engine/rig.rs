@@ -21,7 +21,7 @@ use super::judge::Judge;
 use super::observer::{NoObserver, Observer, RunStart};
 use super::outcome::EndReason;
 use super::pose_source::PoseSource;
-use super::report::{HiddenObstacle, Progress, RunReport, TimeSplit};
+use super::report::{HiddenObstacle, Progress, RunReport, SpeedLowered, TimeSplit};
 use super::schedule::Scheduler;
 use crate::error::{Error, Result};
 use crate::scenario::RunConfig;
@@ -81,17 +81,30 @@ pub fn distance_cap_m(model: &CollisionModel, autonomy: &AutonomyConfig) -> f32 
 /// obstacle outside it could lower. A candidate's pose lies within the horizon plus twice the
 /// largest offset of the vehicle (the vehicle may be off the route too); the early out reads the
 /// map at the bounding circle's centre up to its radius plus the safety distance plus a cell
-/// diagonal, and every circle lies inside the bounding circle; 1 m is kept.
-pub fn distance_map_half_size_m(model: &CollisionModel, autonomy: &AutonomyConfig) -> f64 {
+/// diagonal, and every circle lies inside the bounding circle; 1 m is kept. `horizon_m` is the
+/// longest horizon the planner will check ([`longest_horizon_m`]).
+pub fn distance_map_half_size_m(
+    model: &CollisionModel,
+    autonomy: &AutonomyConfig,
+    horizon_m: f64,
+) -> f64 {
     let b = model.bounding_circle();
     let safety = autonomy.planner_safety_m.max(autonomy.avoider_safety_m) as f64;
-    autonomy.horizon_m
+    horizon_m
         + 2.0 * autonomy.max_offset_m
         + b.center.coords.norm()
         + b.radius_m
         + safety
         + 0.3
         + 1.0
+}
+
+/// The longest horizon the planner checks on a route at `route_m_s` with braking
+/// `deceleration_m_s2`: the horizon grows with the speed it drives (the route's, capped to
+/// what it can stop from within the longest horizon and the detection range).
+pub fn longest_horizon_m(route_m_s: f64, deceleration_m_s2: f64, autonomy: &AutonomyConfig) -> f64 {
+    let cap = autonomy::planner::speed_cap_m_s(deceleration_m_s2, autonomy).0;
+    autonomy::planner::horizon_for_m(route_m_s.min(cap), deceleration_m_s2, autonomy)
 }
 
 /// Runs a scenario in closed loop over its offline map (which must exist: see `mapping`).
@@ -352,6 +365,14 @@ impl<'a> Rig<'a> {
                 ..self.fault_counts
             },
             localization: self.localization_errors.as_ref().map(|l| l.report()),
+            speed_lowered: self
+                .driver
+                .route_speed_lowered()
+                .map(|(cap_m_s, limit)| SpeedLowered {
+                    route_m_s: self.scenario.route.speed_m_s,
+                    cap_m_s,
+                    limit,
+                }),
             config: self.config,
         }
     }
@@ -400,10 +421,14 @@ fn driver(
     route: &RoutePath,
 ) -> Driver {
     let vehicle = &scenario.vehicle.vehicle;
-    let odm_half_size_m = config
-        .mapping
-        .distance_map_half_size_m
-        .unwrap_or_else(|| distance_map_half_size_m(model, &config.autonomy));
+    let odm_half_size_m = config.mapping.distance_map_half_size_m.unwrap_or_else(|| {
+        let horizon = longest_horizon_m(
+            scenario.route.speed_m_s,
+            vehicle.spec.motion.max_deceleration_m_s2,
+            &config.autonomy,
+        );
+        distance_map_half_size_m(model, &config.autonomy, horizon)
+    });
     Driver::new(
         route.clone(),
         VehicleModel {

@@ -280,6 +280,8 @@ fn every_shipped_campaign_reads_and_its_first_variants_are_valid_scenarios() {
             "low_debris_car",
             "parking_lot_random",
             "smoke",
+            "traffic_airliner",
+            "traffic_jet",
             "tune_a320",
             "tune_car",
             "tune_praetor",

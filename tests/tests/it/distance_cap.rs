@@ -58,7 +58,22 @@ fn region_maps(
 
 #[test]
 fn capped_region_maps_give_the_same_plans_as_30_m_maps_of_the_whole_area() {
-    let cfg = AutonomyConfig::default();
+    // The default horizon, and the one the jet (1.5 m/s^2) checks at 10 m/s: it grows with
+    // speed, to 0.5 x 10 + 100 / 3 + 3 + 0.5 = 41.8 m.
+    let fast = sim::engine::longest_horizon_m(10.0, 1.5, &AutonomyConfig::default());
+    assert!((fast - 41.83).abs() < 0.01, "{fast}");
+    for horizon_m in [30.0, fast] {
+        compare_plans(&AutonomyConfig {
+            horizon_m,
+            ..AutonomyConfig::default()
+        });
+    }
+}
+
+/// Plans and speeds over maps of the square `distance_map_half_size_m` gives for `cfg`'s
+/// horizon against maps of the whole area.
+fn compare_plans(cfg: &AutonomyConfig) {
+    let cfg = cfg.clone();
     let route = RoutePath::new(&[Point2::new(-15.0, 0.0), Point2::new(75.0, 0.0)], false);
     for (vehicle, behaviour) in [
         ("iara_car_fake_wing", Behaviour::Deviate),
@@ -70,9 +85,9 @@ fn capped_region_maps_give_the_same_plans_as_30_m_maps_of_the_whole_area() {
             .unwrap()
             .model;
         let cap = sim::engine::distance_cap_m(&model, &cfg);
-        let half = sim::engine::distance_map_half_size_m(&model, &cfg);
+        let half = sim::engine::distance_map_half_size_m(&model, &cfg, cfg.horizon_m);
         assert!(
-            cap < 30.0 && half < 60.0,
+            cap < 30.0 && half < 75.0,
             "{vehicle}: cap {cap}, half {half}"
         );
         let levels = model.level_count();

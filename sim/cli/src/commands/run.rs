@@ -221,6 +221,21 @@ fn run_config(args: &RunArgs, scenario: &Scenario) -> anyhow::Result<RunConfig> 
 }
 
 /// The human summary of a run.
+/// The line saying the stack lowered the route's speed, when it did.
+fn speed_lowered_line(t: &mut String, r: &RunReport) {
+    use std::fmt::Write as _;
+    let Some(l) = &r.speed_lowered else { return };
+    let why = match l.limit {
+        sim::autonomy::planner::SpeedLimit::Horizon => "autonomy.max_horizon_m",
+        sim::autonomy::planner::SpeedLimit::DetectionRange => "autonomy.detection_range_m",
+    };
+    let _ = writeln!(
+        t,
+        "route speed {:.1} m/s lowered to {:.1} m/s: faster, the vehicle could not stop within {why}",
+        l.route_m_s, l.cap_m_s
+    );
+}
+
 pub fn table(r: &RunReport) -> String {
     use std::fmt::Write as _;
     let mut t = String::new();
@@ -292,6 +307,7 @@ pub fn table(r: &RunReport) -> String {
             );
         }
     }
+    speed_lowered_line(&mut t, r);
     if let Some(w) = &r.waiting_for {
         let _ = writeln!(
             t,
