@@ -101,6 +101,11 @@ pub struct Driver {
     predictions: Vec<Prediction>,
     /// The conflict with a mover the last plan found on the chosen path.
     conflict: Option<Conflict>,
+    /// When a plan last found a conflict with a mover, seconds.
+    last_conflict_s: Option<f64>,
+    /// The line the vehicle holds short of for a mover: its track, the route arc length,
+    /// when the conflict was last found.
+    hold: Option<(u32, f64, f64)>,
 }
 
 impl Driver {
@@ -135,6 +140,8 @@ impl Driver {
             last_revolution_s: None,
             predictions: Vec::new(),
             conflict: None,
+            last_conflict_s: None,
+            hold: None,
         }
     }
 
@@ -182,6 +189,8 @@ impl Driver {
     /// start over.
     pub fn restart(&mut self) {
         self.status = DriverStatus::Driving;
+        self.last_conflict_s = None;
+        self.hold = None;
         self.route_s_m = None;
         self.estimate = None;
         self.last_odometry = None;
@@ -235,24 +244,24 @@ impl Driver {
             }
         }
         let mut chosen = p.chosen().clone();
-        if let Some(c) = &conflict {
-            // Stop before the conflict zone when it can; before the conflict itself otherwise.
-            let short_of_zone = stopping_distance_m(v0, decel, &config) < c.zone_m;
-            let stop_at = if short_of_zone { c.zone_m } else { c.at_m };
-            chosen.collision_at_m = Some(chosen.collision_at_m.map_or(stop_at, |s| s.min(stop_at)));
+        if let Some(stop_at) =
+            self.hold_line(conflict.as_ref(), s, v0, decel, estimate.t_s, &config)
+        {
+            chosen.collision_at_m = Some(chosen.collision_at_m.map_or(stop_at, |c| c.min(stop_at)));
         }
         let (v, _) = avoid(&chosen, wanted, decel, &config);
         self.speed_command_m_s = v;
         self.status = match conflict {
             _ if v > 0.0 => DriverStatus::Driving,
-            Some(c) if chosen.collision_at_m != p.chosen().collision_at_m => {
-                DriverStatus::Yielding {
-                    track_id: c.track_id,
-                    mover_at: c.mover_at,
-                }
-            }
+            _ if chosen.collision_at_m != p.chosen().collision_at_m => DriverStatus::Yielding {
+                track_id: self.hold.map_or(u32::MAX, |h| h.0),
+                mover_at: conflict.map_or(here, |c| c.mover_at),
+            },
             _ => self.stopped_status(&p, map, estimate.t_s),
         };
+        if conflict.is_some() {
+            self.last_conflict_s = Some(estimate.t_s);
+        }
         self.conflict = conflict;
         if let Some(c) = &conflict {
             // The plan shows where the vehicle stops for the mover.
@@ -264,6 +273,49 @@ impl Driver {
             distance_maps_s: (t1 - t0).as_secs_f64(),
             planning_s: t1.elapsed().as_secs_f64(),
         })
+    }
+
+    /// Where the vehicle must stop for movers, as a distance ahead of route progress `s`: before
+    /// the conflict zone when it can stop short of it, before the conflict itself otherwise.
+    /// Once two plans in a row find the conflict, the line is held on the route - never moved
+    /// further on while the conflict lasts, nor for `conflict_memory_s` after it was last
+    /// found - so a prediction that flickers or a zone that shifts does not let the vehicle
+    /// creep into the mover's path.
+    fn hold_line(
+        &mut self,
+        conflict: Option<&Conflict>,
+        s: f64,
+        v0: f64,
+        decel: f64,
+        now_s: f64,
+        config: &AutonomyConfig,
+    ) -> Option<f64> {
+        let previous = self.conflict.map(|c| c.track_id);
+        if let Some(c) = conflict {
+            let short_of_zone = stopping_distance_m(v0, decel, config) < c.zone_m;
+            let line = s + if short_of_zone { c.zone_m } else { c.at_m };
+            let held = match self.hold {
+                Some((id, held, _)) if id == c.track_id => held.min(line),
+                _ => line,
+            };
+            if previous != Some(c.track_id) && self.hold.is_none() {
+                // Found on one plan only (a prediction may flicker): this plan stops short of
+                // it; the line is held once the next plan finds it again.
+                return Some(line - s);
+            }
+            self.hold = Some((c.track_id, held, now_s));
+        } else if self
+            .hold
+            .is_some_and(|(_, _, t)| now_s - t >= config.traffic.conflict_memory_s)
+        {
+            self.hold = None;
+        }
+        // A line well behind the vehicle (a closed route's lap started over, or it went on
+        // committed) holds nothing.
+        if self.hold.is_some_and(|(_, line, _)| line - s < -1.0) {
+            self.hold = None;
+        }
+        self.hold.map(|(_, line, _)| (line - s).max(0.0))
     }
 
     /// The movers predicted from `map`'s tracker, and the first conflict on `p`'s chosen path
@@ -302,7 +354,12 @@ impl Driver {
             step_m: config.step_m,
             profile,
             now_s,
-            yielding: matches!(self.status, DriverStatus::Yielding { .. }),
+            // Yielding, or slowing for a conflict found lately: the margin after grows, so a
+            // prediction that flickers does not let the vehicle creep into the mover's path.
+            yielding: matches!(self.status, DriverStatus::Yielding { .. })
+                || self
+                    .last_conflict_s
+                    .is_some_and(|t| now_s - t < traffic.conflict_memory_s),
         };
         first_conflict(&path, &self.vehicle.collision, &self.predictions, traffic)
     }

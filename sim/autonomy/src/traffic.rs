@@ -39,8 +39,12 @@ pub struct TrafficConfig {
     /// The vehicle keeps out of where a mover is predicted from this long before it is at a
     /// pose to this long after, seconds. Default 1.5.
     pub time_margin_s: f64,
-    /// While yielding, the margin after grows by this much, seconds. Default 1.
+    /// While yielding - stopped for a mover, or within `conflict_memory_s` of a plan that found
+    /// a conflict - the margin after grows by this much, seconds. Default 1.
     pub resume_margin_s: f64,
+    /// How long after a conflict was last found the vehicle counts as yielding, seconds.
+    /// Default 2.
+    pub conflict_memory_s: f64,
     /// The margin of a vehicle too close to stop short of a mover's path: it drives on when it
     /// clears the mover by this much (standing in the path would be worse), seconds. Default 0.5.
     pub committed_margin_s: f64,
@@ -52,7 +56,8 @@ pub struct TrafficConfig {
     /// What may lie of a mover beyond the box of its hits, along and across its motion (the far
     /// side of a van seen from one side, its back seen from the front), metres. Default 1.
     pub hidden_m: f64,
-    /// Movers slower than this are left to the map, m/s. Default 0.3.
+    /// Movers slower than this are left to the map, m/s. Default 0.8 (a static object's visible
+    /// part, sliding as it is hidden or revealed, seldom seems faster).
     pub min_speed_m_s: f64,
 }
 
@@ -63,11 +68,12 @@ impl Default for TrafficConfig {
             horizon_s: 8.0,
             time_margin_s: 1.5,
             resume_margin_s: 1.0,
+            conflict_memory_s: 2.0,
             committed_margin_s: 0.5,
             sigmas: 2.0,
             margin_m: 0.5,
             hidden_m: 1.0,
-            min_speed_m_s: 0.3,
+            min_speed_m_s: 0.8,
         }
     }
 }
@@ -79,6 +85,7 @@ impl TrafficConfig {
         let non_negative = [
             ("time_margin_s", self.time_margin_s),
             ("resume_margin_s", self.resume_margin_s),
+            ("conflict_memory_s", self.conflict_memory_s),
             ("committed_margin_s", self.committed_margin_s),
             ("sigmas", self.sigmas),
             ("margin_m", self.margin_m),
