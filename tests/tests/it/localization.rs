@@ -69,10 +69,14 @@ fn on_a_featureless_lot_the_covariance_grows_and_the_vehicle_slows_or_stops() {
         l.max_sigma_cross_m > slow_m,
         "the sigma never passed {slow_m} m: {l:?}"
     );
-    // Slower than the lap with markings (90.9 s; 98.5 s seen), or stopped for good.
+    // Slower than the lap with markings (90.9 s; 98.5 s seen), or stopped for good (timed out,
+    // or - since the prediction of movers, issue 36 - stopped and calling a pilot).
     let lap_s = r.lap_times_s.first().copied();
     assert!(
-        r.end == EndReason::TimedOut || lap_s.is_some_and(|t| t > 95.0),
+        matches!(
+            r.end,
+            EndReason::TimedOut | EndReason::WaitingForHiddenObstacle
+        ) || lap_s.is_some_and(|t| t > 95.0),
         "end {:?}, lap {lap_s:?}",
         r.end
     );
