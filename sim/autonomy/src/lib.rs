@@ -24,7 +24,7 @@ pub mod stack;
 pub mod traffic;
 
 pub use messages::{Command, LidarRevolution, Odometry, PoseEstimate};
-pub use online_map::{ForgettingConfig, ForgettingRule, OnlineMap};
+pub use online_map::{ForgettingConfig, ForgettingRule, OnlineMap, trusted_range_m};
 pub use planner::{AutonomyConfig, Behaviour, Candidate, Plan, avoid, plan, pure_pursuit};
 pub use route::{RoutePath, wrap_angle};
 pub use stack::{Driver, DriverStatus, PlanTimes, VehicleModel};

@@ -14,6 +14,9 @@ pub struct LidarRevolution {
     pub scan: mapper::Scan,
     /// The pose estimate the revolution was taken at.
     pub world_from_vehicle_estimate: Isometry2<f64>,
+    /// That estimate's covariance (x, y in metres, heading in radians; zero for an exact pose):
+    /// how far the returns may be from where they are placed.
+    pub estimate_covariance: Matrix3<f64>,
 }
 
 /// A pose estimate from the localizer (or the simulator's stand-in for one).

@@ -2,7 +2,7 @@
 //! around the vehicle's estimated pose, and the distance maps the collision checks read.
 
 use mapper::{CollisionModel, MultiHeightMap, Tracker, TrackerConfig, WorldCell};
-use nalgebra::Point2;
+use nalgebra::{Matrix3, Point2};
 use serde::{Deserialize, Serialize};
 
 use crate::messages::LidarRevolution;
@@ -58,18 +58,49 @@ pub struct OnlineMap {
     self_filter: CollisionModel,
     forgetting: ForgettingConfig,
     scan_period_s: f64,
+    max_return_error_m: f64,
     tracker: Tracker,
     revolutions: u64,
+    /// Whether the estimate has trusted a revolution out to the obstacle test's range yet.
+    started: bool,
+}
+
+/// How far from the sensor a revolution taken at an estimate of covariance `c` (x, y, heading)
+/// can be mapped: out to where the estimate's 2-sigma error - its position's (largest axis) and
+/// its heading's times the range, added in quadrature - moves a return by `max_error_m`,
+/// metres. Infinite for an exact pose; 0 when the position alone errs by that much.
+///
+/// A heading 0.05 rad off (the fix's spread) puts a return 70 m away 3.5 m from where it is;
+/// such a return, mapped at the height of a wing where no later beam passes, stays an
+/// obstacle for good (`tests/found/phantom_from_the_first_revolution.toml`).
+pub fn trusted_range_m(c: &Matrix3<f64>, max_error_m: f64) -> f64 {
+    let (a, b, d) = (c[(0, 0)], c[(0, 1)], c[(1, 1)]);
+    let largest = 0.5 * (a + d) + (0.25 * (a - d) * (a - d) + b * b).sqrt();
+    // A NaN (an estimate that knows nothing) makes both NaN: nothing is trusted.
+    let position = 2.0 * largest.sqrt();
+    let heading = 2.0 * c[(2, 2)].sqrt();
+    if position.is_nan() || heading.is_nan() || position >= max_error_m {
+        return 0.0;
+    }
+    let spare = (max_error_m * max_error_m - position * position).sqrt();
+    if heading > 0.0 {
+        spare / heading
+    } else {
+        f64::INFINITY
+    }
 }
 
 impl OnlineMap {
     /// `map` (its window, offline prior and live store already set), the circles whose
     /// neighbourhood holds the LiDAR's self-hits, forgetting, and the time between revolutions.
+    /// Mapping starts once a revolution is trusted out to the obstacle test's range for
+    /// `max_return_error_m` ([`Self::update`]).
     pub fn new(
         map: MultiHeightMap,
         self_filter: CollisionModel,
         forgetting: ForgettingConfig,
         scan_period_s: f64,
+        max_return_error_m: f64,
     ) -> Self {
         let tracker = Tracker::new(forgetting.tracking.clone(), map.config().resolution_m);
         OnlineMap {
@@ -77,8 +108,10 @@ impl OnlineMap {
             self_filter,
             forgetting,
             scan_period_s,
+            max_return_error_m,
             tracker,
             revolutions: 0,
+            started: false,
         }
     }
 
@@ -86,6 +119,13 @@ impl OnlineMap {
     /// `time_decay`) what is no longer seen faded, the revolution inserted (its beams lower
     /// what they pass through, its hits raise what they hit), then what the tracked moving
     /// objects left cleared.
+    ///
+    /// Mapping starts with the first revolution whose estimate is trusted out to the obstacle
+    /// test's range ([`trusted_range_m`] of `max_return_error_m`): the revolutions taken while
+    /// a localizer still spreads from its fix are left out whole (a part of one, mapped,
+    /// leaves near cells hit without the free-space evidence of the rest). From then on every
+    /// revolution is mapped, whatever the estimate: the stack slows and stops for an uncertain
+    /// estimate itself.
     pub fn update(&mut self, revolution: &LidarRevolution) -> Result<(), mapper::MapError> {
         let at = Point2::from(revolution.world_from_vehicle_estimate.translation.vector);
         self.map.recenter(at)?;
@@ -93,6 +133,13 @@ impl OnlineMap {
         if f.rule == ForgettingRule::TimeDecay {
             self.map
                 .forget_unseen(at, f.half_size_m, self.scan_period_s, f.time_constant_s);
+        }
+        if !self.started {
+            let range_m = trusted_range_m(&revolution.estimate_covariance, self.max_return_error_m);
+            if range_m < self.map.config().obstacle_test.max_range_m {
+                return Ok(());
+            }
+            self.started = true;
         }
         self.map
             .insert_scan(&revolution.scan, Some(&self.self_filter))?;
@@ -107,6 +154,12 @@ impl OnlineMap {
             self.tracker.prune(&at, half);
         }
         Ok(())
+    }
+
+    /// Whether mapping has started: a revolution's estimate has been trusted out to the obstacle
+    /// test's range ([`Self::update`]). Until then the driver holds the vehicle.
+    pub fn mapping_started(&self) -> bool {
+        self.started
     }
 
     /// When a revolution last hit the world cell `cell` as an obstacle, seconds (`None`: not
@@ -139,5 +192,38 @@ impl OnlineMap {
     /// The map, to update its distance maps.
     pub fn map_mut(&mut self) -> &mut MultiHeightMap {
         &mut self.map
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn covariance(sigma_m: f64, sigma_rad: f64) -> Matrix3<f64> {
+        Matrix3::from_diagonal(&nalgebra::Vector3::new(
+            sigma_m * sigma_m,
+            sigma_m * sigma_m,
+            sigma_rad * sigma_rad,
+        ))
+    }
+
+    #[test]
+    fn the_trusted_range_shrinks_with_the_estimates_uncertainty() {
+        assert_eq!(trusted_range_m(&Matrix3::zeros(), 1.0), f64::INFINITY);
+        // At the fix (0.5 m, 0.05 rad): 2 sigma of position alone is the whole bound.
+        assert_eq!(trusted_range_m(&covariance(0.5, 0.05), 1.0), 0.0);
+        // Settled (0.05 m, 0.005 rad): sqrt(1 - 0.1^2) / 0.01.
+        let settled = trusted_range_m(&covariance(0.05, 0.005), 1.0);
+        assert!((settled - 0.99_f64.sqrt() / 0.01).abs() < 1e-9, "{settled}");
+        // Half-way (0.3 m, 0.008 rad, the filter 0.6 s after its fix): 50 m.
+        let r = trusted_range_m(&covariance(0.3, 0.008), 1.0);
+        assert!((r - 50.0).abs() < 1e-9, "{r}");
+        // The largest axis counts: all the error across, none along.
+        let mut c = covariance(0.0, 0.005);
+        c[(1, 1)] = 0.3 * 0.3;
+        assert!((trusted_range_m(&c, 1.0) - 80.0).abs() < 1e-9);
+        // A NaN covariance trusts nothing.
+        assert_eq!(trusted_range_m(&covariance(f64::NAN, 0.0), 1.0), 0.0);
+        assert_eq!(trusted_range_m(&covariance(0.0, f64::NAN), 1.0), 0.0);
     }
 }

@@ -198,9 +198,11 @@ impl Driver {
 
     /// Plans from the current estimate over `map`'s distance maps (brought up to date around the
     /// estimate first): the planner's candidates and choice, then the avoider's speed. Without an
-    /// estimate the vehicle is held (speed 0).
+    /// estimate, or before the online map has started mapping (an estimate not yet trusted out
+    /// to the obstacle test's range: [`OnlineMap::mapping_started`]), the vehicle is held
+    /// (speed 0): blind to what the offline map does not hold, it would drive into it.
     pub fn plan(&mut self, map: &mut OnlineMap) -> Result<PlanTimes, MapError> {
-        let Some(estimate) = self.estimate else {
+        let Some(estimate) = self.estimate.filter(|_| map.mapping_started()) else {
             self.speed_command_m_s = 0.0;
             return Ok(PlanTimes::default());
         };
@@ -518,6 +520,11 @@ mod tests {
     }
 
     fn empty_map() -> OnlineMap {
+        started(unstarted_map(), 20.0)
+    }
+
+    /// An empty map centred at (20, 0) that no revolution has reached.
+    fn unstarted_map() -> OnlineMap {
         let config = MapConfig {
             block_cells: 100,
             max_distance_m: 5.0,
@@ -535,7 +542,53 @@ mod tests {
             vec![0.0],
         )
         .unwrap();
-        OnlineMap::new(map, self_filter, ForgettingConfig::default(), 0.1)
+        OnlineMap::new(map, self_filter, ForgettingConfig::default(), 0.1, 1.0)
+    }
+
+    /// `map` after an empty revolution at an exact pose at `x_m` (where it is centred):
+    /// mapping has started.
+    fn started(mut map: OnlineMap, x_m: f64) -> OnlineMap {
+        assert!(!map.mapping_started());
+        map.update(&crate::LidarRevolution {
+            t_s: 0.0,
+            scan: mapper::Scan::new(1, Vec::new(), Vec::new()).unwrap(),
+            world_from_vehicle_estimate: nalgebra::Isometry2::translation(x_m, 0.0),
+            estimate_covariance: nalgebra::Matrix3::zeros(),
+        })
+        .unwrap();
+        assert!(map.mapping_started());
+        map
+    }
+
+    /// Until mapping has started (no revolution yet, or none taken at an estimate trusted out
+    /// to the obstacle test's range), the vehicle is held, whatever the estimate.
+    #[test]
+    fn the_vehicle_is_held_until_mapping_has_started() {
+        let mut map = unstarted_map();
+        let mut d = driver();
+        d.on_pose(at(0.0, 10.0, 0.0, 0.0));
+        let revolution = |t_s: f64, sigma_rad: f64| crate::LidarRevolution {
+            t_s,
+            scan: mapper::Scan::new(1, Vec::new(), Vec::new()).unwrap(),
+            world_from_vehicle_estimate: nalgebra::Isometry2::translation(10.0, 0.0),
+            estimate_covariance: nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(
+                0.0025,
+                0.0025,
+                sigma_rad * sigma_rad,
+            )),
+        };
+        d.plan(&mut map).unwrap();
+        assert_eq!(d.speed_command_m_s(), 0.0);
+        // 2 x 0.01 rad x 70 m = 1.4 m: not yet.
+        map.update(&revolution(0.0, 0.01)).unwrap();
+        d.plan(&mut map).unwrap();
+        assert!(!map.mapping_started());
+        assert_eq!(d.speed_command_m_s(), 0.0);
+        // 2 x 0.004 rad x 70 m = 0.56 m (with 0.1 m of position): mapping starts, the vehicle goes.
+        map.update(&revolution(0.1, 0.004)).unwrap();
+        d.plan(&mut map).unwrap();
+        assert!(map.mapping_started());
+        assert!(d.speed_command_m_s() > 0.0);
     }
 
     fn at(t_s: f64, x: f64, y: f64, yaw: f64) -> PoseEstimate {
@@ -609,7 +662,10 @@ mod tests {
         let levels = Levels::cumulative(vec![0.0]).unwrap();
         let wide = MultiHeightMap::new(config, levels, Point2::new(40.0, 0.0)).unwrap();
         let self_filter = fast.vehicle.collision.clone();
-        let mut map = OnlineMap::new(wide, self_filter, ForgettingConfig::default(), 0.1);
+        let mut map = started(
+            OnlineMap::new(wide, self_filter, ForgettingConfig::default(), 0.1, 1.0),
+            40.0,
+        );
         fast.on_pose(at(0.0, 10.0, 0.0, 0.0));
         fast.plan(&mut map).unwrap();
         let v = fast.speed_command_m_s();

@@ -43,6 +43,7 @@ pub fn figures_for(
         t_s: 0.0,
         scan,
         world_from_vehicle_estimate: start,
+        estimate_covariance: nalgebra::Matrix3::zeros(),
     };
     let config = LocalizerConfig::default();
     let map_config = run.mapping.map;

@@ -127,7 +127,7 @@ impl Rig<'_> {
         truth: &Isometry2<f64>,
         observer: &mut (dyn Observer + Send),
     ) -> Result<()> {
-        let Some(estimate) = self.driver.estimate().map(|e| e.world_from_vehicle) else {
+        let Some(estimate) = self.driver.estimate().copied() else {
             return Ok(());
         };
         let (index, seed, t_s) = (self.step / self.steps_per_scan, self.seed, self.t_s);
@@ -212,9 +212,11 @@ impl Rig<'_> {
         self.split.mapping += planned.mapping_s;
         self.split.distance_maps += planned.times.distance_maps_s;
         self.split.planning += planned.times.planning_s;
-        let plan = self.driver.last_plan().ok_or_else(|| {
-            Error::Invalid("the driver planned but holds no plan (no pose estimate)".into())
-        })?;
+        let Some(plan) = self.driver.last_plan() else {
+            // Held before its first plan: no revolution mapped yet (the first, overlapped, is
+            // mapped beside this plan), or none at an estimate trusted far enough.
+            return Ok(());
+        };
         self.judge.on_plan(self.t_s, plan.chosen().offset_m);
         for (t, event) in self.judge.drain_events() {
             observer.event(t, &event)?;

@@ -124,6 +124,9 @@ pub struct Judge {
     windows: Vec<PassWindow>,
     obstacles: Vec<ObstacleReport>,
     stops: Vec<Stop>,
+    /// Whether the vehicle has moved yet: held at the start (the localizer settling, mapping
+    /// not begun) is not a stop.
+    started: bool,
     lap_times_s: Vec<f64>,
     lap_start_t_s: f64,
     min_clearance_m: Vec<f64>,
@@ -216,6 +219,7 @@ impl Judge {
             windows,
             obstacles,
             stops: Vec::new(),
+            started: false,
             lap_times_s: Vec::new(),
             lap_start_t_s: 0.0,
             min_clearance_m: vec![f64::INFINITY; levels],
@@ -323,6 +327,7 @@ impl Judge {
 
     fn judge_stops(&mut self, t_s: f64, state: &VehicleState, stopped: bool) {
         let moving = state.speed_m_s.abs() > 0.3;
+        self.started |= moving;
         match self.stops.last_mut() {
             Some(last) if last.end_s.is_none() && moving => {
                 last.end_s = Some(t_s);
@@ -330,7 +335,7 @@ impl Judge {
                 self.events.push((t_s, Event::Resume { stopped_s }));
             }
             Some(last) if last.end_s.is_none() => {}
-            _ if stopped && t_s > 1.0 => {
+            _ if stopped && self.started => {
                 self.stops.push(Stop {
                     start_s: t_s,
                     end_s: None,

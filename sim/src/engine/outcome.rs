@@ -141,7 +141,7 @@ impl JudgedContact {
     }
 }
 
-/// A stop of the vehicle.
+/// A stop of the vehicle (after it first moved).
 #[derive(Clone, Debug, Serialize)]
 pub struct Stop {
     /// When it stopped, seconds.

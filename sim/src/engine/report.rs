@@ -39,7 +39,8 @@ pub struct RunReport {
     pub contacts_struck: usize,
     /// Per run-time obstacle.
     pub obstacles: Vec<ObstacleReport>,
-    /// Stops.
+    /// Stops, once the vehicle has first moved (held at the start while the localizer settles
+    /// is not one).
     pub stops: Vec<Stop>,
     /// Smallest ground-truth clearance per level to any object, metres.
     pub min_clearance_m: Vec<f64>,

@@ -409,6 +409,7 @@ fn online_map(
         crate::offline_map::self_filter_model(vehicle)?,
         config.mapping.forgetting.clone(),
         1.0 / config.scan_hz,
+        config.mapping.max_return_error_m,
     );
     Ok((online, live))
 }

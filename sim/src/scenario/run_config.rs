@@ -88,6 +88,12 @@ pub struct MappingConfig {
     /// increasing). Default `None`: the vehicle's (`heights_of_interest_m` in its sidecar). A
     /// tuning sweep sets it; the offline map follows (its fingerprint holds the levels).
     pub heights_of_interest_m: Option<Vec<f64>>,
+    /// Mapping starts with the first revolution whose pose estimate's 2-sigma error moves a
+    /// return at the obstacle test's range (70 m) by less than this, metres
+    /// (`autonomy::trusted_range_m`; `OnlineMap::update`). Default 1.0: the particle filter
+    /// gets there about 0.5 s after its fix. The fix itself, 0.05 rad off (one sigma), puts a
+    /// return 70 m away 3.5 m from where it is.
+    pub max_return_error_m: f64,
 }
 
 /// Height above the ground from which a return is an obstacle whatever the consecutive-beam
@@ -127,6 +133,7 @@ impl Default for MappingConfig {
             distance_map_half_size_m: None,
             forgetting: ForgettingConfig::default(),
             heights_of_interest_m: None,
+            max_return_error_m: 1.0,
         }
     }
 }
@@ -298,6 +305,10 @@ impl RunConfig {
                 self.scan_hz, self.physics_hz
             ));
         }
+        positive(
+            "mapping.max_return_error_m",
+            self.mapping.max_return_error_m,
+        )?;
         if let Some(h) = self.mapping.distance_map_half_size_m {
             positive("mapping.distance_map_half_size_m", h)?;
         }

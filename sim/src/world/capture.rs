@@ -5,7 +5,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use autonomy::LidarRevolution;
+use autonomy::{LidarRevolution, PoseEstimate};
 use nalgebra::Isometry2;
 
 use super::faults::{FaultCounts, FaultsConfig, degrade};
@@ -59,7 +59,7 @@ impl Sensor<'_> {
     pub fn capture(
         &self,
         truth: &Isometry2<f64>,
-        estimate: &Isometry2<f64>,
+        estimate: &PoseEstimate,
         index: u64,
         t_s: f64,
     ) -> Result<Captured> {
@@ -76,6 +76,7 @@ impl Sensor<'_> {
             self.spurious
                 .fetch_add(counts.spurious_returns, Ordering::Relaxed);
         }
+        let (covariance, estimate) = (estimate.covariance, &estimate.world_from_vehicle);
         let scan = if estimate == truth {
             taken.scan
         } else {
@@ -86,6 +87,7 @@ impl Sensor<'_> {
                 t_s,
                 scan,
                 world_from_vehicle_estimate: *estimate,
+                estimate_covariance: covariance,
             },
             owners: taken.owners,
             truth: *truth,

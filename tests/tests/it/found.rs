@@ -54,22 +54,41 @@ fn the_jet_yields_to_a_van_crossing_its_path() {
     assert!(van.min_ttc_s.is_none_or(|t| t > 1.0), "{van:?}");
 }
 
-/// FIXME (README, Known problems): on a 320 m road with the particle filter, the first
-/// revolution, taken before the filter settled, leaves an obstacle (81.9, -2.7) m that no later
-/// beam clears; the jet stops for it 14 m short and calls a pilot. Found writing the traffic
-/// scenarios (`scenarios/traffic_parked_car_at_speed.toml` at 5 m/s); with the true pose the
-/// lap completes.
+/// Once a FIXME, now a regression: on a 320 m road with the particle filter, the first
+/// revolution is taken at the fix (0.147 rad off with this seed): mapped, it left an obstacle at
+/// (81.9, -2.7) m, at the height of the wings, that no later beam cleared, and the jet stopped
+/// 14 m short of it and called a pilot. Mapping now starts once the estimate trusts a
+/// revolution out to 70 m within `mapping.max_return_error_m` (1 m, 2 sigma), and the filter's
+/// particles spread twice the fix's sigma (drawn with one, they collapsed 0.048 rad off): the
+/// lap completes, and the parked car on it still stops the jet. With the bound lifted the
+/// phantom is back - the bound is what mends it.
 #[test]
-fn fixme_a_phantom_from_the_first_revolution_calls_a_pilot() {
+fn a_revolution_taken_before_the_filter_settled_leaves_no_phantom() {
     let s = found("phantom_from_the_first_revolution");
-    let dir = tempfile::tempdir().unwrap();
-    let config = RunConfig::for_scenario(&s, None).unwrap();
-    sim::offline_map::map_drive(&s, &config, dir.path(), &mut |_, _| {}).unwrap();
-    let setup = RunSetup {
-        config,
-        ..RunSetup::new(dir.path().to_path_buf())
+    let run_with = |max_return_error_m: f64| {
+        run_found_with(&s, |c| c.mapping.max_return_error_m = max_return_error_m)
     };
-    let r = run(&s, &setup).unwrap();
+    let r = run_with(1.0);
+    assert!(
+        matches!(
+            r.config.pose_source,
+            sim::scenario::PoseSourceConfig::ParticleFilter(_)
+        ),
+        "the particle filter is this scenario's default"
+    );
+    assert_eq!(
+        r.end,
+        sim::engine::EndReason::Completed,
+        "{:?}",
+        r.waiting_for
+    );
+    assert!(r.expectations_met && r.contacts.is_empty());
+    assert_eq!(
+        r.obstacles[0].passes[0].outcome,
+        sim::engine::PassOutcome::Stopped
+    );
+
+    let r = run_with(1e6);
     assert_eq!(r.end, sim::engine::EndReason::WaitingForHiddenObstacle);
     let w = r.waiting_for.expect("waiting for the phantom");
     assert!(
@@ -140,11 +159,12 @@ fn fixme_the_car_passes_a_container_inside_the_danger_distance() {
 }
 
 /// With the particle filter (the default since issue #24) the same variant passes the container
-/// 0.68 m off: the estimate's uncertainty widens the margins. The cause above is not found yet;
-/// this only shows the default hides it.
+/// outside the danger distance: the estimate's uncertainty widens the margins (0.68 m off when
+/// the particles spread as the fix; 0.49 m since they spread twice as far and the estimate is
+/// better). The cause above is not found yet; this only shows the default hides it.
 #[test]
 fn with_the_particle_filter_the_container_is_passed_outside_the_danger_distance() {
     let r = run_found_with(&found("parking_lot_variant_505"), |_| {});
     let (p, closest) = container_pass(&r);
-    assert!(closest > 0.5 && p.met, "{p:?}");
+    assert!(closest > 0.4 && p.met, "{p:?}");
 }
