@@ -65,10 +65,11 @@ pub struct OnlineMap {
     started: bool,
 }
 
-/// How far from the sensor a revolution taken at an estimate of covariance `c` (x, y, heading)
-/// can be mapped: out to where the estimate's 2-sigma error - its position's (largest axis) and
-/// its heading's times the range, added in quadrature - moves a return by `max_error_m`,
-/// metres. Infinite for an exact pose; 0 when the position alone errs by that much.
+/// How far from the sensor the returns of a revolution taken at an estimate of covariance `c`
+/// (x, y, heading) are placed within `max_error_m`: out to where the estimate's 2-sigma error -
+/// its position's (largest axis) and its heading's times the range, added in quadrature -
+/// reaches it, metres. Infinite for an exact pose; 0 when the position alone errs by that much.
+/// [`OnlineMap::update`] starts mapping once this reaches the obstacle test's range.
 ///
 /// A heading 0.05 rad off (the fix's spread) puts a return 70 m away 3.5 m from where it is;
 /// such a return, mapped at the height of a wing where no later beam passes, stays an
