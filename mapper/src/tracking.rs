@@ -195,6 +195,9 @@ impl Motion {
 #[derive(Clone, Debug)]
 struct Track {
     id: u32,
+    /// Where it was first seen (kept when it is seen anew within its extent: it is the same
+    /// object).
+    origin: Point2<f64>,
     first: Point2<f64>,
     last: Point2<f64>,
     last_t_s: f64,
@@ -255,6 +258,9 @@ pub struct TrackState {
     pub levels: u32,
     /// Confirmed moving by the stricter rule that lets it clear what it left.
     pub confirmed: bool,
+    /// How far its centre is from where it was first seen, metres: beyond its extent, it moved
+    /// (the centre of a static object's hits stays within its extent however it is hidden).
+    pub travel_m: f64,
     /// The bounding box of its hits this revolution (world cells, lower and upper corners).
     pub bbox: (WorldCell, WorldCell),
     /// That box's size along x and y, metres.
@@ -322,6 +328,19 @@ impl Tracker {
     /// confirmed moving and seen this revolution, whose centre is now farther from them than its
     /// largest extent plus the clear margin, and not hit by anything since.
     pub fn update_with_levels(&mut self, t_s: f64, hits: &[(WorldCell, u32)]) -> Vec<WorldCell> {
+        self.update_except(t_s, hits, |_| false)
+    }
+
+    /// [`Tracker::update_with_levels`], but the hits on cells `is_static` names (an offline
+    /// map's obstacles) are only noted as hit: no object is clustered from them, so a static
+    /// object never passes for a mover, and a mover passing one (a truck beside a lamp post)
+    /// is followed on its own hits.
+    pub fn update_except(
+        &mut self,
+        t_s: f64,
+        hits: &[(WorldCell, u32)],
+        is_static: impl Fn(WorldCell) -> bool,
+    ) -> Vec<WorldCell> {
         for &(c, _) in hits {
             self.cells
                 .entry(c)
@@ -334,7 +353,12 @@ impl Tracker {
         if !self.config.enabled {
             return Vec::new();
         }
-        let clusters = self.clusters(hits);
+        let movable: Vec<(WorldCell, u32)> = hits
+            .iter()
+            .copied()
+            .filter(|&(c, _)| !is_static(c))
+            .collect();
+        let clusters = self.clusters(&movable);
         let assigned = self.associate(t_s, &clusters);
         for t in &mut self.tracks {
             t.bbox = None;
@@ -361,6 +385,7 @@ impl Tracker {
         let cfg = &self.config;
         self.tracks.push(Track {
             id: self.next_id,
+            origin: cluster.center,
             first: cluster.center,
             last: cluster.center,
             last_t_s: t_s,
@@ -409,14 +434,30 @@ impl Tracker {
         track.smooth = dt > 0.0 && ((dt <= cfg.max_gap_s && miss <= tolerance) || regained);
         if dt > 0.0 && !track.smooth && track.seen > 1 {
             // Perhaps another object's hits now: what it painted so far is no longer its to
-            // clear (it keeps its state), and its motion starts over from here.
+            // clear (it keeps its state), and its motion starts over from here. A step beyond
+            // its own extent is another object's hits: a new track, under a new id, with no
+            // evidence yet that it moves (a crossing car gone from view, its track taken over
+            // by a ground return by the jet's wing 22 m away, is no mover there); within it,
+            // the same object seen anew (a truck's side coming into view as the nose hides its
+            // front).
             track.painted.clear();
             track.steady = 0;
+            let another = miss > track.max_extent_m + cfg.max_step_error_m;
+            if another {
+                track.id = self.next_id;
+                self.next_id = self.next_id.wrapping_add(1);
+                track.origin = cluster.center;
+                track.moving = false;
+                track.predictable = false;
+                track.levels = 0;
+                track.max_extent_m = 0.0;
+                track.seen = 0;
+            }
             track.first = cluster.center;
             track.path_m = 0.0;
             track.motion = Motion::new(
                 cluster.center,
-                velocity,
+                if another { Vector2::zeros() } else { velocity },
                 cfg.position_sigma_m,
                 0.5 * cfg.max_speed_m_s,
             );
@@ -536,6 +577,7 @@ impl Tracker {
                     extent_m: t.max_extent_m,
                     levels: t.levels,
                     confirmed: t.moving,
+                    travel_m: (t.last - t.origin).norm(),
                 }
             })
             .collect()
@@ -899,6 +941,39 @@ mod tests {
                 assert!(now.is_empty(), "{k}");
             }
         }
+    }
+
+    /// A person (3 x 3 cells, 1.4 m/s) walks out of view; 1.5 s later a single return 20 m
+    /// away - within the gate of the lost track, beyond its extent - is another object: a new
+    /// track under a new id, not offered as a mover. Seen again where its motion said, the
+    /// person keeps their id.
+    #[test]
+    fn a_lost_track_taking_over_hits_beyond_its_extent_is_a_new_track() {
+        let mut t = Tracker::new(TrackerConfig::default(), 0.2);
+        let walker = |k: i64| block((k * 7) / 10, 0, 3, 3);
+        for k in 0..30 {
+            t.update(k as f64 * 0.1, &walker(k));
+        }
+        let person = t.movers();
+        assert_eq!(person.len(), 1);
+        let id = person[0].id;
+        for k in 30..45 {
+            t.update(k as f64 * 0.1, &[]);
+        }
+        t.update(4.5, &block(120, 0, 1, 1));
+        let now = t.movers();
+        assert!(now.iter().all(|m| m.id != id), "{now:?}");
+        assert!(now.iter().all(|m| m.position.x < 20.0), "{now:?}");
+        // The same walk, seen again after the gap where its motion said: the same track.
+        let mut t = Tracker::new(TrackerConfig::default(), 0.2);
+        for k in 0..30 {
+            t.update(k as f64 * 0.1, &walker(k));
+        }
+        for k in 30..35 {
+            t.update(k as f64 * 0.1, &[]);
+        }
+        t.update(3.5, &walker(35));
+        assert_eq!(t.movers().first().map(|m| m.id), Some(id));
     }
 
     #[test]

@@ -145,7 +145,15 @@ impl OnlineMap {
         self.map
             .insert_scan(&revolution.scan, Some(&self.self_filter))?;
         let hits = self.map.last_scan_hits_by_level();
-        let clear = self.tracker.update_with_levels(revolution.t_s, &hits);
+        // Hits on or beside (one cell: the estimate's error) an offline-map obstacle are no
+        // mover's: a lamp post is not tracked, and a truck passing one is tracked on its own.
+        let (map, levels) = (&self.map, self.map.levels().count());
+        let is_static = |(x, y): WorldCell| {
+            (x - 1..=x + 1).any(|x| {
+                (y - 1..=y + 1).any(|y| (0..levels).any(|l| map.is_prior_obstacle(l, (x, y))))
+            })
+        };
+        let clear = self.tracker.update_except(revolution.t_s, &hits, is_static);
         self.map.clear_live(&clear);
         self.revolutions += 1;
         if self.revolutions.is_multiple_of(50) {
@@ -169,20 +177,12 @@ impl OnlineMap {
         self.tracker.last_hit_s(cell)
     }
 
-    /// The tracked objects whose motion can be predicted, as of the last revolution - but not
-    /// those whose hits lie on an obstacle of the offline map (of any level): a static object
-    /// the map holds, whose visible part slid as the vehicle drove by, or whose hits a track
-    /// took over from another, never moved.
+    /// The tracked objects whose motion can be predicted, as of the last revolution. None is
+    /// made of hits on or beside an obstacle of the offline map (of any level, [`Self::update`]):
+    /// a static object the map holds, whose visible part slides as the vehicle drives by, never
+    /// moved.
     pub fn movers(&self) -> Vec<mapper::TrackState> {
-        let levels = self.map.levels().count();
-        let mut movers = self.tracker.movers();
-        movers.retain(|t| {
-            let ((x0, y0), (x1, y1)) = t.bbox;
-            !(x0..=x1).any(|x| {
-                (y0..=y1).any(|y| (0..levels).any(|l| self.map.is_prior_obstacle(l, (x, y))))
-            })
-        });
-        movers
+        self.tracker.movers()
     }
 
     /// The multi-height map (occupancy and distance maps per level).

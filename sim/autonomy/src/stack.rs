@@ -12,7 +12,10 @@ use crate::planner::{
     speed_cap_m_s, stopping_distance_m,
 };
 use crate::route::{RoutePath, wrap_angle};
-use crate::traffic::{Conflict, Prediction, SpeedProfile, TimedPath, first_conflict, predict};
+use crate::traffic::{
+    Conflict, Prediction, SpeedProfile, TimedPath, at_body, first_conflict,
+    moved_beyond_its_extent, predict,
+};
 
 /// Half length of the stretch of route searched around the last progress when the estimate is
 /// projected onto it, metres (so a circuit that passes near itself is followed in order).
@@ -106,7 +109,20 @@ pub struct Driver {
     /// The line the vehicle holds short of for a mover: its track, the route arc length,
     /// when the conflict was last found.
     hold: Option<(u32, f64, f64)>,
+    /// The movers at the vehicle's body ([`at_body`]): track id, where it was last seen, when.
+    /// Kept while the track is lost: it is released only once seen away from the body.
+    at_body: Vec<(u32, Point2<f64>, f64)>,
+    /// Each track seen and predicted as a mover lately: its id, when last, and since when
+    /// without a break, seconds (kept for [`MOVER_LATELY_S`]).
+    predicted_s: Vec<(u32, f64, f64)>,
 }
+
+/// A track seen and predicted as a mover without a break for this long, seconds ...
+const MOVER_FOR_S: f64 = 1.0;
+/// ... this lately, seconds, may arrive at the body ([`Driver::plan`]): one that slowed as it
+/// reached it, or walked out of view into it, is still one. A static object's sliding visible
+/// part seems to move in bursts, not for a second on end.
+const MOVER_LATELY_S: f64 = 6.0;
 
 impl Driver {
     /// A driver of `vehicle` along `route` at `wanted_speed_m_s`, keeping the distance maps up
@@ -142,6 +158,8 @@ impl Driver {
             conflict: None,
             last_conflict_s: None,
             hold: None,
+            at_body: Vec::new(),
+            predicted_s: Vec::new(),
         }
     }
 
@@ -190,6 +208,8 @@ impl Driver {
     pub fn restart(&mut self) {
         self.status = DriverStatus::Driving;
         self.last_conflict_s = None;
+        self.at_body.clear();
+        self.predicted_s.clear();
         self.hold = None;
         self.route_s_m = None;
         self.estimate = None;
@@ -251,9 +271,14 @@ impl Driver {
         {
             chosen.collision_at_m = Some(chosen.collision_at_m.map_or(stop_at, |c| c.min(stop_at)));
         }
-        let (v, _) = avoid(&chosen, wanted, decel, &config);
+        let (mut v, _) = avoid(&chosen, wanted, decel, &config);
+        let body = self.movers_at_body(map, &estimate.world_from_vehicle, estimate.t_s, &config);
+        if body.is_some() {
+            v = 0.0;
+        }
         self.speed_command_m_s = v;
         self.status = match conflict {
+            _ if let Some(held) = body => held,
             _ if v > 0.0 => DriverStatus::Driving,
             _ if chosen.collision_at_m != p.chosen().collision_at_m => DriverStatus::Yielding {
                 track_id: self.hold.map_or(u32::MAX, |h| h.0),
@@ -364,6 +389,76 @@ impl Driver {
                     .is_some_and(|t| now_s - t < traffic.conflict_memory_s),
         };
         first_conflict(&path, &self.vehicle.collision, &self.predictions, traffic)
+    }
+
+    /// The movers at the body now ([`at_body`]) joined to those lost there before; what holds
+    /// the vehicle for them (`None`: nothing at the body): stopped for the nearest seen now,
+    /// else waiting for one lost there, as for a hidden obstacle.
+    fn movers_at_body(
+        &mut self,
+        map: &OnlineMap,
+        pose: &Isometry2<f64>,
+        now_s: f64,
+        config: &AutonomyConfig,
+    ) -> Option<DriverStatus> {
+        if !config.traffic.enabled {
+            self.at_body.clear();
+            return None;
+        }
+        let cfg = &config.traffic;
+        // Seen this revolution or the last (0.25 s), predicted now: its streak goes on.
+        for p in self
+            .predictions
+            .iter()
+            .filter(|p| now_s - p.track.t_s <= 0.25)
+        {
+            match self.predicted_s.iter_mut().find(|r| r.0 == p.track.id) {
+                Some(r) if now_s - r.1 <= 0.25 => r.1 = now_s,
+                Some(r) => *r = (p.track.id, now_s, now_s),
+                None => self.predicted_s.push((p.track.id, now_s, now_s)),
+            }
+        }
+        self.predicted_s.retain(|r| now_s - r.1 <= MOVER_LATELY_S);
+        let movers = map.movers();
+        // A mover arriving at the body, or one held there before and not seen away.
+        let mut body: Vec<(u32, Point2<f64>, f64)> = movers
+            .iter()
+            .filter(|t| {
+                let held = self.at_body.iter().any(|r| r.0 == t.id);
+                let arriving = self
+                    .predicted_s
+                    .iter()
+                    .any(|r| r.0 == t.id && r.1 - r.2 >= MOVER_FOR_S)
+                    && moved_beyond_its_extent(t, cfg);
+                (held || arriving) && at_body(&self.vehicle.collision, pose, t, now_s, cfg)
+            })
+            .map(|t| (t.id, t.position, t.t_s))
+            .collect();
+        let lost = self
+            .at_body
+            .iter()
+            .filter(|r| !movers.iter().any(|t| t.id == r.0));
+        body.extend(lost);
+        self.at_body = body;
+        let seen = self
+            .at_body
+            .iter()
+            .filter(|r| now_s - r.2 <= self.config.hidden_after_s);
+        if let Some(&(_, obstacle, last_seen_s)) = seen.max_by(|a, b| a.2.total_cmp(&b.2)) {
+            return Some(DriverStatus::StoppedFor {
+                obstacle,
+                last_seen_s,
+            });
+        }
+        let &(_, obstacle, last_seen_s) = self.at_body.first()?;
+        Some(DriverStatus::WaitingForHiddenObstacle {
+            obstacle,
+            last_seen_s: Some(last_seen_s),
+            since_s: match self.status {
+                DriverStatus::WaitingForHiddenObstacle { since_s, .. } => since_s,
+                _ => now_s,
+            },
+        })
     }
 
     /// The fastest the driver will go on this route, and why, when it is below the route's

@@ -21,6 +21,14 @@
 //!   margin after grows by `resume_margin_s`, so the vehicle does not creep off and stop again.
 //! - Movers slower than `min_speed_m_s`, or than `sigmas` standard deviations of their speed,
 //!   are left to the map (their cells are obstacles there).
+//! - **A mover at the body** ([`at_body`]): one seen, or predicted while out of view, within
+//!   `at_body_m` of a circle of a level it occupies is where the map cannot hold it (returns
+//!   within the map's self-hit margin of the vehicle are dropped as its own): the vehicle does
+//!   not move until it is seen away from the body, and one lost there is waited for as a hidden
+//!   obstacle (the pilot is called). A person who walked up to the fuselage, a truck that
+//!   struck the nose: the vehicle moving on would meet them. Only a mover arrives there: a
+//!   track predicted lately that has moved beyond its own extent
+//!   ([`moved_beyond_its_extent`]) - not a parked car whose visible part slides.
 
 use aircraft::footprint::segment_distance;
 use mapper::{CollisionModel, TrackState};
@@ -59,6 +67,10 @@ pub struct TrafficConfig {
     /// Movers slower than this are left to the map, m/s. Default 0.8 (a static object's visible
     /// part, sliding as it is hidden or revealed, seldom seems faster).
     pub min_speed_m_s: f64,
+    /// A tracked mover this close to the vehicle's body (beyond a circle's radius, on a level it
+    /// occupies) holds the vehicle ([`at_body`]), metres. Default 1 (the map drops returns
+    /// within 0.8 m of a circle as the vehicle's own).
+    pub at_body_m: f64,
 }
 
 impl Default for TrafficConfig {
@@ -74,6 +86,7 @@ impl Default for TrafficConfig {
             margin_m: 0.5,
             hidden_m: 1.0,
             min_speed_m_s: 0.8,
+            at_body_m: 1.0,
         }
     }
 }
@@ -91,6 +104,7 @@ impl TrafficConfig {
             ("margin_m", self.margin_m),
             ("hidden_m", self.hidden_m),
             ("min_speed_m_s", self.min_speed_m_s),
+            ("at_body_m", self.at_body_m),
         ];
         positive
             .into_iter()
@@ -206,6 +220,50 @@ pub fn predict(tracks: &[TrackState], now_s: f64, cfg: &TrafficConfig) -> Vec<Pr
             }
         })
         .collect()
+}
+
+/// Whether the tracked mover `t` has moved beyond its own extent plus `cfg.hidden_m` since it
+/// was first seen: the centre of a static object's hits stays within its extent, however it is
+/// hidden or revealed (a row of parked cars merged into one track can still slide further).
+pub fn moved_beyond_its_extent(t: &TrackState, cfg: &TrafficConfig) -> bool {
+    t.travel_m > t.extent_m + cfg.hidden_m
+}
+
+/// Whether the tracked object `t` is at the body of the vehicle `model` standing at `pose` at
+/// `now_s`: the box of its hits when it was last seen, moved along its motion from then to now
+/// (not at all when it was seen now), comes within what of it the sensor may not see
+/// (`cfg.hidden_m`, or more: what its box is smaller than the largest extent it was seen with)
+/// plus `cfg.at_body_m` of a circle of a level it occupies. Seen or not, moving or not: a mover predicted to walk on through the airframe
+/// stopped at it. The box, not the centre of the hits: the centre of a truck whose front
+/// touches the nose and whose side comes into view slides away from the nose.
+pub fn at_body(
+    model: &CollisionModel,
+    pose: &Isometry2<f64>,
+    t: &TrackState,
+    now_s: f64,
+    cfg: &TrafficConfig,
+) -> bool {
+    let ((x0, y0), (x1, y1)) = t.bbox;
+    let r = t.size_m[0] / (x1 - x0 + 1).max(1) as f64;
+    let lo = Vector2::new(x0 as f64 * r, y0 as f64 * r);
+    let hi = Vector2::new((x1 + 1) as f64 * r, (y1 + 1) as f64 * r);
+    // What of it may lie beyond the box: `hidden_m`, or what it is seen smaller than its
+    // largest extent (a truck whose front a wing hides).
+    let hidden_m = cfg.hidden_m.max(t.extent_m - (hi - lo).norm());
+    let (now_at, _) = t.predict((now_s - t.t_s).max(0.0));
+    let moved = now_at - t.position;
+    // The box every half metre along the way.
+    let steps = (moved.norm() / 0.5).ceil().max(1.0) as usize;
+    (0..=steps).any(|k| {
+        let shift = moved * (k as f64 / steps as f64);
+        let (lo, hi) = (lo + shift, hi + shift);
+        model.circles().iter().any(|c| {
+            let p = pose * Point2::new(c.x_m, c.y_m);
+            let out = (lo - p.coords).sup(&(p.coords - hi)).sup(&Vector2::zeros());
+            t.levels & (1u32 << c.level.min(31)) != 0
+                && out.norm() <= c.radius_m + hidden_m + cfg.at_body_m
+        })
+    })
 }
 
 /// A mover's shape as the check uses it.
@@ -435,7 +493,12 @@ mod tests {
             extent_m: 2.0,
             levels,
             confirmed: true,
-            bbox: ((0, 0), (0, 0)),
+            travel_m: 10.0,
+            // Its hits: the 1 m cell it stands in.
+            bbox: (
+                (x.floor() as i64, y.floor() as i64),
+                (x.floor() as i64, y.floor() as i64),
+            ),
             size_m: [1.0, 1.0],
         }
     }
@@ -532,6 +595,40 @@ mod tests {
         assert!(check(&mover(20.0, -9.0, 0.0, 3.0, 1), &still, true).is_some());
         // Past the path by 12 m: clear.
         assert_eq!(check(&mover(20.0, 12.0, 0.0, 3.0, 1), &still, true), None);
+    }
+
+    /// A mover beside the fuselage, seen there or predicted there while out of view, is at the
+    /// body; one 3 m off it, or on a level the near circles do not occupy, is not.
+    #[test]
+    fn a_mover_at_the_body_is_found_seen_or_predicted() {
+        let cfg = TrafficConfig::default();
+        let pose = Isometry2::identity();
+        // The fuselage's circles: y = 0 +- 1 on level 0, x 0..10.
+        let beside = mover(4.0, 1.8, 0.0, 0.0, 0b01);
+        assert!(at_body(&model(), &pose, &beside, 0.0, &cfg));
+        let off = mover(4.0, 5.0, 0.0, 0.0, 0b01);
+        assert!(!at_body(&model(), &pose, &off, 0.0, &cfg));
+        // Only the wing tip's level (1) there: the fuselage's level-0 circles do not count.
+        let high = mover(4.0, 1.8, 0.0, 0.0, 0b10);
+        assert!(!at_body(&model(), &pose, &high, 0.0, &cfg));
+        // Last seen 5 m off walking towards it at 1.4 m/s: 3 s later its motion crossed it.
+        let walking = mover(4.0, -6.0, 0.0, 1.4, 0b01);
+        assert!(!at_body(&model(), &pose, &walking, 0.0, &cfg));
+        assert!(at_body(&model(), &pose, &walking, 3.0, &cfg));
+        // A 9 m truck seen as its last metre 5 m off: its hidden front may touch the body.
+        let hidden_front = TrackState {
+            extent_m: 9.0,
+            travel_m: 40.0,
+            ..mover(4.0, 5.0, 0.0, 0.0, 0b01)
+        };
+        assert!(at_body(&model(), &pose, &hidden_front, 0.0, &cfg));
+        // Never moved beyond its extent (plus what it may hide): perhaps a static object.
+        assert!(moved_beyond_its_extent(&beside, &cfg));
+        let sliding = TrackState {
+            travel_m: 2.5,
+            ..beside.clone()
+        };
+        assert!(!moved_beyond_its_extent(&sliding, &cfg));
     }
 
     /// A slow mover is left to the map.

@@ -129,6 +129,7 @@ fn traffic_figures(samples: usize) -> Vec<Figure> {
                 extent_m: 4.9,
                 levels: 0b11,
                 confirmed: true,
+                travel_m: 20.0,
                 bbox: ((0, 0), (22, 8)),
                 size_m: [4.6, 1.8],
             }

@@ -245,13 +245,19 @@ impl Rig<'_> {
         })
     }
 
-    /// Run-time obstacles appear, move and go as the scenario says: the traffic steps to now
+    /// Run-time obstacles appear, move and go as the scenario says: a mover touching the
+    /// vehicle halts for good ([`super::traffic::Traffic::halt`]), the traffic steps to now
     /// around the vehicle's true pose (drivers that yield react to it), then each obstacle's
     /// collider is shown, placed or hidden.
     fn move_obstacles(&mut self) {
+        let first = self.scenario.objects.len();
+        for k in 0..self.scenario.obstacles.len() {
+            if self.world.touches_vehicle(first + k) {
+                self.traffic.halt(k);
+            }
+        }
         self.traffic
             .step(self.t_s, &self.state.world_from_vehicle());
-        let first = self.scenario.objects.len();
         for (k, o) in self.scenario.obstacles.iter().enumerate() {
             let i = first + k;
             match self.traffic.state(k) {

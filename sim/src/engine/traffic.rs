@@ -19,6 +19,11 @@
 //!   `wait_s` at each stop, and stands at the path's end;
 //! - a train's car: it keeps its place behind its lead (`TrainLink::behind_m` along the path)
 //!   whatever the lead does - profiles, stops, waits for the vehicle.
+//!
+//! Whatever its kind, a mover that touches the vehicle halts where it is for good
+//! ([`Traffic::halt`]; a train with it): a driver who hits an aircraft stops, a person does not
+//! walk on through an airframe. Without it a mover would pass through the vehicle's colliders
+//! (they are kinematic) and come out under a wing, where the vehicle moving on meets it again.
 
 use aircraft::footprint::{Footprint, segment_distance, segments_distance};
 use nalgebra::{Isometry2, Point2};
@@ -54,6 +59,8 @@ enum Drive {
     Yielding(Reactive),
     /// A train's car behind obstacle `lead` by `behind_m` along the path.
     Car { lead: usize, behind_m: f64 },
+    /// Halted where it touched the vehicle, for good.
+    Halted(MoverState),
 }
 
 /// The run-time obstacles of a run, moved step by step.
@@ -139,6 +146,7 @@ impl Traffic {
                         };
                         Some(advance(r, m, length_m, dt, near))
                     }
+                    (Drive::Halted(at), _) => Some(*at),
                     (Drive::Car { lead, behind_m }, Some(m)) => {
                         self.states.get(*lead).copied().flatten().map(|lead| {
                             m.state_at_arc(lead.arc_m.min(m.length_m()) - *behind_m, lead.speed_m_s)
@@ -148,6 +156,28 @@ impl Traffic {
                 }
             };
             self.states[k] = state;
+        }
+    }
+
+    /// Obstacle `k`, touching the vehicle, halts for good where it stood at the last step
+    /// (standing: speed 0); a train's car halts its lead, so the whole train stands. An absent
+    /// or static obstacle is left as it is.
+    pub fn halt(&mut self, k: usize) {
+        let Some(state) = self.state(k) else {
+            return;
+        };
+        if self.obstacles[k].motion.is_none() {
+            return;
+        }
+        match self.drives[k] {
+            Drive::Halted(_) => {}
+            Drive::Car { lead, .. } => self.halt(lead),
+            Drive::Planned | Drive::Yielding(_) => {
+                self.drives[k] = Drive::Halted(MoverState {
+                    speed_m_s: 0.0,
+                    ..state
+                });
+            }
         }
     }
 
@@ -376,6 +406,29 @@ speed_m_s = 3.0
             assert_eq!(
                 traffic.state(0).map(|v| (v.x_m, v.y_m, v.yaw_rad)),
                 plain.obstacles[0].pose_at(t)
+            );
+        }
+    }
+
+    /// A plain mover and a yielding driver, halted (they touched the vehicle), stand where
+    /// they were for good, speed 0; a static obstacle or an absent one is left alone.
+    #[test]
+    fn a_halted_mover_stands_for_good() {
+        for extra in ["", "yields_to_vehicle_m = 5.0"] {
+            let s = scenario(extra);
+            let mut traffic = Traffic::new(&s.obstacles, &s.vehicle.vehicle);
+            let far = Isometry2::new(nalgebra::Vector2::new(-200.0, 0.0), 0.0);
+            traffic.halt(0); // not there yet: nothing to halt
+            let t = run(&mut traffic, -0.01, 5.0, &far);
+            let before = traffic.state(0).expect("present");
+            assert!(before.speed_m_s > 0.0, "{extra}: moving");
+            traffic.halt(0);
+            run(&mut traffic, t, t + 20.0, &far);
+            let after = traffic.state(0).expect("present");
+            assert_eq!(
+                (after.x_m, after.y_m, after.speed_m_s),
+                (before.x_m, before.y_m, 0.0),
+                "{extra}"
             );
         }
     }

@@ -366,6 +366,11 @@ impl World {
             })
     }
 
+    /// Whether object `i` (indexed like `scene().solids`) touches the vehicle now.
+    pub fn touches_vehicle(&self, i: usize) -> bool {
+        self.touching.iter().any(|&(object, _)| object == i)
+    }
+
     /// Contacts so far, in time order.
     pub fn contacts(&self) -> &[Contact] {
         &self.contacts

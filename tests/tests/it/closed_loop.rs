@@ -432,15 +432,20 @@ fn the_car_copes_with_dropout_dead_beams_noise_and_spurious_returns() {
         r.faults
     );
     assert!(r.contacts.is_empty() && r.expectations_met, "{r:#?}");
-    // FIXME (README, Known problems): with the prediction of movers on (the default), the
-    // degraded returns make static objects seem to move and the car stops for them again and
-    // again, until the time limit. Asserted as it is: no contact, the run times out.
-    let r = run_with(true);
-    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
-    assert_eq!(
-        r.end,
-        sim::engine::EndReason::TimedOut,
-        "FIXME fixed? {r:#?}"
+    // With the prediction of movers on (the default) too: until the tracker was given no hits
+    // beside the offline map's obstacles (issue 36) the run timed out. FIXME (README, Known
+    // problems): the degraded returns still make static objects seem to move, and the car
+    // stops for them again and again - 27 stops, a 190.6 s lap against 43.3 s without the
+    // prediction. Asserted as it is.
+    let on = run_with(true);
+    assert!(on.contacts.is_empty() && on.expectations_met, "{on:#?}");
+    assert_eq!(on.end, sim::engine::EndReason::Completed);
+    assert!(
+        on.stops.len() > 10 && on.lap_times_s[0] > 3.0 * r.lap_times_s[0],
+        "FIXME fixed? {:?} {:?} against {:?}",
+        on.stops,
+        on.lap_times_s,
+        r.lap_times_s
     );
 }
 
