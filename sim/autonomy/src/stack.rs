@@ -109,19 +109,43 @@ pub struct Driver {
     /// The line the vehicle holds short of for a mover: its track, the route arc length,
     /// when the conflict was last found.
     hold: Option<(u32, f64, f64)>,
-    /// The movers at the vehicle's body ([`at_body`]): track id, where it was last seen, when.
-    /// Kept while the track is lost: it is released only once seen away from the body.
-    at_body: Vec<(u32, Point2<f64>, f64)>,
-    /// Each track seen and predicted as a mover lately: its id, when last, and since when
-    /// without a break, seconds (kept for [`MOVER_LATELY_S`]).
-    predicted_s: Vec<(u32, f64, f64)>,
+    /// The movers at the vehicle's body ([`at_body`]): released once seen away from the body,
+    /// kept for good once lost.
+    at_body: Vec<AtBody>,
+    /// The tracks seen and predicted as movers lately.
+    streaks: Vec<MoverStreak>,
+}
+
+/// A mover at the vehicle's body.
+#[derive(Clone, Copy, Debug)]
+struct AtBody {
+    /// Its track.
+    id: u32,
+    /// Where it was last seen (the centre of its hits), metres.
+    at: Point2<f64>,
+    /// When it was last seen, seconds.
+    seen_s: f64,
+}
+
+/// A track seen and predicted as a mover on consecutive plans.
+#[derive(Clone, Copy, Debug)]
+struct MoverStreak {
+    /// Its track.
+    id: u32,
+    /// The last plan that saw and predicted it, seconds.
+    last_s: f64,
+    /// Since when without a break, seconds.
+    since_s: f64,
+    /// The last plan of its last streak, once that lasted [`MOVER_FOR_S`] (`None`: it has not).
+    mover_s: Option<f64>,
 }
 
 /// A track seen and predicted as a mover without a break for this long, seconds ...
 const MOVER_FOR_S: f64 = 1.0;
 /// ... this lately, seconds, may arrive at the body ([`Driver::plan`]): one that slowed as it
 /// reached it, or walked out of view into it, is still one. A static object's sliding visible
-/// part seems to move in bursts, not for a second on end.
+/// part seems to move in bursts, not for a second on end (a row of parked cars a stale map
+/// does not hold, on the parking lot).
 const MOVER_LATELY_S: f64 = 6.0;
 
 impl Driver {
@@ -159,7 +183,7 @@ impl Driver {
             last_conflict_s: None,
             hold: None,
             at_body: Vec::new(),
-            predicted_s: Vec::new(),
+            streaks: Vec::new(),
         }
     }
 
@@ -209,7 +233,7 @@ impl Driver {
         self.status = DriverStatus::Driving;
         self.last_conflict_s = None;
         self.at_body.clear();
-        self.predicted_s.clear();
+        self.streaks.clear();
         self.hold = None;
         self.route_s_m = None;
         self.estimate = None;
@@ -392,8 +416,8 @@ impl Driver {
     }
 
     /// The movers at the body now ([`at_body`]) joined to those lost there before; what holds
-    /// the vehicle for them (`None`: nothing at the body): stopped for the nearest seen now,
-    /// else waiting for one lost there, as for a hidden obstacle.
+    /// the vehicle for them (`None`: nothing at the body): stopped for the one seen last, if
+    /// seen within `hidden_after_s`, else waiting for one lost there, as for a hidden obstacle.
     fn movers_at_body(
         &mut self,
         map: &OnlineMap,
@@ -406,59 +430,95 @@ impl Driver {
             return None;
         }
         let cfg = &config.traffic;
-        // Seen this revolution or the last (0.25 s), predicted now: its streak goes on.
-        for p in self
-            .predictions
-            .iter()
-            .filter(|p| now_s - p.track.t_s <= 0.25)
-        {
-            match self.predicted_s.iter_mut().find(|r| r.0 == p.track.id) {
-                Some(r) if now_s - r.1 <= 0.25 => r.1 = now_s,
-                Some(r) => *r = (p.track.id, now_s, now_s),
-                None => self.predicted_s.push((p.track.id, now_s, now_s)),
-            }
-        }
-        self.predicted_s.retain(|r| now_s - r.1 <= MOVER_LATELY_S);
+        self.note_streaks(now_s);
         let movers = map.movers();
         // A mover arriving at the body, or one held there before and not seen away.
-        let mut body: Vec<(u32, Point2<f64>, f64)> = movers
+        let mut body: Vec<AtBody> = movers
             .iter()
             .filter(|t| {
-                let held = self.at_body.iter().any(|r| r.0 == t.id);
-                let arriving = self
-                    .predicted_s
-                    .iter()
-                    .any(|r| r.0 == t.id && r.1 - r.2 >= MOVER_FOR_S)
-                    && moved_beyond_its_extent(t, cfg);
-                (held || arriving) && at_body(&self.vehicle.collision, pose, t, now_s, cfg)
+                let at = || at_body(&self.vehicle.collision, pose, t, now_s, cfg);
+                if self.at_body.iter().any(|r| r.id == t.id) {
+                    // Held: released only once seen away (a prediction carrying it on through
+                    // the airframe is no evidence that it left).
+                    let seen_now = now_s - t.t_s <= 0.25;
+                    return !seen_now || at();
+                }
+                let arriving = self.streaks.iter().any(|r| {
+                    r.id == t.id && r.mover_s.is_some_and(|m| now_s - m <= MOVER_LATELY_S)
+                }) && moved_beyond_its_extent(t, cfg);
+                arriving && at()
             })
-            .map(|t| (t.id, t.position, t.t_s))
+            .map(|t| AtBody {
+                id: t.id,
+                at: t.position,
+                seen_s: t.t_s,
+            })
             .collect();
+        // One lost (its track gone, or renumbered: seen again beyond its own extent from where
+        // it was lost) is waited for for good, as a hidden obstacle: the pilot is called. Its
+        // cells reading free would prove nothing - within the map's self-hit margin of the
+        // body nothing is ever mapped.
         let lost = self
             .at_body
             .iter()
-            .filter(|r| !movers.iter().any(|t| t.id == r.0));
+            .filter(|r| !movers.iter().any(|t| t.id == r.id));
         body.extend(lost);
         self.at_body = body;
         let seen = self
             .at_body
             .iter()
-            .filter(|r| now_s - r.2 <= self.config.hidden_after_s);
-        if let Some(&(_, obstacle, last_seen_s)) = seen.max_by(|a, b| a.2.total_cmp(&b.2)) {
+            .filter(|r| now_s - r.seen_s <= self.config.hidden_after_s);
+        if let Some(r) = seen.max_by(|a, b| a.seen_s.total_cmp(&b.seen_s)) {
             return Some(DriverStatus::StoppedFor {
-                obstacle,
-                last_seen_s,
+                obstacle: r.at,
+                last_seen_s: r.seen_s,
             });
         }
-        let &(_, obstacle, last_seen_s) = self.at_body.first()?;
+        let r = self.at_body.first()?;
         Some(DriverStatus::WaitingForHiddenObstacle {
-            obstacle,
-            last_seen_s: Some(last_seen_s),
+            obstacle: r.at,
+            last_seen_s: Some(r.seen_s),
             since_s: match self.status {
                 DriverStatus::WaitingForHiddenObstacle { since_s, .. } => since_s,
                 _ => now_s,
             },
         })
+    }
+
+    /// Each track seen (this revolution or the last, 0.25 s) and predicted now continues its
+    /// streak, or starts one; its last streak, once it lasted [`MOVER_FOR_S`], makes it a mover
+    /// as of the streak's last plan. Streaks not continued are kept for [`MOVER_LATELY_S`].
+    fn note_streaks(&mut self, now_s: f64) {
+        for p in self
+            .predictions
+            .iter()
+            .filter(|p| now_s - p.track.t_s <= 0.25)
+        {
+            let id = p.track.id;
+            let r = match self.streaks.iter_mut().find(|r| r.id == id) {
+                Some(r) => r,
+                None => {
+                    self.streaks.push(MoverStreak {
+                        id,
+                        last_s: now_s,
+                        since_s: now_s,
+                        mover_s: None,
+                    });
+                    self.streaks.last_mut().expect("just pushed")
+                }
+            };
+            if now_s - r.last_s > 0.25 {
+                // A new streak: an earlier one does not count (a row of parked cars the map
+                // does not hold, merged into one track, seems to move in bursts).
+                r.since_s = now_s;
+                r.mover_s = None;
+            }
+            r.last_s = now_s;
+            if now_s - r.since_s >= MOVER_FOR_S {
+                r.mover_s = Some(now_s);
+            }
+        }
+        self.streaks.retain(|r| now_s - r.last_s <= MOVER_LATELY_S);
     }
 
     /// The fastest the driver will go on this route, and why, when it is below the route's

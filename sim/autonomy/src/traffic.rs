@@ -21,8 +21,9 @@
 //!   margin after grows by `resume_margin_s`, so the vehicle does not creep off and stop again.
 //! - Movers slower than `min_speed_m_s`, or than `sigmas` standard deviations of their speed,
 //!   are left to the map (their cells are obstacles there).
-//! - **A mover at the body** ([`at_body`]): one seen, or predicted while out of view, within
-//!   `at_body_m` of a circle of a level it occupies is where the map cannot hold it (returns
+//! - **A mover at the body** ([`at_body`]): one seen, or predicted while out of view, whose box
+//!   of hits, grown by what of it may be hidden, comes within `at_body_m` of a circle of a level
+//!   it occupies is where the map cannot hold it (returns
 //!   within the map's self-hit margin of the vehicle are dropped as its own): the vehicle does
 //!   not move until it is seen away from the body, and one lost there is waited for as a hidden
 //!   obstacle (the pilot is called). A person who walked up to the fuselage, a truck that
@@ -67,7 +68,8 @@ pub struct TrafficConfig {
     /// Movers slower than this are left to the map, m/s. Default 0.8 (a static object's visible
     /// part, sliding as it is hidden or revealed, seldom seems faster).
     pub min_speed_m_s: f64,
-    /// A tracked mover this close to the vehicle's body (beyond a circle's radius, on a level it
+    /// A tracked mover whose box of hits, grown by what of it may be hidden (`hidden_m` or
+    /// more), comes this close to the vehicle's body (beyond a circle's radius, on a level it
     /// occupies) holds the vehicle ([`at_body`]), metres. Default 1 (the map drops returns
     /// within 0.8 m of a circle as the vehicle's own).
     pub at_body_m: f64,
@@ -230,7 +232,7 @@ pub fn moved_beyond_its_extent(t: &TrackState, cfg: &TrafficConfig) -> bool {
 }
 
 /// Whether the tracked object `t` is at the body of the vehicle `model` standing at `pose` at
-/// `now_s`: the box of its hits when it was last seen, moved along its motion from then to now
+/// `now_s`: the box of its hits when it was last seen, moved to where its motion puts it now
 /// (not at all when it was seen now), comes within what of it the sensor may not see
 /// (`cfg.hidden_m`, or more: what its box is smaller than the largest extent it was seen with)
 /// plus `cfg.at_body_m` of a circle of a level it occupies. Seen or not, moving or not: a mover predicted to walk on through the airframe
@@ -250,19 +252,16 @@ pub fn at_body(
     // What of it may lie beyond the box: `hidden_m`, or what it is seen smaller than its
     // largest extent (a truck whose front a wing hides).
     let hidden_m = cfg.hidden_m.max(t.extent_m - (hi - lo).norm());
+    // Where its motion puts the box now (where it was seen, when seen now): checked every plan,
+    // a mover walking on out of view cannot step over the body unnoticed.
     let (now_at, _) = t.predict((now_s - t.t_s).max(0.0));
-    let moved = now_at - t.position;
-    // The box every half metre along the way.
-    let steps = (moved.norm() / 0.5).ceil().max(1.0) as usize;
-    (0..=steps).any(|k| {
-        let shift = moved * (k as f64 / steps as f64);
-        let (lo, hi) = (lo + shift, hi + shift);
-        model.circles().iter().any(|c| {
-            let p = pose * Point2::new(c.x_m, c.y_m);
-            let out = (lo - p.coords).sup(&(p.coords - hi)).sup(&Vector2::zeros());
-            t.levels & (1u32 << c.level.min(31)) != 0
-                && out.norm() <= c.radius_m + hidden_m + cfg.at_body_m
-        })
+    let shift = now_at - t.position;
+    let (lo, hi) = (lo + shift, hi + shift);
+    model.circles().iter().any(|c| {
+        let p = pose * Point2::new(c.x_m, c.y_m);
+        let out = (lo - p.coords).sup(&(p.coords - hi)).sup(&Vector2::zeros());
+        t.levels & (1u32 << c.level.min(31)) != 0
+            && out.norm() <= c.radius_m + hidden_m + cfg.at_body_m
     })
 }
 
@@ -611,10 +610,12 @@ mod tests {
         // Only the wing tip's level (1) there: the fuselage's level-0 circles do not count.
         let high = mover(4.0, 1.8, 0.0, 0.0, 0b10);
         assert!(!at_body(&model(), &pose, &high, 0.0, &cfg));
-        // Last seen 5 m off walking towards it at 1.4 m/s: 3 s later its motion crossed it.
+        // Last seen 5 m off walking towards it at 1.4 m/s: 3 s later its motion puts it there,
+        // 10 s later through and 8 m beyond (the plans between found it at the body).
         let walking = mover(4.0, -6.0, 0.0, 1.4, 0b01);
         assert!(!at_body(&model(), &pose, &walking, 0.0, &cfg));
         assert!(at_body(&model(), &pose, &walking, 3.0, &cfg));
+        assert!(!at_body(&model(), &pose, &walking, 10.0, &cfg));
         // A 9 m truck seen as its last metre 5 m off: its hidden front may touch the body.
         let hidden_front = TrackState {
             extent_m: 9.0,

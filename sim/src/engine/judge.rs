@@ -11,6 +11,9 @@
 //! conflict area before the vehicle entered it (PET > 0, mover first), and the vehicle drove on:
 //! the pass closed with the vehicle 10 m past the point, or the run ended by time (`timed_out`).
 //!
+//! A contact is judged when it begins, and again, once, if the vehicle moves while it lasts (a
+//! mover that struck the standing vehicle and halted against it, then driven into: at fault).
+//!
 //! `[expectations] no_contact_at_fault = true`: a contact while the vehicle moved fails the run
 //! whatever the obstacles expect; a contact while it stood (struck) counts against neither the
 //! run nor a pass (a `yield` pass still needs no contact at all), and the danger distance is
@@ -137,6 +140,8 @@ pub struct Judge {
     s_total: f64,
     deviating: bool,
     contacts_seen: usize,
+    /// The (object, part) pairs touching now already judged at fault while they touch.
+    pushing: Vec<(String, String)>,
     events: Vec<(f64, Event)>,
     /// Every contact judged, in the world's order.
     contacts: Vec<JudgedContact>,
@@ -229,6 +234,7 @@ impl Judge {
             s_total: 0.0,
             deviating: false,
             contacts_seen: 0,
+            pushing: Vec::new(),
             events: Vec::new(),
             contacts: Vec::new(),
             no_contact_at_fault: scenario.no_contact_at_fault,
@@ -281,12 +287,7 @@ impl Judge {
         let stopped = state.speed_m_s.abs() < 0.05 && speed_command_m_s == 0.0;
         self.judge_stops(t_s, state, stopped);
         self.speed_now_m_s = state.speed_m_s;
-        for c in &world.contacts()[self.contacts_seen..] {
-            let judged = JudgedContact::new(c.clone(), state.speed_m_s);
-            self.events.push((c.time_s, Event::Contact(judged.clone())));
-            self.contacts.push(judged);
-        }
-        self.contacts_seen = world.contacts().len();
+        self.judge_contacts(state.speed_m_s, world);
         self.watch_traffic(t_s, state, world);
         self.judge_passes(t_s, d_now, stopped, world);
         self.clearance_now_m.fill(f64::INFINITY);
@@ -322,6 +323,19 @@ impl Judge {
         StepVerdict {
             lap_ended,
             fraction: fraction.clamp(0.0, 1.0),
+        }
+    }
+
+    /// The contacts begun since the last step and those lasting while the vehicle moves,
+    /// judged ([`judge_contacts`]).
+    fn judge_contacts(&mut self, speed_m_s: f64, world: &World) {
+        let begun = &world.contacts()[self.contacts_seen..];
+        self.contacts_seen = world.contacts().len();
+        let judged = judge_contacts(&mut self.pushing, begun, &world.touching_now(), speed_m_s);
+        for j in judged {
+            self.events
+                .push((j.contact.time_s, Event::Contact(j.clone())));
+            self.contacts.push(j);
         }
     }
 
@@ -800,6 +814,36 @@ fn closest_on_route(route: &RoutePath, path: &[Point2<f64>]) -> Option<Point2<f6
     best.map(|b| b.1)
 }
 
+/// The contacts `begun` since the last step, judged by the vehicle's speed now; and each
+/// (object, part) pair `touching` now while the vehicle moves - a mover that struck it standing
+/// and halted against it, then driven into - judged at fault, once while it lasts. `pushing`
+/// holds the pairs touching and already judged at fault.
+fn judge_contacts(
+    pushing: &mut Vec<(String, String)>,
+    begun: &[Contact],
+    touching: &[Contact],
+    speed_m_s: f64,
+) -> Vec<JudgedContact> {
+    let key = |c: &Contact| (c.object.clone(), c.part.clone());
+    pushing.retain(|k| touching.iter().any(|c| key(c) == *k));
+    let moving = speed_m_s.abs() > AT_FAULT_SPEED_M_S;
+    let pushed = touching
+        .iter()
+        .filter(|c| moving && !begun.iter().any(|b| key(b) == key(c)));
+    let mut judged = Vec::new();
+    for c in begun.iter().chain(pushed) {
+        if pushing.contains(&key(c)) {
+            continue;
+        }
+        let j = JudgedContact::new(c.clone(), speed_m_s);
+        if j.at_fault {
+            pushing.push(key(c));
+        }
+        judged.push(j);
+    }
+    judged
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -813,6 +857,33 @@ mod tests {
             kind: ObjectKind::Vehicle,
             part: "nose".into(),
         }
+    }
+
+    /// A truck strikes the standing jet's wing (struck) and halts against it; the jet then
+    /// moves while they touch: at fault, once while it lasts; touching anew later, judged anew.
+    #[test]
+    fn a_contact_lasting_while_the_vehicle_moves_is_at_fault_once() {
+        let c = |t: f64| Contact {
+            time_s: t,
+            object: "truck".into(),
+            kind: ObjectKind::FuelTruck,
+            part: "wing_left".into(),
+        };
+        let mut pushing = Vec::new();
+        let j = judge_contacts(&mut pushing, &[c(1.0)], &[c(1.0)], 0.0);
+        assert_eq!(j.len(), 1);
+        assert!(!j[0].at_fault);
+        assert!(judge_contacts(&mut pushing, &[], &[c(2.0)], 0.0).is_empty());
+        let j = judge_contacts(&mut pushing, &[], &[c(3.0)], 0.8);
+        assert_eq!(j.len(), 1);
+        assert!(j[0].at_fault && j[0].contact.time_s == 3.0);
+        assert!(judge_contacts(&mut pushing, &[], &[c(3.1)], 0.9).is_empty());
+        // Apart, then touching again while moving: a new contact, judged once.
+        assert!(judge_contacts(&mut pushing, &[], &[], 0.9).is_empty());
+        let j = judge_contacts(&mut pushing, &[c(5.0)], &[c(5.0)], 0.9);
+        assert_eq!(j.len(), 1);
+        assert!(j[0].at_fault);
+        assert!(judge_contacts(&mut pushing, &[], &[c(5.1)], 0.9).is_empty());
     }
 
     #[test]

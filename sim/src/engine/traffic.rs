@@ -20,8 +20,8 @@
 //! - a train's car: it keeps its place behind its lead (`TrainLink::behind_m` along the path)
 //!   whatever the lead does - profiles, stops, waits for the vehicle.
 //!
-//! Whatever its kind, a mover that touches the vehicle halts where it is for good
-//! ([`Traffic::halt`]; a train with it): a driver who hits an aircraft stops, a person does not
+//! Whatever its kind, a mover that touches the vehicle halts where it is for the rest of the run
+//! (until its `disappears_s`, if any: [`Traffic::halt`]; a train with it): a driver who hits an aircraft stops, a person does not
 //! walk on through an airframe. Without it a mover would pass through the vehicle's colliders
 //! (they are kinematic) and come out under a wing, where the vehicle moving on meets it again.
 
@@ -159,7 +159,8 @@ impl Traffic {
         }
     }
 
-    /// Obstacle `k`, touching the vehicle, halts for good where it stood at the last step
+    /// Obstacle `k`, touching the vehicle, halts where it stood at the last step, for the rest of
+    /// its presence
     /// (standing: speed 0); a train's car halts its lead, so the whole train stands. An absent
     /// or static obstacle is left as it is.
     pub fn halt(&mut self, k: usize) {

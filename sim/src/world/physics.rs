@@ -371,6 +371,25 @@ impl World {
         self.touching.iter().any(|&(object, _)| object == i)
     }
 
+    /// Every object and vehicle part touching now, as contacts at this time, in object then
+    /// part order.
+    pub fn touching_now(&self) -> Vec<Contact> {
+        let mut pairs: Vec<(usize, usize)> = self.touching.iter().copied().collect();
+        pairs.sort_unstable();
+        pairs
+            .into_iter()
+            .map(|(o, p)| {
+                let solid = &self.scene.solids[o];
+                Contact {
+                    time_s: self.time_s,
+                    object: solid.id.clone(),
+                    kind: solid.kind,
+                    part: self.parts[p].1.clone(),
+                }
+            })
+            .collect()
+    }
+
     /// Contacts so far, in time order.
     pub fn contacts(&self) -> &[Contact] {
         &self.contacts

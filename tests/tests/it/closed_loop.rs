@@ -441,7 +441,9 @@ fn the_car_copes_with_dropout_dead_beams_noise_and_spurious_returns() {
     assert!(on.contacts.is_empty() && on.expectations_met, "{on:#?}");
     assert_eq!(on.end, sim::engine::EndReason::Completed);
     assert!(
-        on.stops.len() > 10 && on.lap_times_s[0] > 3.0 * r.lap_times_s[0],
+        (20..=35).contains(&on.stops.len())
+            && (150.0..230.0).contains(&on.lap_times_s[0])
+            && r.lap_times_s[0] < 50.0,
         "FIXME fixed? {:?} {:?} against {:?}",
         on.stops,
         on.lap_times_s,
