@@ -2,7 +2,7 @@
 //! odometry between estimates), tracks its own progress along the route from that estimate,
 //! plans over the online map's distance maps, and turns the plan into a command.
 
-use mapper::{CollisionModel, MapError};
+use mapper::{CollisionModel, MapError, TrackState};
 use nalgebra::{Isometry2, Point2, Vector2};
 
 use crate::messages::{Command, Odometry, PoseEstimate};
@@ -279,12 +279,14 @@ impl Driver {
             self.vehicle.behaviour,
             &config,
         );
-        let mut conflict = self.traffic_conflict(&p, map, wanted, estimate.t_s, &config, false);
+        // The tracker's movers, once a plan: the space-time check and the body hold read them.
+        let movers = map.movers();
+        let mut conflict = self.traffic_conflict(&p, &movers, wanted, estimate.t_s, &config, false);
         let v0 = self.last_odometry.map_or(0.0, |o| o.speed_m_s.max(0.0));
         if conflict.is_some_and(|c| stopping_distance_m(v0, decel, &config) >= c.zone_m) {
             // Too late to stop short of the mover's path: standing in it is the worst choice.
             // Drive on if the vehicle clears the mover with the tighter committed margin.
-            let committed = self.traffic_conflict(&p, map, wanted, estimate.t_s, &config, true);
+            let committed = self.traffic_conflict(&p, &movers, wanted, estimate.t_s, &config, true);
             if committed.is_none() {
                 conflict = None;
             }
@@ -296,7 +298,8 @@ impl Driver {
             chosen.collision_at_m = Some(chosen.collision_at_m.map_or(stop_at, |c| c.min(stop_at)));
         }
         let (mut v, _) = avoid(&chosen, wanted, decel, &config);
-        let body = self.movers_at_body(map, &estimate.world_from_vehicle, estimate.t_s, &config);
+        let body =
+            self.movers_at_body(&movers, &estimate.world_from_vehicle, estimate.t_s, &config);
         if body.is_some() {
             v = 0.0;
         }
@@ -369,13 +372,13 @@ impl Driver {
         self.hold.map(|(_, line, _)| (line - s).max(0.0))
     }
 
-    /// The movers predicted from `map`'s tracker, and the first conflict on `p`'s chosen path
-    /// for a vehicle going from its speed now to `wanted` m/s (`None` with traffic off);
-    /// `committed`: with the time margin of a vehicle that can no longer stop short.
+    /// The `movers` (the online map's tracker's) predicted, and the first conflict on `p`'s
+    /// chosen path for a vehicle going from its speed now to `wanted` m/s (`None` with traffic
+    /// off); `committed`: with the time margin of a vehicle that can no longer stop short.
     fn traffic_conflict(
         &mut self,
         p: &Plan,
-        map: &OnlineMap,
+        movers: &[TrackState],
         wanted: f64,
         now_s: f64,
         config: &AutonomyConfig,
@@ -391,7 +394,7 @@ impl Driver {
             self.predictions.clear();
             return None;
         }
-        self.predictions = predict(&map.movers(), now_s, traffic);
+        self.predictions = predict(movers, now_s, traffic);
         if self.predictions.is_empty() {
             return None;
         }
@@ -420,7 +423,7 @@ impl Driver {
     /// seen within `hidden_after_s`, else waiting for one lost there, as for a hidden obstacle.
     fn movers_at_body(
         &mut self,
-        map: &OnlineMap,
+        movers: &[TrackState],
         pose: &Isometry2<f64>,
         now_s: f64,
         config: &AutonomyConfig,
@@ -431,7 +434,6 @@ impl Driver {
         }
         let cfg = &config.traffic;
         self.note_streaks(now_s);
-        let movers = map.movers();
         // A mover arriving at the body, or one held there before and not seen away.
         let mut body: Vec<AtBody> = movers
             .iter()
