@@ -1,0 +1,25 @@
+//! taxi-sim's airports: an X-Plane `apt.dat` (versions 1000 through 1200) read into a local
+//! metric frame at the airport's datum, its taxi routing network, and taxi routes along named
+//! taxiways rounded into paths an aircraft can drive.
+//!
+//! Pure geometry and graphs: no simulator, renderer or scenario files (`sim` builds a world from
+//! an [`Airport`]).
+
+pub mod apt_dat;
+pub mod bezier;
+mod error;
+pub mod geodesy;
+pub mod model;
+pub mod network;
+pub mod path;
+pub mod route;
+mod row;
+pub mod size;
+
+pub use error::AirportError;
+pub use geodesy::{LatLon, LocalFrame};
+pub use model::{Airport, Pavement, Runway, Sign, Stand, Surface};
+pub use network::{Edge, EdgeClass, Network, Node};
+pub use path::{PathOptions, TaxiPath, smooth};
+pub use route::{NetworkRoute, Place, RouteRequest, find};
+pub use size::SizeClass;

@@ -1,0 +1,577 @@
+//! Taxi routes: from a stand, a network node or a runway to a runway's hold point, a stand or a
+//! node, along the named taxiways in order; the shortest such path on the network that admits
+//! the aircraft's code letter, keeps one-way edges' direction, never enters the zone of the
+//! runway it is bound for, and never turns back on itself or through more than
+//! [`MAX_DEFLECTION_DEG`] at a node. `smooth` then rounds it into a path the aircraft can drive.
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use nalgebra::Vector2;
+
+use crate::error::AirportError;
+use crate::model::Airport;
+use crate::network::{EdgeClass, Network};
+use crate::size::SizeClass;
+
+/// The sharpest turn at a node a route takes (deflection from straight on, degrees).
+pub const MAX_DEFLECTION_DEG: f64 = 135.0;
+
+/// Where a route starts or ends, as a scenario writes it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Place {
+    /// A stand, by its name (`Gate 4 South A`).
+    Stand(String),
+    /// A network node by id (`node 12`).
+    Node(u32),
+    /// A runway end (`runway 28`): as a destination its hold point, as a start its threshold's
+    /// end of the runway (vacating it after landing).
+    Runway(String),
+}
+
+impl Place {
+    /// `node 12`, `runway 28`, or a stand's name.
+    #[must_use]
+    pub fn parse(text: &str) -> Self {
+        let text = text.trim();
+        if let Some(id) = text
+            .strip_prefix("node ")
+            .and_then(|id| id.trim().parse().ok())
+        {
+            return Self::Node(id);
+        }
+        if let Some(number) = text.strip_prefix("runway ") {
+            return Self::Runway(number.trim().to_string());
+        }
+        Self::Stand(text.to_string())
+    }
+}
+
+impl std::fmt::Display for Place {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Stand(name) => write!(f, "stand {name}"),
+            Self::Node(id) => write!(f, "node {id}"),
+            Self::Runway(number) => write!(f, "runway {number}"),
+        }
+    }
+}
+
+/// What a route is asked to be.
+#[derive(Debug, Clone)]
+pub struct RouteRequest {
+    /// Start.
+    pub from: Place,
+    /// End.
+    pub to: Place,
+    /// Taxiway names to follow, in order.
+    pub via: Vec<String>,
+    /// The aircraft's code letter.
+    pub code: SizeClass,
+}
+
+/// A route on the network, before smoothing.
+#[derive(Debug, Clone)]
+pub struct NetworkRoute {
+    /// Where it starts, as asked.
+    pub from: String,
+    /// Where it ends, as asked.
+    pub to: String,
+    /// Its corner points: start, the nodes passed, end (a stand: the point on the taxilane
+    /// abeam it, then the stand).
+    pub points: Vec<Vector2<f64>>,
+    /// The network node of each point, if it is one.
+    pub nodes: Vec<Option<usize>>,
+    /// Taxiway names in the order driven (each run once).
+    pub taxiways: Vec<String>,
+    /// Runway ends whose zones it enters on the way (runway crossings).
+    pub crossings: Vec<String>,
+    /// Length (m).
+    pub length_m: f64,
+}
+
+/// A directed arc of the search graph: a network edge (or part of one) in one direction.
+#[derive(Debug, Clone, Copy)]
+struct Arc {
+    tail: usize,
+    head: usize,
+    edge: usize,
+    length_m: f64,
+}
+
+/// The graph searched: the network's nodes, then a virtual start and end on edges.
+struct Graph<'a> {
+    network: &'a Network,
+    points: Vec<Vector2<f64>>,
+    arcs: Vec<Arc>,
+    leaving: Vec<Vec<usize>>,
+}
+
+impl Graph<'_> {
+    fn add_point(&mut self, at: Vector2<f64>) -> usize {
+        self.points.push(at);
+        self.leaving.push(Vec::new());
+        self.points.len() - 1
+    }
+
+    fn add_arc(&mut self, tail: usize, head: usize, edge: usize) {
+        let length_m = (self.points[head] - self.points[tail]).norm();
+        self.leaving[tail].push(self.arcs.len());
+        self.arcs.push(Arc {
+            tail,
+            head,
+            edge,
+            length_m,
+        });
+    }
+}
+
+/// Finds the route asked for on `airport`'s network.
+///
+/// # Errors
+/// A place or taxiway name that is not there, or no path admitting the code (`AirportError::Route`,
+/// saying which).
+pub fn find(airport: &Airport, request: &RouteRequest) -> Result<NetworkRoute, AirportError> {
+    let network = &airport.network;
+    let fail = |why: String| AirportError::Route {
+        from: request.from.to_string(),
+        to: request.to.to_string(),
+        why,
+    };
+    for name in &request.via {
+        if !network.edges.iter().any(|e| &e.name == name) {
+            let known: Vec<String> = network.taxiways().into_keys().collect();
+            return Err(fail(format!(
+                "no taxiway `{name}` on the network (it has {known:?})"
+            )));
+        }
+    }
+    let admitted: Vec<bool> = network
+        .edges
+        .iter()
+        .map(|e| e.admits(request.code))
+        .collect();
+    if !admitted.iter().any(|&a| a) {
+        return Err(fail(format!(
+            "no edge of the network admits code {}",
+            request.code
+        )));
+    }
+    let mut graph = Graph {
+        network,
+        points: network.nodes.iter().map(|n| n.at).collect(),
+        arcs: Vec::new(),
+        leaving: vec![Vec::new(); network.nodes.len()],
+    };
+    let forbidden_zone = match &request.to {
+        Place::Runway(number) => Some(number.clone()),
+        _ => None,
+    };
+    for (index, edge) in network.edges.iter().enumerate() {
+        let in_target_zone = forbidden_zone
+            .as_deref()
+            .is_some_and(|n| edge.in_zone_of(n));
+        if !admitted[index] || in_target_zone {
+            continue;
+        }
+        graph.add_arc(edge.from, edge.to, index);
+        if !edge.one_way {
+            graph.add_arc(edge.to, edge.from, index);
+        }
+    }
+    let start = start_point(airport, &mut graph, &request.from, request.code).map_err(&fail)?;
+    let (targets, lead_in) =
+        end_points(airport, &mut graph, &request.to, request.code).map_err(&fail)?;
+    let allow_runway = matches!(request.from, Place::Runway(_));
+    let search = Search {
+        graph: &graph,
+        via: &request.via,
+        allow_runway,
+    };
+    let best = search.run(start, &targets, &request.to, airport).ok_or_else(|| {
+        fail(format!(
+            "no path{} admitting code {} (one-way edges kept, no turn over {MAX_DEFLECTION_DEG} degrees)",
+            if request.via.is_empty() { String::new() } else { format!(" along {}", request.via.join(", ")) },
+            request.code
+        ))
+    })?;
+    let mut route = assemble(&graph, start, &best, lead_in, &request.to);
+    route.from = request.from.to_string();
+    route.to = request.to.to_string();
+    Ok(route)
+}
+
+fn nearest_on_edges(
+    graph: &Graph,
+    at: Vector2<f64>,
+    code: SizeClass,
+) -> Option<(usize, Vector2<f64>)> {
+    let network = graph.network;
+    network
+        .edges
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.class != EdgeClass::Runway && e.admits(code))
+        .map(|(i, e)| {
+            let (a, b) = (network.nodes[e.from].at, network.nodes[e.to].at);
+            let t = ((at - a).dot(&(b - a)) / (b - a).norm_squared()).clamp(0.0, 1.0);
+            let p = a + (b - a) * t;
+            (i, p, (p - at).norm())
+        })
+        .min_by(|x, y| x.2.total_cmp(&y.2))
+        .map(|(i, p, _)| (i, p))
+}
+
+fn start_point(
+    airport: &Airport,
+    graph: &mut Graph,
+    from: &Place,
+    code: SizeClass,
+) -> Result<usize, String> {
+    match from {
+        Place::Node(id) => graph
+            .network
+            .node_by_id(*id)
+            .ok_or_else(|| format!("no network node has id {id}")),
+        Place::Runway(number) => runway_node_at_threshold(airport, number),
+        Place::Stand(name) => {
+            let stand = airport
+                .stand(name)
+                .ok_or_else(|| format!("no stand `{name}` (stands: {:?})", stand_names(airport)))?;
+            let (edge, p) = nearest_on_edges(graph, stand.at, code).ok_or_else(|| {
+                format!("no taxiway admitting code {code} to leave stand `{name}` by")
+            })?;
+            let e = graph.network.edges[edge].clone();
+            let s = graph.add_point(p);
+            graph.add_arc(s, e.to, edge);
+            if !e.one_way {
+                graph.add_arc(s, e.from, edge);
+            }
+            Ok(s)
+        }
+    }
+}
+
+fn end_points(
+    airport: &Airport,
+    graph: &mut Graph,
+    to: &Place,
+    code: SizeClass,
+) -> Result<(Vec<usize>, Option<Vector2<f64>>), String> {
+    match to {
+        Place::Node(id) => Ok((
+            vec![
+                graph
+                    .network
+                    .node_by_id(*id)
+                    .ok_or_else(|| format!("no network node has id {id}"))?,
+            ],
+            None,
+        )),
+        Place::Runway(number) => {
+            if runway_end(airport, number).is_none() {
+                return Err(format!(
+                    "no runway end `{number}` (runways: {:?})",
+                    airport
+                        .runways
+                        .iter()
+                        .map(crate::model::Runway::name)
+                        .collect::<Vec<_>>()
+                ));
+            }
+            let holds = hold_points(graph.network, number);
+            if holds.is_empty() {
+                return Err(format!(
+                    "the network has no hold point of runway {number} (no edge in its zone, 1204)"
+                ));
+            }
+            Ok((holds, None))
+        }
+        Place::Stand(name) => {
+            let stand = airport
+                .stand(name)
+                .ok_or_else(|| format!("no stand `{name}` (stands: {:?})", stand_names(airport)))?;
+            if let Some(class) = stand.size_class.filter(|&c| c < code) {
+                return Err(format!(
+                    "stand `{name}` takes aircraft up to code {class}, not {code}"
+                ));
+            }
+            let (edge, p) = nearest_on_edges(graph, stand.at, code).ok_or_else(|| {
+                format!("no taxiway admitting code {code} to reach stand `{name}` by")
+            })?;
+            let e = graph.network.edges[edge].clone();
+            let end = graph.add_point(p);
+            graph.add_arc(e.from, end, edge);
+            if !e.one_way {
+                graph.add_arc(e.to, end, edge);
+            }
+            Ok((vec![end], Some(stand.at)))
+        }
+    }
+}
+
+fn stand_names(airport: &Airport) -> Vec<&str> {
+    airport.stands.iter().map(|s| s.name.as_str()).collect()
+}
+
+fn runway_end<'a>(airport: &'a Airport, number: &str) -> Option<(&'a crate::model::Runway, usize)> {
+    airport.runways.iter().find_map(|r| {
+        r.ends
+            .iter()
+            .position(|e| e.number == number)
+            .map(|i| (r, i))
+    })
+}
+
+/// The runway node nearest the threshold of end `number`.
+fn runway_node_at_threshold(airport: &Airport, number: &str) -> Result<usize, String> {
+    let (runway, end) =
+        runway_end(airport, number).ok_or_else(|| format!("no runway end `{number}`"))?;
+    let threshold = runway.ends[end].at;
+    let network = &airport.network;
+    network
+        .edges
+        .iter()
+        .filter(|e| e.class == EdgeClass::Runway)
+        .flat_map(|e| [e.from, e.to])
+        .min_by(|&a, &b| {
+            (network.nodes[a].at - threshold)
+                .norm()
+                .total_cmp(&(network.nodes[b].at - threshold).norm())
+        })
+        .ok_or_else(|| format!("the network has no runway edge on runway {}", runway.name()))
+}
+
+/// Nodes where an edge in the zone of runway end `number` meets one that is not: where an
+/// aircraft bound for that runway holds short.
+#[must_use]
+pub fn hold_points(network: &Network, number: &str) -> Vec<usize> {
+    let mut inside = vec![false; network.nodes.len()];
+    let mut outside = vec![false; network.nodes.len()];
+    for edge in &network.edges {
+        let flags = if edge.in_zone_of(number) || edge.class == EdgeClass::Runway {
+            &mut inside
+        } else {
+            &mut outside
+        };
+        flags[edge.from] = true;
+        flags[edge.to] = true;
+    }
+    (0..network.nodes.len())
+        .filter(|&i| {
+            inside[i]
+                && outside[i]
+                && network
+                    .edges
+                    .iter()
+                    .any(|e| (e.from == i || e.to == i) && e.in_zone_of(number))
+        })
+        .collect()
+}
+
+/// Dijkstra over (arc, stage): the stage counts the taxiways of `via` reached in order.
+struct Search<'a> {
+    graph: &'a Graph<'a>,
+    via: &'a [String],
+    allow_runway: bool,
+}
+
+#[derive(PartialEq)]
+struct Entry {
+    cost: f64,
+    state: usize,
+}
+
+impl Eq for Entry {}
+
+impl Ord for Entry {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other
+            .cost
+            .total_cmp(&self.cost)
+            .then(other.state.cmp(&self.state))
+    }
+}
+
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Search<'_> {
+    /// The stage after driving an edge named `name` at `stage` (None: not allowed).
+    fn next_stage(&self, stage: usize, name: &str, runway: bool) -> Option<usize> {
+        let k = self.via.len();
+        let named = self.via.iter().position(|v| v == name);
+        if runway && named.is_none() && !(self.allow_runway && stage == 0) {
+            return None;
+        }
+        if name.is_empty() {
+            return Some(stage);
+        }
+        match (stage, named) {
+            (_, None) if stage == 0 || stage == k + 1 || k == 0 => Some(stage),
+            (_, None) if stage == k => Some(k + 1),
+            (_, None) => None,
+            (s, Some(i)) if s >= 1 && s <= k && i == s - 1 => Some(s),
+            (s, Some(i)) if s < k && i == s => Some(s + 1),
+            _ => None,
+        }
+    }
+
+    fn turn_ok(&self, a: &Arc, b: &Arc) -> bool {
+        if a.edge == b.edge && a.tail == b.head {
+            return false;
+        }
+        let points = &self.graph.points;
+        let (u, v) = (
+            points[a.head] - points[a.tail],
+            points[b.head] - points[b.tail],
+        );
+        let cos = u.dot(&v) / (u.norm() * v.norm()).max(1e-12);
+        cos >= MAX_DEFLECTION_DEG.to_radians().cos() - 1e-9
+    }
+
+    fn run(
+        &self,
+        start: usize,
+        targets: &[usize],
+        to: &Place,
+        airport: &Airport,
+    ) -> Option<Vec<usize>> {
+        let stages = self.via.len() + 2;
+        let arcs = &self.graph.arcs;
+        let mut cost = vec![f64::INFINITY; arcs.len() * stages];
+        let mut previous = vec![usize::MAX; arcs.len() * stages];
+        let mut heap = BinaryHeap::new();
+        let runway = |arc: &Arc| self.graph.network.edges[arc.edge].class == EdgeClass::Runway;
+        for &a in &self.graph.leaving[start] {
+            let arc = &arcs[a];
+            if let Some(stage) =
+                self.next_stage(0, &self.graph.network.edges[arc.edge].name, runway(arc))
+            {
+                let state = a * stages + stage;
+                cost[state] = arc.length_m;
+                heap.push(Entry {
+                    cost: arc.length_m,
+                    state,
+                });
+            }
+        }
+        let finished = |stage: usize| self.via.is_empty() || stage >= self.via.len();
+        let mut reached: Vec<(usize, f64)> = Vec::new();
+        while let Some(Entry { cost: c, state }) = heap.pop() {
+            if c > cost[state] {
+                continue;
+            }
+            let (a, stage) = (state / stages, state % stages);
+            let arc = &arcs[a];
+            if targets.contains(&arc.head) && finished(stage) {
+                reached.push((state, c));
+            }
+            for &b in &self.graph.leaving[arc.head] {
+                let next = &arcs[b];
+                if !self.turn_ok(arc, next) {
+                    continue;
+                }
+                let Some(s) = self.next_stage(
+                    stage,
+                    &self.graph.network.edges[next.edge].name,
+                    runway(next),
+                ) else {
+                    continue;
+                };
+                let (n, nc) = (b * stages + s, c + next.length_m);
+                if nc < cost[n] {
+                    cost[n] = nc;
+                    previous[n] = state;
+                    heap.push(Entry { cost: nc, state: n });
+                }
+            }
+        }
+        let best = choose_target(&reached, to, airport, self.graph, stages)?;
+        let mut path = vec![best / stages];
+        let mut state = best;
+        while previous[state] != usize::MAX {
+            state = previous[state];
+            path.push(state / stages);
+        }
+        path.reverse();
+        Some(path)
+    }
+}
+
+/// The shortest way to each target; bound for a runway, the hold point nearest its threshold
+/// (a full-length departure).
+fn choose_target(
+    reached: &[(usize, f64)],
+    to: &Place,
+    airport: &Airport,
+    graph: &Graph,
+    stages: usize,
+) -> Option<usize> {
+    let head = |state: usize| graph.arcs[state / stages].head;
+    match to {
+        Place::Runway(number) => {
+            let threshold = runway_end(airport, number).map(|(r, i)| r.ends[i].at)?;
+            reached
+                .iter()
+                .min_by(|x, y| {
+                    let dx = (graph.points[head(x.0)] - threshold).norm();
+                    let dy = (graph.points[head(y.0)] - threshold).norm();
+                    dx.total_cmp(&dy).then(x.1.total_cmp(&y.1))
+                })
+                .map(|x| x.0)
+        }
+        _ => reached
+            .iter()
+            .min_by(|x, y| x.1.total_cmp(&y.1))
+            .map(|x| x.0),
+    }
+}
+
+fn assemble(
+    graph: &Graph,
+    start: usize,
+    arcs: &[usize],
+    lead_in: Option<Vector2<f64>>,
+    to: &Place,
+) -> NetworkRoute {
+    let network = graph.network;
+    let node_of = |p: usize| (p < network.nodes.len()).then_some(p);
+    let mut points = vec![graph.points[start]];
+    let mut nodes = vec![node_of(start)];
+    let mut taxiways: Vec<String> = Vec::new();
+    let mut crossings: Vec<String> = Vec::new();
+    for &a in arcs {
+        let arc = &graph.arcs[a];
+        let edge = &network.edges[arc.edge];
+        if (graph.points[arc.head] - points[points.len() - 1]).norm() > 1e-6 {
+            points.push(graph.points[arc.head]);
+            nodes.push(node_of(arc.head));
+        }
+        if !edge.name.is_empty() && taxiways.last() != Some(&edge.name) {
+            taxiways.push(edge.name.clone());
+        }
+        for runway in &edge.zone_runways {
+            if !crossings.contains(runway) && !matches!(to, Place::Runway(n) if n == runway) {
+                crossings.push(runway.clone());
+            }
+        }
+    }
+    if let Some(stand) = lead_in {
+        points.push(stand);
+        nodes.push(None);
+    }
+    let length_m = points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    NetworkRoute {
+        from: String::new(),
+        to: String::new(),
+        points,
+        nodes,
+        taxiways,
+        crossings,
+        length_m,
+    }
+}

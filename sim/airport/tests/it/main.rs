@@ -1,0 +1,8 @@
+//! The airport crate's integration tests: the shipped fictional airport read and routed, malformed
+//! files refused with located errors, and (ignored unless asked, run by CI) real KSYR data from
+//! `../shared/data`.
+
+mod fixture;
+mod malformed;
+mod routes;
+mod shared_data;
