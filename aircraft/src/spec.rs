@@ -125,6 +125,11 @@ pub struct VehicleSpec {
     /// anything whose underside is lower is an obstacle.
     #[serde(default = "default_overhead_clearance_m")]
     pub overhead_clearance_m: f64,
+    /// The real aircraft's published wingspan, metres, where the URDF's boxes reach a little
+    /// beyond it (a swept tip as a box): its ICAO code letter is taken from this. Must be within
+    /// 1 m of the parts' span. Default: the parts' span.
+    #[serde(default)]
+    pub wingspan_m: Option<f64>,
     /// Motion limits.
     pub motion: MotionLimits,
     /// LiDAR mount pose.
@@ -149,6 +154,14 @@ impl VehicleSpec {
             return Err(field(
                 "overhead_clearance_m",
                 format!("{} must be finite and >= 0", spec.overhead_clearance_m),
+            ));
+        }
+        if let Some(span) = spec.wingspan_m
+            && !(span.is_finite() && span > 0.0)
+        {
+            return Err(field(
+                "wingspan_m",
+                format!("{span} must be finite and > 0"),
             ));
         }
         let m = &spec.motion;

@@ -50,7 +50,20 @@ impl Vehicle {
     ) -> Result<Self> {
         let spec = VehicleSpec::from_str(spec_toml, spec_file)?;
         let parts = crate::urdf::parts_from_str(urdf, urdf_file)?;
-        Ok(Vehicle { spec, parts })
+        let vehicle = Vehicle { spec, parts };
+        if let Some(wingspan) = vehicle.spec.wingspan_m
+            && (wingspan - vehicle.span_m()).abs() > 1.0
+        {
+            return Err(Error::Field {
+                file: spec_file.to_string(),
+                field: "wingspan_m".to_string(),
+                message: format!(
+                    "{wingspan} m is more than 1 m from the span of the URDF's parts ({:.2} m)",
+                    vehicle.span_m()
+                ),
+            });
+        }
+        Ok(vehicle)
     }
 
     /// Reads a sidecar file and the URDF it names (relative to the sidecar's directory).
@@ -101,6 +114,30 @@ impl Vehicle {
     /// Pose of the LiDAR in the vehicle frame (the sidecar's `lidar.xyz_m` and `lidar.rpy_rad`).
     pub fn vehicle_from_lidar(&self) -> nalgebra::Isometry3<f64> {
         self.spec.lidar.vehicle_from_lidar()
+    }
+
+    /// Its wingspan, metres: the sidecar's `wingspan_m` (the real aircraft's) or else the parts'
+    /// span ([`Self::span_m`]). An aircraft's ICAO code letter follows from it.
+    pub fn wingspan_m(&self) -> f64 {
+        self.spec.wingspan_m.unwrap_or_else(|| self.span_m())
+    }
+
+    /// The parts' span: twice the farthest any part reaches from the centreline (y = 0), metres.
+    pub fn span_m(&self) -> f64 {
+        self.parts
+            .iter()
+            .map(|p| {
+                let (low, high) = p.footprint().bounds();
+                low.y.abs().max(high.y.abs())
+            })
+            .fold(0.0, f64::max)
+            * 2.0
+    }
+
+    /// The radius of its tightest turn, at the reference point (rear axle, main gear): wheelbase
+    /// over the tangent of the largest steering angle, metres.
+    pub fn min_turn_radius_m(&self) -> f64 {
+        self.spec.motion.wheelbase_m / self.spec.motion.max_steering_angle_rad.tan()
     }
 
     /// The vehicle's top: the highest point of its collision parts above the ground, metres

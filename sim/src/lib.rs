@@ -9,6 +9,7 @@
 //! - [`world`]: the simulator's side of the message boundary - the scene, the Rapier world and
 //!   its ground truth, motion, the LiDAR, odometry, faults, the capture of a revolution. The
 //!   only module that names Rapier or parry;
+//! - [`airports`]: real airports (the `airport` crate's) summarised, drawn and made into worlds;
 //! - [`scenario`]: what a run is asked to do - scenario files and run configurations, resolved;
 //! - [`offline_map`]: the mapping drive that builds a scenario's offline map, and its manifest;
 //! - [`engine`]: one run - the rig, the loop, the schedule, pose sources, the judge, the
@@ -24,6 +25,8 @@ pub mod error;
 pub mod toml_file;
 
 pub mod world;
+
+pub mod airports;
 
 pub mod scenario;
 

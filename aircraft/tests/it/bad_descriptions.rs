@@ -2,7 +2,7 @@
 //! and column for the sidecar TOML).
 
 use aircraft::urdf::parts_from_str;
-use aircraft::{Error, VehicleSpec};
+use aircraft::{Error, Vehicle, VehicleSpec};
 
 fn robot(body: &str) -> String {
     format!(r#"<?xml version="1.0"?><robot name="t">{body}</robot>"#)
@@ -252,11 +252,31 @@ fn sidecar_parses_and_errors_carry_line_and_column() {
             "heights_of_interest_m = [0.0, 0.7]\noverhead_clearance_m = inf",
             "overhead_clearance_m",
         ),
+        (
+            "heights_of_interest_m = [0.0, 0.7]",
+            "heights_of_interest_m = [0.0, 0.7]\nwingspan_m = -1.0",
+            "wingspan_m",
+        ),
     ] {
         let e = VehicleSpec::from_str(&SPEC.replace(from, to), "t.toml").expect_err(field);
         assert!(matches!(e, Error::Field { .. }), "{e}");
         assert!(e.to_string().contains(field), "{e}");
     }
+}
+
+#[test]
+fn a_wingspan_far_from_the_parts_span_is_refused() {
+    let shipped = |file: &str| {
+        std::fs::read_to_string(format!("{}/vehicles/{file}", env!("CARGO_MANIFEST_DIR")))
+            .expect("shipped file")
+    };
+    let (spec, urdf) = (shipped("a320.toml"), shipped("a320.urdf"));
+    let wide = spec.replace("wingspan_m = 35.8", "wingspan_m = 40.0");
+    let e = Vehicle::from_strs(&wide, "a320.toml", &urdf, "a320.urdf").expect_err("refused");
+    assert_eq!(
+        e.to_string(),
+        "a320.toml: field `wingspan_m`: 40 m is more than 1 m from the span of the URDF's parts (36.58 m)"
+    );
 }
 
 #[test]

@@ -326,3 +326,25 @@ fn the_airliner_has_its_gear_nacelles_and_wings_on_three_levels() {
         assert_eq!(r.coverage, 1.0, "{r:?}");
     }
 }
+
+#[test]
+fn the_jets_spans_and_tightest_turns_are_the_real_aircrafts() {
+    // Wingspans: Praetor 600 21.5 m (ICAO code B), A320 35.8 m (code C), FACTS.md. The jet's
+    // parts reach it; the airliner's swept tip boxes reach 0.39 m beyond each tip (36.58 m), so
+    // its sidecar gives the real span.
+    let jet = Vehicle::shipped("praetor600").expect("shipped");
+    assert!(
+        (jet.span_m() - 21.5).abs() < 0.3 && jet.spec.wingspan_m.is_none(),
+        "{}",
+        jet.span_m()
+    );
+    let airliner = Vehicle::shipped("a320").expect("shipped");
+    assert!(
+        (airliner.span_m() - 36.58).abs() < 0.01,
+        "{}",
+        airliner.span_m()
+    );
+    assert_eq!(airliner.wingspan_m(), 35.8);
+    let radius = jet.min_turn_radius_m();
+    assert!((radius - 8.0 / 1.05_f64.tan()).abs() < 1e-12, "{radius}");
+}

@@ -414,6 +414,15 @@ impl Reader<'_> {
                 };
                 self.airport(row)?.lights.push(light);
             }
+            1201..=1302 => return self.network_row(row),
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// The taxi network's and the stands' rows, and metadata.
+    fn network_row(&mut self, row: &Row) -> Result<(), AirportError> {
+        match row.code {
             1201 => {
                 let node = RawNode {
                     line: row.line,

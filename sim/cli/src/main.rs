@@ -48,6 +48,9 @@ enum Command {
     /// Campaigns: scenario families sampled, run in parallel, searched for failures.
     #[command(subcommand)]
     Campaign(commands::campaign::CampaignCommand),
+    /// Airport files (X-Plane apt.dat): summary, picture, taxi routes.
+    #[command(subcommand)]
+    Airport(commands::airport::AirportCommand),
     /// Tune the collision model: run a campaign whose parameters are model settings, then
     /// compare them (Pareto front, exact reference, recommended model, pictures).
     /// Exit code 0 when a setting had no unsafe run, 1 when none did, 2 on bad input.
@@ -129,6 +132,7 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
             unreachable!("dispatched in run")
         }
         Command::Scan(args) => commands::scan::run(&args),
+        Command::Airport(cmd) => commands::airport::run(&cmd),
         Command::Config => emit(&sim::scenario::RunConfig::default().to_toml()),
     }
 }

@@ -1,6 +1,7 @@
 //! The `taxi-sim` commands, one module each: its arguments (clap) and its `run`, which parses
 //! them into the library's types and prints what the command shows.
 
+pub mod airport;
 pub mod bench;
 pub mod campaign;
 pub mod check;

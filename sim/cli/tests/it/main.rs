@@ -19,6 +19,7 @@ fn taxi_sim_in(dir: &std::path::Path, args: &[&str]) -> (i32, String, String) {
     )
 }
 
+mod airport;
 mod campaign;
 mod cli;
 mod figures;
