@@ -139,6 +139,10 @@ impl Body {
             SolidShape::Cylinder { radius_m, .. } | SolidShape::Cone { radius_m, .. } => {
                 Hull::disc(Point2::origin(), radius_m)
             }
+            // A parked aircraft's part never moves: its disc about the vehicle frame will do.
+            SolidShape::Part { .. } => {
+                Hull::disc(Point2::origin(), solid.shape.footprint_radius_m())
+            }
         };
         Body::new(vec![hull])
     }

@@ -62,6 +62,36 @@ pub(super) fn log_solid(
         Ok(())
     };
     match solid.shape {
+        SolidShape::Part {
+            shape,
+            vehicle_from_part,
+        } => {
+            // Drawn as the box around the primitive, turned as it is.
+            let half = match shape {
+                aircraft::Shape::Box { half_extents_m } => half_extents_m,
+                aircraft::Shape::Cylinder {
+                    radius_m,
+                    half_length_m,
+                } => nalgebra::Vector3::new(radius_m, radius_m, half_length_m),
+                aircraft::Shape::Capsule {
+                    radius_m,
+                    half_length_m,
+                } => nalgebra::Vector3::new(radius_m, radius_m, half_length_m + radius_m),
+                aircraft::Shape::Sphere { radius_m } => nalgebra::Vector3::repeat(radius_m),
+            };
+            let world_from_vehicle = Isometry3::from_parts(
+                nalgebra::Translation3::new(x, y, 0.0),
+                nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), yaw),
+            );
+            let pose = world_from_vehicle * vehicle_from_part;
+            log(&rerun::Boxes3D::from_centers_and_half_sizes(
+                [v3(&pose.translation.vector)],
+                [v3(&half)],
+            )
+            .with_quaternions([quat(&pose.rotation)])
+            .with_fill_mode(FillMode::Solid)
+            .with_colors([color]))
+        }
         SolidShape::Box { size_m } => log(&rerun::Boxes3D::from_centers_and_half_sizes(
             [center],
             [[

@@ -41,6 +41,11 @@ pub(super) fn kind_color(kind: ObjectKind) -> Rgba32 {
         ObjectKind::Box | ObjectKind::Cylinder => Rgba32::from_rgb(140, 120, 90),
         ObjectKind::Person => Rgba32::from_rgb(255, 160, 200),
         ObjectKind::Tug | ObjectKind::FuelTruck => Rgba32::from_rgb(240, 180, 0),
+        ObjectKind::ParkedAircraft => Rgba32::from_rgb(225, 228, 235),
+        ObjectKind::Sign => Rgba32::from_rgb(250, 210, 0),
+        ObjectKind::EdgeLight => Rgba32::from_rgb(40, 80, 230),
+        ObjectKind::Windsock => Rgba32::from_rgb(255, 120, 0),
+        ObjectKind::LightUnit => Rgba32::from_rgb(200, 30, 30),
         ObjectKind::BaggageCart => Rgba32::from_rgb(60, 110, 200),
     }
 }

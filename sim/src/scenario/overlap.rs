@@ -20,7 +20,7 @@ pub fn start_overlap(
     world_from_vehicle: &Isometry2<f64>,
     solid: &Solid,
 ) -> Option<String> {
-    let (lo, hi) = (solid.z_min_m, solid.z_min_m + solid.shape.height_m());
+    let (lo, hi) = solid.shape.z_range_m(solid.z_min_m);
     let footprint = solid_footprint_in_vehicle(solid, world_from_vehicle);
     vehicle.parts.iter().find_map(|part| {
         let (under, top) = (part.underside_m(), part.top_m());
@@ -38,10 +38,35 @@ pub fn start_overlap(
 fn solid_footprint_in_vehicle(solid: &Solid, world_from_vehicle: &Isometry2<f64>) -> Footprint {
     let vehicle_from_world = world_from_vehicle.inverse();
     let center = vehicle_from_world * Point2::new(solid.x_m, solid.y_m);
+    if let Some(part) = solid.shape.as_part() {
+        // The part's footprint in its vehicle frame, placed by the solid, into the vehicle's.
+        let placed =
+            vehicle_from_world * Isometry2::new(Vector2::new(solid.x_m, solid.y_m), solid.yaw_rad);
+        return match part.footprint() {
+            Footprint::Disc(d) => Footprint::Disc(Disc {
+                center: placed * d.center,
+                radius_m: d.radius_m,
+            }),
+            Footprint::Polygon(p) => {
+                let corners: Vec<Point2<f64>> = p.vertices().iter().map(|v| placed * v).collect();
+                ConvexPolygon::hull(&corners).map_or(
+                    Footprint::Disc(Disc {
+                        center,
+                        radius_m: 0.0,
+                    }),
+                    Footprint::Polygon,
+                )
+            }
+        };
+    }
     match solid.shape {
         SolidShape::Cone { radius_m, .. } | SolidShape::Cylinder { radius_m, .. } => {
             Footprint::Disc(Disc { center, radius_m })
         }
+        SolidShape::Part { .. } => Footprint::Disc(Disc {
+            center,
+            radius_m: solid.shape.footprint_radius_m(),
+        }),
         SolidShape::Box { size_m } => {
             let yaw = solid.yaw_rad - world_from_vehicle.rotation.angle();
             let (s, c) = yaw.sin_cos();

@@ -207,6 +207,9 @@ pub struct ObjectSpec {
     pub height_m: Option<Spanned<Positive>>,
     /// LiDAR remission in [0, 1]. Default per kind.
     pub remission: Option<Remission>,
+    /// `parked_aircraft` only: the vehicle description whose collision parts it places (a shipped
+    /// name or a sidecar path). Required for that kind, refused for the others.
+    pub vehicle: Option<Spanned<String>>,
 }
 
 /// `[[patches]]`: a painted rectangle on the ground with its own remission (lines, patches).

@@ -684,7 +684,9 @@ impl Vertical {
                 (radius_m, height_m, false)
             }
             super::scene::SolidShape::Cone { radius_m, height_m } => (radius_m, height_m, true),
-            super::scene::SolidShape::Box { .. } => return None,
+            super::scene::SolidShape::Box { .. } | super::scene::SolidShape::Part { .. } => {
+                return None;
+            }
         };
         Some(Vertical {
             cx: s.x_m,

@@ -466,19 +466,26 @@ impl World {
 
 /// Pose of a solid's collider in the world.
 fn solid_pose(s: &Solid) -> Isometry3<f64> {
+    let yaw = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), s.yaw_rad);
+    if let SolidShape::Part {
+        shape,
+        vehicle_from_part,
+    } = s.shape
+    {
+        let world_from_vehicle = Isometry3::from_parts(Translation3::new(s.x_m, s.y_m, 0.0), yaw);
+        return world_from_vehicle * vehicle_from_part * primitive(&shape).1;
+    }
     let h = s.shape.height_m();
-    let base = Isometry3::from_parts(
-        Translation3::new(s.x_m, s.y_m, s.z_min_m + 0.5 * h),
-        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), s.yaw_rad),
-    );
+    let base = Isometry3::from_parts(Translation3::new(s.x_m, s.y_m, s.z_min_m + 0.5 * h), yaw);
     match s.shape {
-        SolidShape::Box { .. } => base,
+        SolidShape::Box { .. } | SolidShape::Part { .. } => base,
         SolidShape::Cylinder { .. } | SolidShape::Cone { .. } => base * y_up_to_z_up(),
     }
 }
 
 fn solid_collider(s: &Solid) -> ColliderBuilder {
     let builder = match s.shape {
+        SolidShape::Part { shape, .. } => primitive(&shape).0,
         SolidShape::Box { size_m } => ColliderBuilder::cuboid(
             (0.5 * size_m[0]) as f32,
             (0.5 * size_m[1]) as f32,
@@ -497,7 +504,14 @@ fn solid_collider(s: &Solid) -> ColliderBuilder {
 /// A vehicle part's collider, positioned relative to the vehicle body. URDF cylinders and
 /// capsules run along z, parry's along y.
 fn part_collider(part: &Part) -> ColliderBuilder {
-    let (builder, local) = match part.shape {
+    let (builder, local) = primitive(&part.shape);
+    builder.position(to_pose(&(part.vehicle_from_part * local)))
+}
+
+/// A URDF primitive's collider, and the turn from its frame to parry's (cylinders and capsules
+/// run along z in URDF, along y in parry).
+fn primitive(shape: &Shape) -> (ColliderBuilder, Isometry3<f64>) {
+    match *shape {
         Shape::Box { half_extents_m: h } => (
             ColliderBuilder::cuboid(h.x as f32, h.y as f32, h.z as f32),
             Isometry3::identity(),
@@ -520,8 +534,7 @@ fn part_collider(part: &Part) -> ColliderBuilder {
             ColliderBuilder::ball(radius_m as f32),
             Isometry3::identity(),
         ),
-    };
-    builder.position(to_pose(&(part.vehicle_from_part * local)))
+    }
 }
 
 /// A bound on how far a part reaches from its centre, metres.

@@ -26,14 +26,48 @@ pub enum SolidShape {
         /// Height.
         height_m: f64,
     },
+    /// One collision part of a vehicle description (a parked aircraft's wing, engine, fin), in
+    /// any orientation: the solid's x, y and yaw place the vehicle frame (its `z_min_m` is 0).
+    Part {
+        /// The primitive.
+        shape: aircraft::Shape,
+        /// Its pose in the vehicle frame.
+        vehicle_from_part: nalgebra::Isometry3<f64>,
+    },
 }
 
 impl SolidShape {
-    /// Height of the shape, metres.
+    /// Height of the shape's top above its base, metres (a part: above the ground).
     pub fn height_m(&self) -> f64 {
         match *self {
             SolidShape::Box { size_m } => size_m[2],
             SolidShape::Cylinder { height_m, .. } | SolidShape::Cone { height_m, .. } => height_m,
+            SolidShape::Part { .. } => self.as_part().map_or(0.0, |p| p.top_m()),
+        }
+    }
+
+    /// The heights the solid occupies, metres above the ground, for a base at `z_min_m`: a
+    /// part's underside to its top (a wing is not a wall down to the ground).
+    pub fn z_range_m(&self, z_min_m: f64) -> (f64, f64) {
+        match self.as_part() {
+            Some(part) => (part.underside_m(), part.top_m()),
+            None => (z_min_m, z_min_m + self.height_m()),
+        }
+    }
+
+    /// A part shape as an `aircraft::Part` (its footprint, underside and top), `None` otherwise.
+    pub fn as_part(&self) -> Option<aircraft::Part> {
+        match *self {
+            SolidShape::Part {
+                shape,
+                vehicle_from_part,
+            } => Some(aircraft::Part {
+                link: String::new(),
+                collision_index: 0,
+                shape,
+                vehicle_from_part,
+            }),
+            _ => None,
         }
     }
     /// Extent along the object's heading, metres (a box's x size, a round shape's diameter): a
@@ -44,13 +78,22 @@ impl SolidShape {
             SolidShape::Cylinder { radius_m, .. } | SolidShape::Cone { radius_m, .. } => {
                 2.0 * radius_m
             }
+            SolidShape::Part { .. } => 2.0 * self.footprint_radius_m(),
         }
     }
     /// Radius of the smallest vertical cylinder around the shape's axis holding it, metres.
+    /// (A part: around the vehicle frame's origin.)
     pub fn footprint_radius_m(&self) -> f64 {
         match *self {
             SolidShape::Box { size_m } => 0.5 * size_m[0].hypot(size_m[1]),
             SolidShape::Cylinder { radius_m, .. } | SolidShape::Cone { radius_m, .. } => radius_m,
+            SolidShape::Part { .. } => self.as_part().map_or(0.0, |p| {
+                let (low, high) = p.footprint().bounds();
+                [low.x, high.x]
+                    .iter()
+                    .flat_map(|x| [low.y, high.y].map(|y| x.hypot(y)))
+                    .fold(0.0, f64::max)
+            }),
         }
     }
 }
@@ -87,6 +130,16 @@ pub enum ObjectKind {
     BaggageCart,
     /// A fuel truck (a box).
     FuelTruck,
+    /// A parked aircraft's collision part (from a vehicle description: `vehicle = "a320"`).
+    ParkedAircraft,
+    /// An airport sign (a box, sized from its text and size class).
+    Sign,
+    /// A taxiway edge light (a short cylinder).
+    EdgeLight,
+    /// A windsock's mast (a cylinder).
+    Windsock,
+    /// A light unit beside a runway: VASI, PAPI (a box).
+    LightUnit,
 }
 
 impl ObjectKind {
@@ -107,6 +160,11 @@ impl ObjectKind {
             ObjectKind::Tug => "tug",
             ObjectKind::BaggageCart => "baggage_cart",
             ObjectKind::FuelTruck => "fuel_truck",
+            ObjectKind::ParkedAircraft => "parked_aircraft",
+            ObjectKind::Sign => "sign",
+            ObjectKind::EdgeLight => "edge_light",
+            ObjectKind::Windsock => "windsock",
+            ObjectKind::LightUnit => "light_unit",
         }
     }
 
@@ -120,6 +178,8 @@ impl ObjectKind {
                 | ObjectKind::LampPost
                 | ObjectKind::Cylinder
                 | ObjectKind::Person
+                | ObjectKind::EdgeLight
+                | ObjectKind::Windsock
         )
     }
 
@@ -143,7 +203,14 @@ impl ObjectKind {
             ObjectKind::Tug => cuboid(3.0, 1.8, 1.5),
             ObjectKind::BaggageCart => cuboid(2.6, 1.4, 1.0),
             ObjectKind::FuelTruck => cuboid(9.0, 2.5, 3.2),
-            ObjectKind::Building | ObjectKind::Box | ObjectKind::Cylinder => None,
+            ObjectKind::EdgeLight => cylinder(0.06, 0.35),
+            ObjectKind::Windsock => cylinder(0.08, 6.0),
+            ObjectKind::LightUnit => cuboid(0.6, 1.2, 0.9),
+            ObjectKind::Sign => cuboid(0.3, 2.0, 1.07),
+            ObjectKind::Building
+            | ObjectKind::Box
+            | ObjectKind::Cylinder
+            | ObjectKind::ParkedAircraft => None,
         }
     }
 
@@ -161,7 +228,11 @@ impl ObjectKind {
             | ObjectKind::Cylinder
             | ObjectKind::Person
             | ObjectKind::Tug
-            | ObjectKind::FuelTruck => 0.3,
+            | ObjectKind::FuelTruck
+            | ObjectKind::ParkedAircraft
+            | ObjectKind::Windsock => 0.3,
+            ObjectKind::Sign | ObjectKind::LightUnit => 0.6,
+            ObjectKind::EdgeLight => 0.5,
         }
     }
 }

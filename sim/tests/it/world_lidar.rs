@@ -196,7 +196,7 @@ fn surface_residual(solid: &Solid, p: &nalgebra::Point3<f64>) -> f64 {
             (radial - radius_m * (1.0 - p.z / height_m)).abs()
                 * (height_m / radius_m.hypot(height_m))
         }
-        SolidShape::Box { .. } => f64::NAN,
+        SolidShape::Box { .. } | SolidShape::Part { .. } => f64::NAN,
     }
 }
 
@@ -209,7 +209,7 @@ fn surface_distance(solid: &Solid, p: &nalgebra::Point3<f64>) -> f64 {
             radius_m * (1.0 - p.z.clamp(0.0, height_m) / height_m),
             height_m,
         ),
-        SolidShape::Box { .. } => return f64::INFINITY,
+        SolidShape::Box { .. } | SolidShape::Part { .. } => return f64::INFINITY,
     };
     (radial - r).max(0.0).hypot((p.z - h).max(0.0))
 }

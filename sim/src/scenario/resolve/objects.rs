@@ -30,6 +30,24 @@ impl Resolver<'_> {
             let field = format!("objects[{i}]");
             let o_ref = o.get_ref();
             self.claim_id(ids, &o_ref.id, &field)?;
+            if o_ref.kind == ObjectKind::ParkedAircraft {
+                for solid in self.parked_aircraft(o, &field)? {
+                    self.inside_world(world, &field, o_ref.id.span(), solid.x_m, solid.y_m)?;
+                    self.no_start_overlap(vehicle, &solid, &field, o_ref.id.span())?;
+                    objects.push(solid);
+                }
+                continue;
+            }
+            if let Some(v) = &o_ref.vehicle {
+                return Err(self.err(
+                    v.span(),
+                    &format!("{field}.vehicle"),
+                    format!(
+                        "only a parked_aircraft names a vehicle, not a {}",
+                        o_ref.kind.name()
+                    ),
+                ));
+            }
             let shape = self.shape(
                 &field,
                 o.span(),
@@ -235,6 +253,13 @@ impl Resolver<'_> {
         height: &Option<Spanned<Positive>>,
     ) -> Result<SolidShape, LocatedError> {
         let name = kind.name();
+        if kind == ObjectKind::ParkedAircraft {
+            return Err(self.err(
+                table_span,
+                &format!("{field}.kind"),
+                "a parked_aircraft is placed from a vehicle description: only in [[objects]], with vehicle = \"a320\" (or another)",
+            ));
+        }
         let default = kind.default_shape();
         if kind.is_round() {
             if let Some(s) = size {
@@ -296,5 +321,58 @@ impl Resolver<'_> {
                 })?;
             Ok(SolidShape::Box { size_m })
         }
+    }
+
+    /// A `parked_aircraft`: one solid per collision part of its vehicle description, placed by
+    /// the object's x, y and heading (ids `<id>/<link>#<k>`).
+    fn parked_aircraft(
+        &self,
+        o: &Spanned<ObjectSpec>,
+        field: &str,
+    ) -> Result<Vec<Solid>, LocatedError> {
+        let s = o.get_ref();
+        let Some(name) = &s.vehicle else {
+            return Err(self.err(
+                o.span(),
+                &format!("{field}.vehicle"),
+                "a parked_aircraft needs vehicle = \"a320\" (a shipped vehicle or a sidecar path)",
+            ));
+        };
+        for (given, key) in [
+            (s.size_m.is_some(), "size_m"),
+            (s.radius_m.is_some(), "radius_m"),
+            (s.height_m.is_some(), "height_m"),
+            (s.z_min_m.0 != 0.0, "z_min_m"),
+        ] {
+            if given {
+                return Err(self.err(
+                    o.span(),
+                    &format!("{field}.{key}"),
+                    format!("a parked_aircraft's shape is its vehicle's: drop {key}"),
+                ));
+            }
+        }
+        let vehicle = self.load_vehicle(name, &format!("{field}.vehicle"))?;
+        let remission = s
+            .remission
+            .map_or_else(|| ObjectKind::ParkedAircraft.default_remission(), |r| r.0);
+        Ok(vehicle
+            .parts
+            .iter()
+            .map(|part| Solid {
+                id: format!("{}/{}#{}", s.id.get_ref(), part.link, part.collision_index),
+                kind: ObjectKind::ParkedAircraft,
+                shape: SolidShape::Part {
+                    shape: part.shape,
+                    vehicle_from_part: part.vehicle_from_part,
+                },
+                x_m: s.x_m.0,
+                y_m: s.y_m.0,
+                z_min_m: 0.0,
+                yaw_rad: s.yaw_rad.0,
+                remission,
+                runtime: false,
+            })
+            .collect())
     }
 }

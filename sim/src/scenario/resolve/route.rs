@@ -147,23 +147,7 @@ impl Resolver<'_> {
         route: &Route,
         world: &Ground,
     ) -> Result<ScenarioVehicle, LocatedError> {
-        let name = v.description.get_ref();
-        let as_path = self.dir.join(name);
-        let loaded = if aircraft::SHIPPED_VEHICLES.contains(&name.as_str())
-            || (!as_path.exists() && Path::new(name).extension().is_none())
-        {
-            // A shipped name, or neither a name nor a file: the error lists the shipped names.
-            aircraft::Vehicle::shipped(name)
-        } else {
-            aircraft::Vehicle::from_file(&as_path)
-        };
-        let vehicle = loaded.map_err(|e| {
-            self.err(
-                v.description.span(),
-                "vehicle.description",
-                format!("cannot load the vehicle: {e}"),
-            )
-        })?;
+        let vehicle = self.load_vehicle(&v.description, "vehicle.description")?;
         let world_from_start = match &v.start {
             Some(s) => {
                 let p = s.get_ref();
@@ -187,9 +171,27 @@ impl Resolver<'_> {
             }
         };
         Ok(ScenarioVehicle {
-            description: name.clone(),
+            description: v.description.get_ref().clone(),
             vehicle,
             world_from_start,
         })
+    }
+
+    /// A vehicle description: a shipped name or a sidecar path relative to the scenario file.
+    pub(super) fn load_vehicle(
+        &self,
+        name: &Spanned<String>,
+        field: &str,
+    ) -> Result<aircraft::Vehicle, LocatedError> {
+        let as_path = self.dir.join(name.get_ref());
+        let loaded = if aircraft::SHIPPED_VEHICLES.contains(&name.get_ref().as_str())
+            || (!as_path.exists() && Path::new(name.get_ref()).extension().is_none())
+        {
+            // A shipped name, or neither a name nor a file: the error lists the shipped names.
+            aircraft::Vehicle::shipped(name.get_ref())
+        } else {
+            aircraft::Vehicle::from_file(&as_path)
+        };
+        loaded.map_err(|e| self.err(name.span(), field, format!("cannot load the vehicle: {e}")))
     }
 }

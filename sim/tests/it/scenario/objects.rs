@@ -393,3 +393,71 @@ fn row_ids_and_objects_are_checked_like_objects() {
         "`k_1` (container, z 0.00..1.10 m) overlaps the vehicle at its start pose",
     );
 }
+
+/// A `parked_aircraft` places its vehicle's collision parts (at their heights, turned as they are)
+/// as static objects; it needs a vehicle and takes no shape of its own; no other kind names one.
+#[test]
+fn a_parked_aircraft_places_its_vehicles_parts() {
+    let jet = "[[objects]]\nid = \"jet\"\nkind = \"parked_aircraft\"\nx_m = 60.0\ny_m = 30.0\nyaw_rad = 1.25\n";
+    let wide = BASE.replace("max_m = [100.0, 10.0]", "max_m = [100.0, 60.0]");
+    let s = read(&format!("{wide}{jet}vehicle = \"praetor600\"\n")).expect("reads");
+    let parts: Vec<_> = s
+        .objects
+        .iter()
+        .filter(|o| o.kind == ObjectKind::ParkedAircraft)
+        .collect();
+    let vehicle = aircraft::Vehicle::shipped("praetor600").expect("shipped");
+    assert_eq!(parts.len(), vehicle.parts.len());
+    let fin = parts.iter().find(|o| o.id == "jet/fin#0").expect("the fin");
+    assert!(matches!(fin.shape, SolidShape::Part { .. }));
+    let (under, top) = fin.shape.z_range_m(fin.z_min_m);
+    assert!(
+        (under - 2.3).abs() < 0.01 && (top - 6.604).abs() < 0.01,
+        "{under}..{top}"
+    );
+    // Every part is placed by the object's pose; the farthest reach from it (the nose or the tail
+    // cone, about 12 m) bounds each part's footprint.
+    assert!(
+        parts
+            .iter()
+            .all(|o| (o.x_m, o.y_m, o.yaw_rad, o.z_min_m) == (60.0, 30.0, 1.25, 0.0))
+    );
+    let reach = parts
+        .iter()
+        .map(|o| o.shape.footprint_radius_m())
+        .fold(0.0, f64::max);
+    assert!((11.0..12.5).contains(&reach), "{reach}");
+    assert_error(
+        &format!("{wide}{jet}"),
+        "[[objects]]\nid = \"jet\"",
+        "objects[1].vehicle",
+        "a parked_aircraft needs vehicle = \"a320\"",
+    );
+    assert_error(
+        &format!("{wide}{jet}vehicle = \"a320\"\nsize_m = [1, 1, 1]\n"),
+        "[[objects]]\nid = \"jet\"",
+        "objects[1].size_m",
+        "a parked_aircraft's shape is its vehicle's",
+    );
+    assert_error(
+        &format!("{wide}{jet}vehicle = \"b747\"\n"),
+        "\"b747\"",
+        "objects[1].vehicle",
+        "cannot load the vehicle",
+    );
+    let cone =
+        "[[objects]]\nid = \"c\"\nkind = \"cone\"\nx_m = 30.0\ny_m = 5.0\nvehicle = \"a320\"\n";
+    assert_error(
+        &format!("{BASE}{cone}"),
+        "\"a320\"",
+        "objects[1].vehicle",
+        "only a parked_aircraft names a vehicle, not a cone",
+    );
+    let moving = "[[obstacles]]\nid = \"p\"\nkind = \"parked_aircraft\"\nx_m = 30.0\ny_m = 5.0\nexpect = \"stop\"\n";
+    assert_error(
+        &format!("{BASE}{moving}"),
+        "[[obstacles]]\nid = \"p\"",
+        "obstacles[0].kind",
+        "only in [[objects]]",
+    );
+}
