@@ -1,6 +1,7 @@
 //! A network route rounded into a path an aircraft can drive: a fillet (circular arc) at every
-//! corner, as wide as `turn_radius_m` where the legs leave room and never tighter than the
-//! aircraft turns; and the speed pilots taxi at - `straight_speed_m_s` on straights, in turns
+//! corner, as wide as `turn_radius_m` where the legs leave room and the arc stays within
+//! `max_corner_cut_m` of the corner (a junction's pavement), never tighter than the aircraft
+//! turns; and the speed pilots taxi at - `straight_speed_m_s` on straights, in turns
 //! what `lateral_acceleration_m_s2` allows, slowed beforehand at `deceleration_m_s2`.
 
 use nalgebra::Vector2;
@@ -13,6 +14,9 @@ use crate::route::NetworkRoute;
 pub struct PathOptions {
     /// The radius of a turn where there is room (m).
     pub turn_radius_m: f64,
+    /// How far inside a corner the arc may pass (m): a junction's fillet pavement. A sharp turn
+    /// gets a tighter radius (90 degrees and 2.5 m: 6 m), down to the aircraft's tightest.
+    pub max_corner_cut_m: f64,
     /// The aircraft's tightest turn (m): a corner with less room is an error.
     pub min_turn_radius_m: f64,
     /// Speed on straights (m/s).
@@ -38,6 +42,9 @@ pub struct TaxiPath {
 
 /// Longest chord of an arc (m).
 const ARC_CHORD_M: f64 = 1.0;
+/// Longest step along a straight (m): the speed limits between points are interpolated, so a
+/// straight's braking into the next turn needs points along it.
+const STRAIGHT_STEP_M: f64 = 5.0;
 /// Corners turning less than this are left as they are (rad).
 const STRAIGHT_RAD: f64 = 1e-4;
 
@@ -55,7 +62,16 @@ pub fn smooth(route: &NetworkRoute, options: &PathOptions) -> Result<TaxiPath, A
     for i in 1..n.saturating_sub(1) {
         let (u, v) = ((p[i] - p[i - 1]).normalize(), (p[i + 1] - p[i]).normalize());
         deflection[i] = u.dot(&v).clamp(-1.0, 1.0).acos();
-        wanted[i] = options.turn_radius_m * (deflection[i] / 2.0).tan();
+        // The arc's middle lies r (1 / cos(d/2) - 1) inside the corner.
+        let cut_per_m = 1.0 / (deflection[i] / 2.0).cos() - 1.0;
+        let radius = if cut_per_m > 0.0 {
+            options
+                .turn_radius_m
+                .min(options.max_corner_cut_m / cut_per_m)
+        } else {
+            options.turn_radius_m
+        };
+        wanted[i] = radius.max(options.min_turn_radius_m) * (deflection[i] / 2.0).tan();
     }
     // Each leg is shared between its two corners in proportion to what they want of it.
     let mut tangent = wanted.clone();
@@ -105,6 +121,7 @@ pub fn smooth(route: &NetworkRoute, options: &PathOptions) -> Result<TaxiPath, A
         let pieces = ((radius * deflection[i] / ARC_CHORD_M).ceil() as usize).max(1);
         let start_angle = (a - centre).y.atan2((a - centre).x);
         let sweep = if left { deflection[i] } else { -deflection[i] };
+        straight_to(&mut points, &mut curvature, a);
         push(&mut points, &mut curvature, a, 1.0 / radius);
         for k in 1..pieces {
             let angle = start_angle + sweep * k as f64 / pieces as f64;
@@ -117,6 +134,7 @@ pub fn smooth(route: &NetworkRoute, options: &PathOptions) -> Result<TaxiPath, A
         }
         push(&mut points, &mut curvature, b, 0.0);
     }
+    straight_to(&mut points, &mut curvature, p[n - 1]);
     push(&mut points, &mut curvature, p[n - 1], 0.0);
     let speed_m_s = speeds(&points, &curvature, options);
     let length_m = points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
@@ -126,6 +144,20 @@ pub fn smooth(route: &NetworkRoute, options: &PathOptions) -> Result<TaxiPath, A
         tightest_radius_m: tightest,
         length_m,
     })
+}
+
+/// Points every [`STRAIGHT_STEP_M`] from the last point toward `to` (`to` left out).
+fn straight_to(points: &mut Vec<Vector2<f64>>, curvature: &mut Vec<f64>, to: Vector2<f64>) {
+    let Some(&from) = points.last() else { return };
+    let steps = ((to - from).norm() / STRAIGHT_STEP_M).ceil() as usize;
+    for k in 1..steps {
+        push(
+            points,
+            curvature,
+            from + (to - from) * (k as f64 / steps as f64),
+            0.0,
+        );
+    }
 }
 
 /// Adds a point (the curvature is that of the piece leaving it), skipping one on the last.

@@ -10,6 +10,8 @@ pub struct RoutePath {
     /// Arc length at each point (and at the closing point for a closed route).
     s: Vec<f64>,
     closed: bool,
+    /// A speed limit at each point (m/s), if the route has them.
+    speed_limits: Option<Vec<f64>>,
 }
 
 impl RoutePath {
@@ -28,7 +30,29 @@ impl RoutePath {
             points: pts,
             s,
             closed,
+            speed_limits: None,
         }
+    }
+
+    /// The route with a speed limit at each of its points (m/s; a taxi route's turns, braked
+    /// into). `None`, or a list of another length than the points, leaves it without.
+    #[must_use]
+    pub fn with_speed_limits(mut self, limits: Option<Vec<f64>>) -> Self {
+        let count = self.points.len() - usize::from(self.closed);
+        self.speed_limits = limits.filter(|l| l.len() == count && !self.closed);
+        self
+    }
+
+    /// The speed limit at arc length `s`, interpolated between points (infinite without limits).
+    pub fn speed_limit_at(&self, s: f64) -> f64 {
+        let Some(limits) = &self.speed_limits else {
+            return f64::INFINITY;
+        };
+        let s = self.wrap(s);
+        let i = self.segment(s);
+        let span = (self.s[i + 1] - self.s[i]).max(1e-12);
+        let t = ((s - self.s[i]) / span).clamp(0.0, 1.0);
+        limits[i] + (limits[i + 1] - limits[i]) * t
     }
     /// Total length, metres.
     pub fn length_m(&self) -> f64 {
@@ -150,6 +174,24 @@ mod tests {
         );
         let (_, d) = r.project(&Point2::new(5.0, -1.0), 5.0, 10.0);
         assert!((d + 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn speed_limits_are_interpolated_along_the_route_and_only_where_given() {
+        let pts = [
+            Point2::new(0.0, 0.0),
+            Point2::new(10.0, 0.0),
+            Point2::new(10.0, 10.0),
+        ];
+        let r = RoutePath::new(&pts, false).with_speed_limits(Some(vec![6.0, 4.0, 6.0]));
+        assert_eq!(r.speed_limit_at(0.0), 6.0);
+        assert!((r.speed_limit_at(5.0) - 5.0).abs() < 1e-12);
+        assert!((r.speed_limit_at(15.0) - 5.0).abs() < 1e-12);
+        assert_eq!(r.speed_limit_at(30.0), 6.0, "clamped at the end");
+        let unlimited = RoutePath::new(&pts, false);
+        assert_eq!(unlimited.speed_limit_at(5.0), f64::INFINITY);
+        let wrong_count = RoutePath::new(&pts, false).with_speed_limits(Some(vec![1.0]));
+        assert_eq!(wrong_count.speed_limit_at(5.0), f64::INFINITY);
     }
 
     /// The windowed search (bisection on arc length) agrees with testing every segment.

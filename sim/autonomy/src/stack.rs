@@ -268,7 +268,9 @@ impl Driver {
         let sigma_m = estimate.lateral_sigma_at_m(self.reach_m);
         let (mut config, speed_factor) = self.config.under_uncertainty(sigma_m);
         let decel = self.vehicle.deceleration_m_s2;
-        let wanted = (self.wanted_speed_m_s * speed_factor).min(speed_cap_m_s(decel, &config).0);
+        let wanted = (self.wanted_speed_m_s * speed_factor)
+            .min(self.route.speed_limit_at(s))
+            .min(speed_cap_m_s(decel, &config).0);
         config.horizon_m = horizon_for_m(wanted, decel, &config);
         let mut p = plan(
             &checker,

@@ -11,6 +11,9 @@ use crate::error::{Error, Result};
 /// Radius of a turn where the legs leave room (m). Airliners at Zurich turn on a median radius of
 /// about 39 m (FACTS.md); junctions here are often tighter, so 30 m.
 pub const DEFAULT_TURN_RADIUS_M: f64 = 30.0;
+/// How far inside a junction's corner a turn may pass (m): about a taxiway's half width less the
+/// main gear's margin for code B and C (Annex 14: 10.5 m and 15 m wide, 2.25 m and 3 m margins).
+pub const MAX_CORNER_CUT_M: f64 = 2.5;
 /// Taxi speed on straights (m/s): Zurich's median ground speed is 6.0 m/s (FACTS.md).
 pub const DEFAULT_TAXI_SPEED_M_S: f64 = 6.0;
 
@@ -101,6 +104,7 @@ pub fn plan_taxi(
     let motion = &vehicle.spec.motion;
     let options = PathOptions {
         turn_radius_m: turn_radius_m.max(vehicle.min_turn_radius_m()),
+        max_corner_cut_m: MAX_CORNER_CUT_M,
         min_turn_radius_m: vehicle.min_turn_radius_m(),
         straight_speed_m_s: speed_m_s.min(motion.max_speed_m_s),
         lateral_acceleration_m_s2: motion.max_centripetal_acceleration_m_s2,

@@ -97,6 +97,7 @@ pub fn lidar_scene() -> crate::world::Scene {
         pavement_texture: 0.0,
         solids,
         patches: Vec::new(),
+        areas: Vec::new(),
     }
 }
 

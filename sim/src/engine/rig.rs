@@ -217,7 +217,8 @@ impl<'a> Rig<'a> {
             .iter()
             .map(|p| aircraft::fit::level_of(p.underside_m(), &heights))
             .collect();
-        let route = RoutePath::new(&scenario.route.waypoints_m, scenario.route.closed);
+        let route = RoutePath::new(&scenario.route.waypoints_m, scenario.route.closed)
+            .with_speed_limits(scenario.route.speed_limits_m_s.clone());
         let start = scenario.vehicle.world_from_start;
         let scene = scenario.full_scene();
         let mut world = World::with_obstacles(&scene, vehicle, &start);

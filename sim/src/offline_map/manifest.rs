@@ -42,8 +42,14 @@ pub fn fingerprint(scenario: &Scenario, config: &RunConfig) -> Result<String> {
         source,
     })?);
     // The world as resolved (a default the code changes, like the pavement's texture, is not in
-    // the file).
-    h.update(format!("{:?}{:?}", scenario.world, scenario.patches).as_bytes());
+    // the file; an airport's ground and objects come from its apt.dat).
+    h.update(
+        format!(
+            "{:?}{:?}{:?}",
+            scenario.world, scenario.patches, scenario.objects
+        )
+        .as_bytes(),
+    );
     h.update(format!("{:?}", scenario.vehicle.vehicle).as_bytes());
     h.update(format!("{:?}", levels_of(scenario, config)?).as_bytes());
     h.update(format!("{:?}{:?}{MAP_FORMAT}", map_config(config), config.lidar).as_bytes());

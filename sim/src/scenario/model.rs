@@ -25,6 +25,8 @@ pub struct Ground {
     pub ground_remission: f32,
     /// Amplitude of the pavement's texture (`[world] pavement_texture`).
     pub pavement_texture: f32,
+    /// Paved areas (an airport's pavement and runways), over the bare ground.
+    pub areas: Vec<crate::world::Area>,
 }
 
 /// The vehicle of a scenario.
@@ -49,6 +51,8 @@ pub struct Route {
     pub closed: bool,
     /// Target speed, m/s.
     pub speed_m_s: f64,
+    /// A speed limit at each waypoint, m/s (a taxi route's turns, braked into), if any.
+    pub speed_limits_m_s: Option<Vec<f64>>,
 }
 
 impl Route {
@@ -431,6 +435,7 @@ impl Scenario {
             pavement_texture: self.world.pavement_texture,
             solids,
             patches: self.patches.clone(),
+            areas: self.world.areas.clone(),
         }
     }
 }

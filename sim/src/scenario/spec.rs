@@ -36,8 +36,10 @@ pub struct ScenarioFile {
     /// How many times the route is driven (a closed route loops). Integer >= 1, default 1.
     #[serde(default)]
     pub laps: Laps,
-    /// The ground. Required.
-    pub world: WorldSpec,
+    /// The ground. Required unless `[airport]` is given (then the airport's extent, on grass).
+    pub world: Option<WorldSpec>,
+    /// A real airport's ground and objects from an X-Plane apt.dat.
+    pub airport: Option<Spanned<AirportSpec>>,
     /// The vehicle and its start pose. Required.
     pub vehicle: VehicleEntry,
     /// The route to follow. Required.
@@ -146,10 +148,64 @@ pub struct StartPose {
     pub yaw_rad: Finite,
 }
 
-/// `[route]`: the path the vehicle follows. Exactly one of `waypoints_m` and `pose_file`.
+/// `[airport]`: an apt.dat airport as the world: its pavement, runways and painted lines on the
+/// ground, its signs and lights, parked aircraft at its stands.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AirportSpec {
+    /// The apt.dat file, relative to the scenario file's directory. Required.
+    pub file: Spanned<String>,
+    /// The airport's code, when the file holds several.
+    pub code: Option<String>,
+    /// Its signs as objects. Default true.
+    #[serde(default = "yes")]
+    pub signs: bool,
+    /// Its light units, windsocks and taxiway edge lights as objects. Default true.
+    #[serde(default = "yes")]
+    pub lights: bool,
+    /// A tug and a baggage cart beside each parked aircraft. Default false.
+    #[serde(default)]
+    pub ground_equipment: bool,
+    /// Aircraft parked at stands.
+    #[serde(default)]
+    pub parked: Vec<Spanned<ParkedSpec>>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// `[[airport.parked]]`: an aircraft parked at a stand.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParkedSpec {
+    /// The stand's name, as the file has it. Required.
+    pub stand: Spanned<String>,
+    /// A vehicle description (shipped name or sidecar path). Required.
+    pub vehicle: Spanned<String>,
+}
+
+/// `route.taxi`: a route on the airport's taxi network.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TaxiSpec {
+    /// A stand's name, `node <id>` or `runway <number>` (vacating it). Required.
+    pub from: String,
+    /// `runway <number>` (its hold point), a stand's name or `node <id>`. Required.
+    pub to: String,
+    /// Taxiways to follow in order. Default none.
+    #[serde(default)]
+    pub via: Vec<String>,
+}
+
+/// `[route]`: the path the vehicle follows. Exactly one of `waypoints_m`, `pose_file` and `taxi`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RouteSpec {
+    /// A taxi route on the `[airport]`'s network: from, to, via.
+    pub taxi: Option<Spanned<TaxiSpec>>,
+    /// With `taxi`: the radius of a turn where the legs leave room, metres. Default 30.
+    pub turn_radius_m: Option<Positive>,
     /// Waypoints `[[x, y], ...]`, metres; at least 2 (3 when closed), no two consecutive equal.
     pub waypoints_m: Option<Spanned<Vec<[Finite; 2]>>>,
     /// A pose file, relative to the scenario file's directory: one pose a line,

@@ -403,6 +403,7 @@ mod tests {
             .collect();
         solids.push(solid("hangar", ObjectKind::Building, 100.0));
         let scene = Scene {
+            areas: Vec::new(),
             min_m: [-10.0, -10.0],
             max_m: [200.0, 50.0],
             solids,

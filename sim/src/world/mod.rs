@@ -20,4 +20,4 @@ pub use lidar::{Lidar, LidarConfig, LidarScan, SweepPoses};
 pub use motion::{Bicycle, Command, VehicleState, wrap_angle};
 pub use odometry::{OdometryConfig, OdometrySensor};
 pub use physics::{Contact, Owner, World, planar_to_3d, to_pose};
-pub use scene::{GroundTexture, ObjectKind, Patch, Scene, Solid, SolidShape, pavement};
+pub use scene::{Area, GroundTexture, ObjectKind, Patch, Scene, Solid, SolidShape, pavement};

@@ -289,6 +289,41 @@ impl Patch {
     }
 }
 
+/// A painted or paved area of the ground: a polygon with holes (an airport's pavement, a
+/// runway), its own remission. Later areas cover earlier ones; patches cover areas.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Area {
+    /// Unique name.
+    pub id: String,
+    /// The outline, metres (either winding; not closed by repeating its first point).
+    pub outline: Vec<[f64; 2]>,
+    /// Holes in it.
+    pub holes: Vec<Vec<[f64; 2]>>,
+    /// LiDAR remission in [0, 1].
+    pub remission: f32,
+}
+
+impl Area {
+    /// True when the ground point (x, y) lies in the area (even-odd over the outline and holes).
+    pub fn contains(&self, x: f64, y: f64) -> bool {
+        std::iter::once(&self.outline)
+            .chain(&self.holes)
+            .map(|ring| crossings(ring, y).filter(|&cx| cx > x).count())
+            .sum::<usize>()
+            % 2
+            == 1
+    }
+}
+
+/// Where a ring's edges cross the line at height `y` (half-open in y, so a vertex is counted once).
+fn crossings(ring: &[[f64; 2]], y: f64) -> impl Iterator<Item = f64> + '_ {
+    let n = ring.len();
+    (0..n).filter_map(move |i| {
+        let (a, b) = (ring[i], ring[(i + 1) % n]);
+        ((a[1] <= y) != (b[1] <= y)).then(|| a[0] + (y - a[1]) / (b[1] - a[1]) * (b[0] - a[0]))
+    })
+}
+
 /// The whole static description of a world.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Scene {
@@ -304,19 +339,28 @@ pub struct Scene {
     pub pavement_texture: f32,
     /// Solid objects (static and run-time).
     pub solids: Vec<Solid>,
-    /// Painted markings (later ones paint over earlier ones).
+    /// Painted markings (later ones paint over earlier ones and over the areas).
     pub patches: Vec<Patch>,
+    /// Paved or painted areas (polygons; later ones cover earlier ones).
+    pub areas: Vec<Area>,
 }
 
 impl Scene {
     /// Remission of the ground at (x, y): the last patch holding the point, else bare ground.
     pub fn ground_remission_at(&self, x: f64, y: f64) -> f32 {
+        let area = || {
+            self.areas
+                .iter()
+                .rev()
+                .find(|a| a.contains(x, y))
+                .map_or(self.ground_remission, |a| a.remission)
+        };
         let base = self
             .patches
             .iter()
             .rev()
             .find(|p| p.contains(x, y))
-            .map_or(self.ground_remission, |p| p.remission);
+            .map_or_else(area, |p| p.remission);
         pavement(base, self.pavement_texture, x, y)
     }
 
@@ -350,6 +394,7 @@ impl Scene {
             pavement_texture: self.pavement_texture,
             patches,
             bins,
+            areas: AreaRows::new(&self.areas),
         }
     }
 }
@@ -389,6 +434,80 @@ pub struct GroundTexture {
     /// Last painted first.
     patches: Vec<PreparedPatch>,
     bins: PatchBins,
+    areas: AreaRows,
+}
+
+/// The areas cut into rows of [`AREA_ROW_M`]: each row's disjoint x intervals with the remission
+/// of the last area covering them at the row's middle (an area's edge is placed to within half a
+/// row in y, exactly in x). A point outside every row is on no area.
+#[derive(Clone, Debug, Default)]
+struct AreaRows {
+    y0: f64,
+    /// Row r's intervals, sorted: `(x_from, x_to, remission)`.
+    rows: Vec<Vec<(f64, f64, f32)>>,
+}
+
+/// Height of a row of [`AreaRows`], metres.
+pub const AREA_ROW_M: f64 = 0.25;
+
+impl AreaRows {
+    fn new(areas: &[Area]) -> Self {
+        let ys = areas.iter().flat_map(|a| a.outline.iter().map(|p| p[1]));
+        let (lo, hi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), y| {
+            (l.min(y), h.max(y))
+        });
+        if !(lo.is_finite() && hi.is_finite()) {
+            return Self::default();
+        }
+        let count = ((hi - lo) / AREA_ROW_M).ceil() as usize + 1;
+        let rows = (0..count)
+            .map(|r| Self::row(areas, lo + (r as f64 + 0.5) * AREA_ROW_M))
+            .collect();
+        Self { y0: lo, rows }
+    }
+
+    /// One row: each area's even-odd intervals, the later over the earlier.
+    fn row(areas: &[Area], y: f64) -> Vec<(f64, f64, f32)> {
+        let mut row: Vec<(f64, f64, f32)> = Vec::new();
+        for area in areas {
+            let mut xs: Vec<f64> = std::iter::once(&area.outline)
+                .chain(&area.holes)
+                .flat_map(|ring| crossings(ring, y))
+                .collect();
+            xs.sort_by(f64::total_cmp);
+            for pair in xs.chunks_exact(2) {
+                let (from, to) = (pair[0], pair[1]);
+                // Cut what it covers out of the row, then put it in.
+                let mut next = Vec::with_capacity(row.len() + 2);
+                for &(a, b, r) in &row {
+                    if b <= from || a >= to {
+                        next.push((a, b, r));
+                        continue;
+                    }
+                    if a < from {
+                        next.push((a, from, r));
+                    }
+                    if b > to {
+                        next.push((to, b, r));
+                    }
+                }
+                next.push((from, to, area.remission));
+                next.sort_by(|p, q| p.0.total_cmp(&q.0));
+                row = next;
+            }
+        }
+        row
+    }
+
+    fn at(&self, x: f64, y: f64) -> Option<f32> {
+        let r = (y - self.y0) / AREA_ROW_M;
+        if !(r >= 0.0 && r < self.rows.len() as f64) {
+            return None;
+        }
+        let row = &self.rows[r as usize];
+        let i = row.partition_point(|iv| iv.1 <= x);
+        row.get(i).filter(|iv| iv.0 <= x).map(|iv| iv.2)
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -510,17 +629,17 @@ impl GroundTexture {
                 return pavement(p.remission, self.pavement_texture, x, y);
             }
         }
-        pavement(self.ground_remission, self.pavement_texture, x, y)
+        let base = self.areas.at(x, y).unwrap_or(self.ground_remission);
+        pavement(base, self.pavement_texture, x, y)
     }
 
     /// [`Self::remission_at`] trying every patch, the straightforward way (for tests).
     #[cfg(test)]
     fn remission_at_every_patch(&self, x: f64, y: f64) -> f32 {
-        let base = self
-            .patches
-            .iter()
-            .find(|p| p.contains(x, y))
-            .map_or(self.ground_remission, |p| p.remission);
+        let base = self.patches.iter().find(|p| p.contains(x, y)).map_or_else(
+            || self.areas.at(x, y).unwrap_or(self.ground_remission),
+            |p| p.remission,
+        );
         pavement(base, self.pavement_texture, x, y)
     }
 }
@@ -578,6 +697,7 @@ mod tests {
             remission,
         };
         let scene = Scene {
+            areas: Vec::new(),
             min_m: [-20.0, -20.0],
             max_m: [20.0, 20.0],
             ground_remission: 0.2,
@@ -610,5 +730,62 @@ mod tests {
             painted > 5_000,
             "the patches cover part of the sweep: {painted}"
         );
+    }
+
+    /// Areas: a pavement with a hole, a runway across it, a patch on top. The rows give what the
+    /// polygons give on each row's middle line, exactly in x, and nothing outside them.
+    #[test]
+    fn area_rows_give_the_polygons_remission_on_their_middle_lines() {
+        let scene = Scene {
+            min_m: [-50.0, -50.0],
+            max_m: [50.0, 50.0],
+            ground_remission: 0.1,
+            pavement_texture: 0.0,
+            solids: Vec::new(),
+            patches: vec![Patch {
+                id: "line".into(),
+                x_m: 0.0,
+                y_m: 0.0,
+                yaw_rad: 0.3,
+                length_m: 20.0,
+                width_m: 0.2,
+                remission: 0.9,
+            }],
+            areas: vec![
+                Area {
+                    id: "apron".into(),
+                    outline: vec![[-30.0, -20.0], [25.0, -25.0], [30.0, 20.0], [-20.0, 30.0]],
+                    holes: vec![vec![[-5.0, -5.0], [5.0, -5.0], [0.0, 8.0]]],
+                    remission: 0.35,
+                },
+                Area {
+                    id: "runway".into(),
+                    outline: vec![[-40.0, 10.0], [40.0, 14.0], [40.0, 19.0], [-40.0, 15.0]],
+                    holes: Vec::new(),
+                    remission: 0.2,
+                },
+            ],
+        };
+        let texture = scene.ground_texture();
+        let mut seen = [0usize; 4];
+        for r in 0..400 {
+            let y = texture.areas.y0 + (r as f64 + 0.5) * AREA_ROW_M;
+            for k in 0..200 {
+                let x = -45.0 + 0.4513 * k as f64;
+                let want = scene.ground_remission_at(x, y);
+                assert_eq!(texture.remission_at(x, y), want, "({x}, {y})");
+                let i = [0.1, 0.35, 0.2, 0.9]
+                    .iter()
+                    .position(|&v| v == want)
+                    .unwrap();
+                seen[i] += 1;
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 20), "{seen:?}");
+        // The hole is bare ground, the apron around it concrete.
+        let y0 = texture.areas.y0;
+        let middle = y0 + (((0.0 - y0) / AREA_ROW_M).floor() + 0.5) * AREA_ROW_M;
+        assert_eq!(texture.remission_at(0.0, middle), 0.1);
+        assert_eq!(texture.remission_at(-10.0, middle), 0.35);
     }
 }

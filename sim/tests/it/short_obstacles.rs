@@ -30,6 +30,7 @@ fn debris_at(x_m: f64) -> Scene {
             runtime: true,
         }],
         patches: vec![],
+        areas: Vec::new(),
     }
 }
 

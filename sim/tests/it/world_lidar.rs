@@ -29,6 +29,7 @@ fn scene(solids: Vec<Solid>) -> Scene {
         pavement_texture: 0.0,
         solids,
         patches: vec![],
+        areas: Vec::new(),
     }
 }
 

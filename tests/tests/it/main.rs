@@ -3,6 +3,7 @@
 //! localization, overhead structures, permanence of what is unseen, the failures the campaigns
 //! found, traffic, the distance cap and the mapping demo.
 
+mod airports;
 mod closed_loop;
 mod common;
 mod demo;

@@ -93,6 +93,7 @@ fn ksyr_routes_from_a_gate_to_runway_28() {
         &route,
         &PathOptions {
             turn_radius_m: 30.0,
+            max_corner_cut_m: 2.5,
             min_turn_radius_m: 12.0,
             straight_speed_m_s: 8.0,
             lateral_acceleration_m_s2: 1.0,

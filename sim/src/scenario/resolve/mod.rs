@@ -5,6 +5,7 @@
 //! the field, with the offending line quoted. This file holds the entry ([`Resolver::resolve`])
 //! and the helpers the parts share: ids, the world and its bounds, polylines, the start overlap.
 
+mod airport;
 mod motion;
 mod objects;
 mod route;
@@ -40,14 +41,43 @@ impl Resolver<'_> {
         spec: ScenarioFile,
         path: &Path,
     ) -> Result<Scenario, LocatedError> {
-        let world = self.world(&spec.world)?;
-        let route = self.route(&spec.route, &world)?;
+        let airport = spec
+            .airport
+            .as_ref()
+            .map(|a| self.load_airport(a))
+            .transpose()?;
+        let mut world = match (&spec.world, &airport) {
+            (Some(w), _) => self.world(w)?,
+            (None, Some(loaded)) => Self::airport_ground(loaded),
+            (None, None) => {
+                return Err(self.err(
+                    0..0,
+                    "world",
+                    "missing [world] (min_m, max_m), or an [airport] to take it from",
+                ));
+            }
+        };
+        if let Some(loaded) = &airport {
+            world.areas.clone_from(&loaded.made.areas);
+        }
+        let route = match &spec.route.get_ref().taxi {
+            Some(taxi) => {
+                self.taxi_route(&spec.route, taxi, airport.as_ref(), &spec.vehicle, &world)?
+            }
+            None => self.route(&spec.route, &world)?,
+        };
         let vehicle = self.vehicle(&spec.vehicle, &route, &world)?;
         // Every id, with who uses it (as error messages name it).
         let mut ids: HashMap<String, String> = HashMap::new();
-        let mut objects = self.objects(&spec.objects, &world, &vehicle, &mut ids)?;
+        let (mut objects, mut patches) = match (&spec.airport, &airport) {
+            (Some(a), Some(loaded)) => {
+                self.airport_objects(a, loaded, &world, &vehicle, &mut ids)?
+            }
+            _ => (Vec::new(), Vec::new()),
+        };
+        objects.extend(self.objects(&spec.objects, &world, &vehicle, &mut ids)?);
         self.rows(&spec.rows, &world, &route, &vehicle, &mut ids, &mut objects)?;
-        let patches = self.patches(&spec.patches, &world, &mut ids)?;
+        patches.extend(self.patches(&spec.patches, &world, &mut ids)?);
         let obstacles = self.obstacles(&spec.obstacles, &world, &vehicle, &mut ids)?;
         if let Some(c) = &spec.config {
             crate::scenario::RunConfig::from_table(c.get_ref().clone())
@@ -131,6 +161,7 @@ impl Resolver<'_> {
             max_m,
             ground_remission: w.ground_remission.0,
             pavement_texture: w.pavement_texture.0,
+            areas: Vec::new(),
         })
     }
 

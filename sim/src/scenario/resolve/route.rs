@@ -69,11 +69,15 @@ impl Resolver<'_> {
                 ));
             }
         }
+        if spec.turn_radius_m.is_some() {
+            return Err(self.err(span, "route.turn_radius_m", "turn_radius_m goes with taxi"));
+        }
         Ok(Route {
             waypoints_m,
             yaws_rad,
             closed: spec.closed,
             speed_m_s: spec.speed_m_s.0,
+            speed_limits_m_s: None,
         })
     }
 

@@ -5,6 +5,7 @@
 //! (`shipped`). Every mistake is an error naming the file, the line, the column and the field;
 //! this module holds the valid scenario the error cases edit and the assertions on the errors.
 
+mod airport;
 mod objects;
 mod obstacles;
 mod reading;

@@ -1,0 +1,270 @@
+//! The resolver's airport: the `[airport]` file read, the world taken from it (its extent on grass
+//! unless `[world]` crops it), its ground areas, painted lines, signs and lights, the aircraft
+//! parked at its stands, and `route.taxi` planned on its network.
+
+use std::collections::HashMap;
+
+use airport::Airport;
+use nalgebra::{Point2, Vector2};
+use toml::Spanned;
+
+use super::Resolver;
+use crate::airports::{AirportWorld, Furniture, GRASS_REMISSION, airport_world, plan_taxi};
+use crate::scenario::model::{Ground, Route, ScenarioVehicle};
+use crate::scenario::spec::{AirportSpec, RouteSpec, TaxiSpec, VehicleEntry};
+use crate::toml_file::LocatedError;
+use crate::world::{ObjectKind, Patch, Solid, SolidShape};
+
+/// Grass beyond the airport's extent in a world taken from it, metres.
+const MARGIN_M: f64 = 100.0;
+
+/// An `[airport]` read and made a world.
+pub(super) struct LoadedAirport {
+    pub airport: Airport,
+    pub made: AirportWorld,
+}
+
+impl Resolver<'_> {
+    pub(super) fn load_airport(
+        &self,
+        spec: &Spanned<AirportSpec>,
+    ) -> Result<LoadedAirport, LocatedError> {
+        let a = spec.get_ref();
+        let path = self.dir.join(a.file.get_ref());
+        let airport = Airport::read(&path, a.code.as_deref()).map_err(|e| {
+            self.err(
+                a.file.span(),
+                "airport.file",
+                format!("cannot read the airport: {e}"),
+            )
+        })?;
+        let made = airport_world(
+            &airport,
+            Furniture {
+                signs: a.signs,
+                lights: a.lights,
+            },
+        );
+        Ok(LoadedAirport { airport, made })
+    }
+
+    /// The world of an airport scenario without `[world]`: its extent and a margin, on grass.
+    pub(super) fn airport_ground(loaded: &LoadedAirport) -> Ground {
+        let (low, high) = loaded.airport.extent();
+        Ground {
+            min_m: [low.x - MARGIN_M, low.y - MARGIN_M],
+            max_m: [high.x + MARGIN_M, high.y + MARGIN_M],
+            ground_remission: GRASS_REMISSION,
+            pavement_texture: 0.05,
+            areas: Vec::new(),
+        }
+    }
+
+    /// `route.taxi`: the taxi route planned for the vehicle on the airport's network.
+    pub(super) fn taxi_route(
+        &self,
+        r: &Spanned<RouteSpec>,
+        taxi: &Spanned<TaxiSpec>,
+        loaded: Option<&LoadedAirport>,
+        vehicle: &VehicleEntry,
+        world: &Ground,
+    ) -> Result<Route, LocatedError> {
+        let spec = r.get_ref();
+        if let Some(span) = spec
+            .waypoints_m
+            .as_ref()
+            .map(Spanned::span)
+            .or_else(|| spec.pose_file.as_ref().map(Spanned::span))
+        {
+            return Err(self.err(
+                span,
+                "route.taxi",
+                "give one of waypoints_m, pose_file and taxi",
+            ));
+        }
+        if spec.closed {
+            return Err(self.err(taxi.span(), "route.closed", "a taxi route is not closed"));
+        }
+        let Some(loaded) = loaded else {
+            return Err(self.err(taxi.span(), "route.taxi", "a taxi route needs an [airport]"));
+        };
+        let t = taxi.get_ref();
+        let description = self.load_vehicle(&vehicle.description, "vehicle.description")?;
+        let turn_radius_m = spec
+            .turn_radius_m
+            .map_or(crate::airports::DEFAULT_TURN_RADIUS_M, |r| r.0);
+        let planned = plan_taxi(
+            &loaded.airport,
+            &description,
+            &t.from,
+            &t.to,
+            &t.via,
+            turn_radius_m,
+            spec.speed_m_s.0,
+        )
+        .map_err(|e| self.err(taxi.span(), "route.taxi", e.to_string()))?;
+        let waypoints_m: Vec<Point2<f64>> = planned
+            .path
+            .points
+            .iter()
+            .map(|p| Point2::new(p.x, p.y))
+            .collect();
+        if let Some(p) = waypoints_m.iter().find(|p| {
+            p.x < world.min_m[0]
+                || p.x > world.max_m[0]
+                || p.y < world.min_m[1]
+                || p.y > world.max_m[1]
+        }) {
+            return Err(self.err(
+                taxi.span(),
+                "route.taxi",
+                format!(
+                    "the route passes ({:.1}, {:.1}), outside the world",
+                    p.x, p.y
+                ),
+            ));
+        }
+        Ok(Route {
+            yaws_rad: vec![None; waypoints_m.len()],
+            waypoints_m,
+            closed: false,
+            speed_m_s: spec.speed_m_s.0,
+            speed_limits_m_s: Some(planned.path.speed_m_s.clone()),
+        })
+    }
+
+    /// The airport's objects inside the world (signs, lights; ids claimed), the aircraft parked at
+    /// its stands and their ground equipment; and its painted lines inside the world.
+    pub(super) fn airport_objects(
+        &self,
+        spec: &Spanned<AirportSpec>,
+        loaded: &LoadedAirport,
+        world: &Ground,
+        vehicle: &ScenarioVehicle,
+        ids: &mut HashMap<String, String>,
+    ) -> Result<(Vec<Solid>, Vec<Patch>), LocatedError> {
+        let inside = |x: f64, y: f64| {
+            x >= world.min_m[0] && x <= world.max_m[0] && y >= world.min_m[1] && y <= world.max_m[1]
+        };
+        let mut solids = Vec::new();
+        for solid in loaded.made.solids.iter().filter(|s| inside(s.x_m, s.y_m)) {
+            self.claim(
+                ids,
+                &solid.id,
+                spec.span(),
+                "airport",
+                format!("the airport's {}", solid.kind.name()),
+                "",
+            )?;
+            self.no_start_overlap(vehicle, solid, "airport", spec.span())?;
+            solids.push(solid.clone());
+        }
+        for (i, parked) in spec.get_ref().parked.iter().enumerate() {
+            let field = format!("airport.parked[{i}]");
+            let p = parked.get_ref();
+            let stand = loaded.airport.stand(p.stand.get_ref()).ok_or_else(|| {
+                let names: Vec<&str> = loaded
+                    .airport
+                    .stands
+                    .iter()
+                    .map(|s| s.name.as_str())
+                    .collect();
+                self.err(
+                    p.stand.span(),
+                    &format!("{field}.stand"),
+                    format!(
+                        "no stand `{}` at {} (its stands: {names:?})",
+                        p.stand.get_ref(),
+                        loaded.airport.code
+                    ),
+                )
+            })?;
+            let description = self.load_vehicle(&p.vehicle, &format!("{field}.vehicle"))?;
+            let id = format!("stand_{}", stand.name.replace(' ', "_"));
+            self.claim(
+                ids,
+                &id,
+                p.stand.span(),
+                &format!("{field}.stand"),
+                format!("`{field}`"),
+                "",
+            )?;
+            let mut here = parked_parts(&id, &description, stand.at, stand.yaw_rad);
+            if spec.get_ref().ground_equipment {
+                here.extend(ground_equipment(
+                    &id,
+                    description.span_m(),
+                    stand.at,
+                    stand.yaw_rad,
+                ));
+            }
+            for solid in here {
+                self.inside_world(world, &field, p.stand.span(), solid.x_m, solid.y_m)?;
+                self.no_start_overlap(vehicle, &solid, &field, p.stand.span())?;
+                solids.push(solid);
+            }
+        }
+        let patches = loaded
+            .made
+            .patches
+            .iter()
+            .filter(|p| inside(p.x_m, p.y_m))
+            .cloned()
+            .collect();
+        Ok((solids, patches))
+    }
+}
+
+/// A parked aircraft's collision parts at a stand (its vehicle frame on the stand's point).
+fn parked_parts(
+    id: &str,
+    vehicle: &aircraft::Vehicle,
+    at: Vector2<f64>,
+    yaw_rad: f64,
+) -> Vec<Solid> {
+    vehicle
+        .parts
+        .iter()
+        .map(|part| Solid {
+            id: format!("{id}/{}#{}", part.link, part.collision_index),
+            kind: ObjectKind::ParkedAircraft,
+            shape: SolidShape::Part {
+                shape: part.shape,
+                vehicle_from_part: part.vehicle_from_part,
+            },
+            x_m: at.x,
+            y_m: at.y,
+            z_min_m: 0.0,
+            yaw_rad,
+            remission: ObjectKind::ParkedAircraft.default_remission(),
+            runtime: false,
+        })
+        .collect()
+}
+
+/// A tug ahead of a parked aircraft's right wing root and a baggage cart behind it, on the
+/// ramp beside the fuselage (its frame: 8 m ahead and 3 m aft, a quarter span to the right).
+fn ground_equipment(id: &str, span_m: f64, at: Vector2<f64>, yaw_rad: f64) -> Vec<Solid> {
+    let (s, c) = yaw_rad.sin_cos();
+    let place = |x: f64, y: f64| at + Vector2::new(c * x - s * y, s * x + c * y);
+    [
+        (ObjectKind::Tug, 8.0, "tug"),
+        (ObjectKind::BaggageCart, -3.0, "cart"),
+    ]
+    .into_iter()
+    .filter_map(|(kind, x, name)| {
+        let p = place(x, -0.25 * span_m);
+        Some(Solid {
+            id: format!("{id}/{name}"),
+            kind,
+            shape: kind.default_shape()?,
+            x_m: p.x,
+            y_m: p.y,
+            z_min_m: 0.0,
+            yaw_rad,
+            remission: kind.default_remission(),
+            runtime: false,
+        })
+    })
+    .collect()
+}

@@ -1,0 +1,195 @@
+//! Airport scenarios (`[airport]`, `route.taxi`): the world taken from an apt.dat - its ground
+//! areas, painted lines, furniture and parked aircraft - and the taxi route planned on its
+//! network; every mistake located in the scenario file (and, for the apt.dat, in that file).
+
+use sim::world::ObjectKind;
+
+use super::{assert_error, error, read, repo};
+
+/// An airport scenario on the shipped fictional airport (paths relative to the fixtures
+/// directory the test scenarios are labelled with).
+fn xtsm(extra: &str) -> String {
+    let file = repo().join("scenarios/airports/xtsm/apt.dat");
+    format!(
+        "name = \"x\"\n[airport]\nfile = \"{}\"\n{extra}[vehicle]\ndescription = \"praetor600\"\n[route]\ntaxi = {{ from = \"S3\", to = \"runway 27\", via = [\"B\", \"A\"] }}\nspeed_m_s = 6.0\n",
+        file.display()
+    )
+}
+
+#[test]
+fn an_airport_scenario_takes_its_world_from_the_file() {
+    let s = read(&xtsm(
+        "parked = [{ stand = \"S2\", vehicle = \"a320\" }]\nground_equipment = true\n",
+    ))
+    .expect("reads");
+    // The airport's extent (x -800..800 with the runway, y 0..340 less the runway's half width)
+    // and 100 m of grass round it.
+    assert!(
+        (s.world.min_m[0] + 900.0).abs() < 0.1 && (s.world.max_m[1] - 440.0).abs() < 0.1,
+        "{:?} {:?}",
+        s.world.min_m,
+        s.world.max_m
+    );
+    assert_eq!(s.world.ground_remission, 0.12);
+    assert_eq!(s.world.areas.len(), 8, "7 pavements and the runway");
+    let count = |kind| s.objects.iter().filter(|o| o.kind == kind).count();
+    let a320 = aircraft::Vehicle::shipped("a320")
+        .expect("shipped")
+        .parts
+        .len();
+    assert_eq!(
+        (
+            count(ObjectKind::Sign),
+            count(ObjectKind::LightUnit),
+            count(ObjectKind::Windsock)
+        ),
+        (4, 1, 1)
+    );
+    // B's two 70 m edge-light lines: a light at 0, 30 and 60 m of each.
+    assert_eq!(count(ObjectKind::EdgeLight), 6);
+    assert_eq!(count(ObjectKind::ParkedAircraft), a320);
+    assert_eq!(
+        (count(ObjectKind::Tug), count(ObjectKind::BaggageCart)),
+        (1, 1)
+    );
+    assert!(s.objects.iter().any(|o| o.id == "stand_S2/wing_left#3"));
+    // Painted lines: one patch per segment.
+    assert!(s.patches.len() > 1000 && s.patches.iter().all(|p| p.id.starts_with("line_")));
+    // The route: from abeam S3 to runway 27's hold point, turns braked into.
+    let route = &s.route;
+    // 1,015 m on the network, 8 m less round its three right-angle turns (radius 6.04 m).
+    assert!(
+        (route.length_m() - 1007.2).abs() < 0.5,
+        "{}",
+        route.length_m()
+    );
+    let limits = route.speed_limits_m_s.as_ref().expect("speed limits");
+    assert_eq!(limits.len(), route.waypoints_m.len());
+    assert!(limits.contains(&6.0) && limits.iter().any(|&v| v < 2.5));
+}
+
+#[test]
+fn a_world_given_crops_the_airport() {
+    let world = "[world]\nmin_m = [-100.0, 100.0]\nmax_m = [800.0, 300.0]\n";
+    let text = format!("{}{world}", xtsm(""));
+    let s = read(&text);
+    // The route ends at 27's hold point (750, 60), outside this world.
+    let message = s.expect_err("the route leaves the world").to_string();
+    assert!(
+        message.contains("`route.taxi`") && message.contains("outside the world"),
+        "{message}"
+    );
+    let world = "[world]\nmin_m = [-100.0, 0.0]\nmax_m = [800.0, 300.0]\n";
+    let s = read(&format!("{}{world}", xtsm(""))).expect("reads");
+    // The signs at x = -765 and the windsock at y = -80 are left out; the rest stays.
+    assert_eq!(
+        s.objects
+            .iter()
+            .filter(|o| o.kind == ObjectKind::Sign)
+            .count(),
+        3
+    );
+    assert_eq!(
+        s.objects
+            .iter()
+            .filter(|o| o.kind == ObjectKind::Windsock)
+            .count(),
+        0
+    );
+}
+
+#[test]
+fn airport_mistakes_are_located() {
+    let text = xtsm("parked = [{ stand = \"S9\", vehicle = \"a320\" }]\n");
+    assert_error(
+        &text,
+        "\"S9\"",
+        "airport.parked[0].stand",
+        "no stand `S9` at XTSM",
+    );
+    let text = xtsm("parked = [{ stand = \"S2\", vehicle = \"b747\" }]\n");
+    assert_error(
+        &text,
+        "\"b747\"",
+        "airport.parked[0].vehicle",
+        "cannot load the vehicle",
+    );
+    let text = xtsm("").replace("praetor600", "a320");
+    assert_error(
+        &text,
+        "{ from",
+        "route.taxi",
+        "no path along B, A admitting code C",
+    );
+    let text = xtsm("").replace("via = [\"B\", \"A\"]", "via = [\"Q\"]");
+    assert_error(
+        &text,
+        "{ from",
+        "route.taxi",
+        "no taxiway `Q` on the network",
+    );
+    let text = xtsm("").replace(
+        "speed_m_s = 6.0",
+        "speed_m_s = 6.0\nwaypoints_m = [[0.0, 0.0], [1.0, 0.0]]",
+    );
+    assert_error(
+        &text,
+        "[[0.0, 0.0]",
+        "route.taxi",
+        "give one of waypoints_m, pose_file and taxi",
+    );
+    // A broken apt.dat: located in the scenario, and the message says where in the apt.dat.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let broken = dir.path().join("broken.dat");
+    let fixture =
+        std::fs::read_to_string(repo().join("scenarios/airports/xtsm/apt.dat")).expect("fixture");
+    std::fs::write(
+        &broken,
+        fixture.replacen(
+            "1202 4 11 twoway taxiway_B B",
+            "1202 4 11 twoway taxiway_B2 B",
+            1,
+        ),
+    )
+    .expect("write");
+    let text = xtsm("").replace(
+        &repo()
+            .join("scenarios/airports/xtsm/apt.dat")
+            .display()
+            .to_string(),
+        &broken.display().to_string(),
+    );
+    let message = error(&text);
+    assert!(
+        message.contains("`airport.file`")
+            && message.contains("broken.dat:")
+            && message.contains("row 1202, field 4 (type): `taxiway_B2`"),
+        "{message}"
+    );
+    // Without an airport: a world is needed, and a taxi route has no network.
+    let bare = "name = \"x\"\n[vehicle]\ndescription = \"praetor600\"\n[route]\nwaypoints_m = [[0.0, 0.0], [10.0, 0.0]]\nspeed_m_s = 3.0\n";
+    assert!(
+        error(bare).contains("missing [world] (min_m, max_m), or an [airport] to take it from"),
+        "{}",
+        error(bare)
+    );
+    let no_airport = "name = \"x\"\n[world]\nmin_m = [-10.0, -10.0]\nmax_m = [10.0, 10.0]\n[vehicle]\ndescription = \"praetor600\"\n[route]\ntaxi = { from = \"S3\", to = \"runway 27\" }\nspeed_m_s = 3.0\n";
+    assert_error(
+        no_airport,
+        "{ from",
+        "route.taxi",
+        "a taxi route needs an [airport]",
+    );
+    let stray_radius = format!(
+        "{}turn_radius_m = 20.0\n",
+        bare.replace(
+            "name = \"x\"\n",
+            "name = \"x\"\n[world]\nmin_m = [-10.0, -10.0]\nmax_m = [20.0, 10.0]\n"
+        )
+    );
+    assert!(
+        error(&stray_radius).contains("turn_radius_m goes with taxi"),
+        "{}",
+        error(&stray_radius)
+    );
+}
