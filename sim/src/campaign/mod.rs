@@ -310,6 +310,27 @@ impl Campaign {
         dir.join(format!("variant-{index}.toml"))
     }
 
+    /// The route of a variant whose `[route]`, `[airport]` or `[vehicle]` differ from the base's
+    /// (resolved without its obstacles); `None` when they do not, or it does not resolve (the
+    /// variant is refused then anyway).
+    fn variant_route(&self, doc: &Table) -> Option<RoutePath> {
+        let same = ["route", "airport", "vehicle"]
+            .iter()
+            .all(|k| doc.get(*k) == self.base_doc.get(*k));
+        if same {
+            return None;
+        }
+        let mut probe = doc.clone();
+        probe.remove("obstacles");
+        absolutize(
+            &mut probe,
+            self.base.path.parent().unwrap_or_else(|| Path::new("")),
+        );
+        let text = toml::to_string(&probe).ok()?;
+        let s = Scenario::from_str(&text, &self.variant_path(0)).ok()?;
+        Some(RoutePath::new(&s.route.waypoints_m, s.route.closed))
+    }
+
     /// Variant `index` at point `u` of the unit cube.
     pub fn variant_at(&self, index: u64, u: &[f64]) -> Variant {
         let n = self.settings.len() as u64;
@@ -326,7 +347,11 @@ impl Campaign {
                 set_path(&mut doc, &path, v);
             }
         }
-        let route = RoutePath::new(&self.base.route.waypoints_m, self.base.route.closed);
+        // Obstacles are placed along the variant's own route when its route or airport is drawn
+        // (a taxi route from a drawn stand), else along the base's.
+        let route = self.variant_route(&doc).unwrap_or_else(|| {
+            RoutePath::new(&self.base.route.waypoints_m, self.base.route.closed)
+        });
         let mut added = Vec::new();
         for node in &self.obstacles {
             if let Value::Table(o) = node.sample(u, &self.layout, &mut drawn) {
@@ -590,7 +615,11 @@ fn round_mm(x: f64) -> f64 {
 /// Makes the vehicle and pose-file paths that exist relative to `dir` absolute, so the variant
 /// runs from anywhere (a failure file in the campaign's output directory).
 fn absolutize(doc: &mut Table, dir: &Path) {
-    for (table, key) in [("vehicle", "description"), ("route", "pose_file")] {
+    for (table, key) in [
+        ("vehicle", "description"),
+        ("route", "pose_file"),
+        ("airport", "file"),
+    ] {
         if let Some(Value::Table(t)) = doc.get_mut(table)
             && let Some(Value::String(s)) = t.get_mut(key)
         {

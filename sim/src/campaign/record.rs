@@ -91,6 +91,10 @@ pub struct RunRecord {
     pub min_clearance_m: Vec<Option<f64>>,
     /// Smallest clearance to any run-time obstacle at any level over the passes, metres.
     pub obstacle_clearance_m: Option<f64>,
+    /// Smallest ground-truth clearance to a static object (sign, light, parked aircraft), metres
+    /// (`None`: none came within 5 m).
+    #[serde(default)]
+    pub static_clearance_m: Option<f64>,
     /// Stops of the vehicle.
     pub stops: usize,
     /// Passes that deviated.
@@ -280,6 +284,7 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
         obstacles,
         min_clearance_m: r.min_clearance_m.iter().copied().map(finite).collect(),
         obstacle_clearance_m: clearance,
+        static_clearance_m: r.closest_static.first().map(|c| c.min_clearance_m),
         stops: r.stops.len(),
         deviations,
         false_stops,
@@ -321,6 +326,7 @@ pub(super) fn invalid(campaign: &Campaign, v: &Variant, why: &str) -> RunRecord 
         obstacles: Vec::new(),
         min_clearance_m: Vec::new(),
         obstacle_clearance_m: None,
+        static_clearance_m: None,
         stops: 0,
         deviations: 0,
         false_stops: 0,

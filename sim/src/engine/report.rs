@@ -44,6 +44,10 @@ pub struct RunReport {
     pub stops: Vec<Stop>,
     /// Smallest ground-truth clearance per level to any object, metres.
     pub min_clearance_m: Vec<f64>,
+    /// The static objects the vehicle came within [`CLOSE_STATIC_M`] of (a parked aircraft as
+    /// one, its parts' id prefix), nearest first, at most [`CLOSEST_STATIC_COUNT`]: how close the
+    /// route comes to the airport's signs, lights and parked wings (ground truth).
+    pub closest_static: Vec<StaticClearance>,
     /// The scenario's danger distance, metres (`None`: not stated): a pass closer than this to
     /// its obstacle, at any level, does not meet its expectation.
     pub danger_distance_m: Option<f64>,
@@ -118,4 +122,43 @@ pub struct Progress {
     pub laps_completed: u32,
     /// Fraction of the whole run done, 0..1.
     pub fraction: f64,
+}
+
+/// How near a static object must come to be listed in [`RunReport::closest_static`], metres.
+pub const CLOSE_STATIC_M: f64 = 5.0;
+/// How many [`RunReport::closest_static`] lists at most.
+pub const CLOSEST_STATIC_COUNT: usize = 10;
+
+/// A static object and the smallest ground-truth clearance the vehicle kept to it.
+#[derive(Clone, Debug, Serialize)]
+pub struct StaticClearance {
+    /// Its id (a parked aircraft's: before the `/` of its parts' ids).
+    pub id: String,
+    /// Its kind.
+    pub kind: crate::world::ObjectKind,
+    /// The smallest clearance over the run, metres.
+    pub min_clearance_m: f64,
+}
+
+/// The static objects of `scene` the vehicle came within [`CLOSE_STATIC_M`] of, by
+/// `clearances_m` (one per solid, as the world keeps them), grouped by id prefix, nearest first.
+pub fn closest_static(scene: &crate::world::Scene, clearances_m: &[f64]) -> Vec<StaticClearance> {
+    let mut nearest: Vec<StaticClearance> = Vec::new();
+    for (solid, &d) in scene.solids.iter().zip(clearances_m) {
+        if solid.runtime || d >= CLOSE_STATIC_M {
+            continue;
+        }
+        let id = solid.id.split('/').next().unwrap_or(&solid.id);
+        match nearest.iter_mut().find(|c| c.id == id) {
+            Some(c) => c.min_clearance_m = c.min_clearance_m.min(d),
+            None => nearest.push(StaticClearance {
+                id: id.to_string(),
+                kind: solid.kind,
+                min_clearance_m: d,
+            }),
+        }
+    }
+    nearest.sort_by(|a, b| a.min_clearance_m.total_cmp(&b.min_clearance_m));
+    nearest.truncate(CLOSEST_STATIC_COUNT);
+    nearest
 }

@@ -355,6 +355,10 @@ impl<'a> Rig<'a> {
             obstacles: verdict.obstacles,
             stops: verdict.stops,
             min_clearance_m: verdict.min_clearance_m,
+            closest_static: super::report::closest_static(
+                &self.scene,
+                self.world.min_clearances_m(),
+            ),
             danger_distance_m: self.scenario.danger_distance_m,
             sim_time_s: self.t_s,
             wall_time_s,

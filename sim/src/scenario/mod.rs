@@ -16,7 +16,7 @@
 
 mod model;
 mod numbers;
-mod overlap;
+pub(crate) mod overlap;
 mod resolve;
 mod run_config;
 mod spec;

@@ -169,6 +169,10 @@ pub struct AirportSpec {
     /// Aircraft parked at stands.
     #[serde(default)]
     pub parked: Vec<Spanned<ParkedSpec>>,
+    /// The share of the other stands occupied, drawn with the scenario's seed: each by the
+    /// largest shipped aircraft its size class takes (code C and up an A320, B a Praetor; A or
+    /// none stays empty). Never the route's own stands. Default 0.
+    pub occupancy: Option<Spanned<Remission>>,
 }
 
 fn yes() -> bool {

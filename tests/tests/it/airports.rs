@@ -33,4 +33,15 @@ fn the_jet_taxis_from_a_stand_to_the_runway_by_b_and_a() {
         "{:?}",
         r.lap_times_s
     );
+    // How close the route came to the airport's furniture (ground truth): B's edge lights, 10 m
+    // either side of its centreline, pass 1.4 m under the wings; nothing nearer.
+    let nearest = &r.closest_static;
+    assert!(
+        nearest.len() >= 6 && nearest[..6].iter().all(|c| c.id.starts_with("edge_light_")),
+        "{nearest:?}"
+    );
+    assert!(
+        (1.2..1.6).contains(&nearest[0].min_clearance_m),
+        "{nearest:?}"
+    );
 }

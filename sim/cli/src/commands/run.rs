@@ -322,6 +322,7 @@ pub fn table(r: &RunReport) -> String {
         );
     }
     obstacle_rows(&mut t, r);
+    closest_static_row(&mut t, r);
     for (k, c) in r.contacts.iter().enumerate() {
         let fault = r.contacts_judged.get(k).map_or(String::new(), |j| {
             if j.at_fault {
@@ -351,6 +352,19 @@ pub fn table(r: &RunReport) -> String {
         s.localization
     );
     t
+}
+
+/// The static objects the vehicle came nearest (ground truth), a line.
+fn closest_static_row(t: &mut String, r: &RunReport) {
+    if !r.closest_static.is_empty() {
+        let near: Vec<String> = r
+            .closest_static
+            .iter()
+            .take(5)
+            .map(|c| format!("{} ({}) {:.2} m", c.id, c.kind.name(), c.min_clearance_m))
+            .collect();
+        t.push_str(&format!("closest static objects: {}\n", near.join(", ")));
+    }
 }
 
 /// The obstacle table of a run's summary: one row per pass (or `not passed`).

@@ -135,6 +135,7 @@ impl Resolver<'_> {
 
     /// The airport's objects inside the world (signs, lights; ids claimed), the aircraft parked at
     /// its stands and their ground equipment; and its painted lines inside the world.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn airport_objects(
         &self,
         spec: &Spanned<AirportSpec>,
@@ -142,6 +143,8 @@ impl Resolver<'_> {
         world: &Ground,
         vehicle: &ScenarioVehicle,
         ids: &mut HashMap<String, String>,
+        seed: u64,
+        route_stands: &[String],
     ) -> Result<(Vec<Solid>, Vec<Patch>), LocatedError> {
         let inside = |x: f64, y: f64| {
             x >= world.min_m[0] && x <= world.max_m[0] && y >= world.min_m[1] && y <= world.max_m[1]
@@ -158,6 +161,36 @@ impl Resolver<'_> {
             )?;
             self.no_start_overlap(vehicle, solid, "airport", spec.span())?;
             solids.push(solid.clone());
+        }
+        for (stand, description, span) in self.occupied_stands(spec, loaded, seed, route_stands)? {
+            let id = format!("stand_{}", stand.name.replace(' ', "_"));
+            self.claim(
+                ids,
+                &id,
+                span.clone(),
+                "airport.occupancy",
+                "`airport.occupancy`".into(),
+                "",
+            )?;
+            let mut here = parked_parts(&id, &description, stand.at, stand.yaw_rad);
+            if spec.get_ref().ground_equipment {
+                here.extend(ground_equipment(
+                    &id,
+                    description.span_m(),
+                    stand.at,
+                    stand.yaw_rad,
+                ));
+            }
+            // A drawn aircraft that would touch the vehicle at its start leaves its stand empty.
+            let start = crate::scenario::overlap::start_overlap;
+            if here.iter().any(|s| {
+                start(&vehicle.vehicle, &vehicle.world_from_start, s).is_some()
+                    || !inside(s.x_m, s.y_m)
+            }) {
+                ids.remove(&id);
+                continue;
+            }
+            solids.extend(here);
         }
         for (i, parked) in spec.get_ref().parked.iter().enumerate() {
             let field = format!("airport.parked[{i}]");
@@ -212,6 +245,57 @@ impl Resolver<'_> {
             .cloned()
             .collect();
         Ok((solids, patches))
+    }
+}
+
+impl Resolver<'_> {
+    /// The stands `occupancy` fills (not those named in `parked`, nor the route's), drawn with
+    /// the scenario's seed, with the vehicle each takes.
+    #[allow(clippy::type_complexity)]
+    fn occupied_stands<'a>(
+        &self,
+        spec: &Spanned<AirportSpec>,
+        loaded: &'a LoadedAirport,
+        seed: u64,
+        route_stands: &[String],
+    ) -> Result<
+        Vec<(
+            &'a airport::Stand,
+            aircraft::Vehicle,
+            std::ops::Range<usize>,
+        )>,
+        LocatedError,
+    > {
+        use rand::{RngExt, SeedableRng};
+        let a = spec.get_ref();
+        let Some(share) = &a.occupancy else {
+            return Ok(Vec::new());
+        };
+        let named: Vec<&str> = a
+            .parked
+            .iter()
+            .map(|p| p.get_ref().stand.get_ref().as_str())
+            .collect();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed ^ 0x0057_A4D5);
+        let mut out = Vec::new();
+        for stand in &loaded.airport.stands {
+            let draw: f64 = rng.random();
+            if draw >= f64::from(share.get_ref().0)
+                || named.contains(&stand.name.as_str())
+                || route_stands.contains(&stand.name)
+            {
+                continue;
+            }
+            let name = match stand.size_class {
+                Some(c) if c >= airport::SizeClass::C => "a320",
+                Some(airport::SizeClass::B) => "praetor600",
+                _ => continue,
+            };
+            let vehicle = aircraft::Vehicle::shipped(name)
+                .map_err(|e| self.err(share.span(), "airport.occupancy", e.to_string()))?;
+            out.push((stand, vehicle, share.span()));
+        }
+        Ok(out)
     }
 }
 

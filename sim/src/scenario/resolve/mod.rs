@@ -71,7 +71,11 @@ impl Resolver<'_> {
         let mut ids: HashMap<String, String> = HashMap::new();
         let (mut objects, mut patches) = match (&spec.airport, &airport) {
             (Some(a), Some(loaded)) => {
-                self.airport_objects(a, loaded, &world, &vehicle, &mut ids)?
+                let route_stands: Vec<String> = (spec.route.get_ref().taxi.iter())
+                    .flat_map(|t| [t.get_ref().from.clone(), t.get_ref().to.clone()])
+                    .collect();
+                let (seed, stands) = (spec.seed, &route_stands);
+                self.airport_objects(a, loaded, &world, &vehicle, &mut ids, seed, stands)?
             }
             _ => (Vec::new(), Vec::new()),
         };
