@@ -2,7 +2,8 @@
 """Checks a taxi-sim Rerun recording: every entity path the README lists is there, with the
 archetype it should hold, on the `sim_time` timeline. Exits 1 naming what is missing.
 
-Usage: check_rrd.py RUN.rrd   (with the rerun-sdk matching the crate, see .ci/run)
+Usage: check_rrd.py RUN.rrd [--airport]   (with the rerun-sdk matching the crate, see .ci/run)
+--airport: also the airport's pavement outlines (`/world/areas`) and parked aircraft.
 """
 
 import sys
@@ -41,18 +42,27 @@ EXPECTED = [
 ]
 
 
+AIRPORT = [
+    ("/world/areas", "rerun.archetypes.LineStrips3D"),
+    ("/world/objects/stand_S2_", None),  # a prefix: the parked A320's parts
+]
+
+
 def main() -> int:
-    if len(sys.argv) != 2:
+    args = sys.argv[1:]
+    airport = "--airport" in args
+    args = [a for a in args if a != "--airport"]
+    if len(args) != 1:
         print(__doc__, file=sys.stderr)
         return 2
-    path = sys.argv[1]
+    path = args[0]
     schema = rr.experimental.RrdReader(path).store().schema()
     columns = schema.component_columns()
     held = {(c.entity_path, c.archetype) for c in columns}
     paths = {c.entity_path for c in columns}
     missing = []
-    for entity, archetype in EXPECTED:
-        if entity.endswith("/"):
+    for entity, archetype in EXPECTED + (AIRPORT if airport else []):
+        if entity.endswith(("/", "_")):
             ok = any(p.startswith(entity) for p in paths)
         elif archetype is None:
             ok = entity in paths

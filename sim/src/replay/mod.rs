@@ -5,7 +5,7 @@
 //!
 //! | path | what | when |
 //! | --- | --- | --- |
-//! | `world/ground`, `world/patches` | the ground slab, painted markings | once (static) |
+//! | `world/ground`, `world/patches`, `world/areas` | the ground slab, painted markings, paved areas' outlines | once (static) |
 //! | `world/objects/<id>` | static objects: boxes, cylinders, cones (meshes) | once (static) |
 //! | `world/route` | the route | once (static) |
 //! | `world/obstacles/<id>` | run-time obstacles in their own frame, cleared while inactive | on change |

@@ -34,11 +34,11 @@ fn log_ground(rec: &RecordingStream, scene: &crate::world::Scene) -> Result<()> 
         .with_fill_mode(FillMode::Solid)
         .with_colors([Rgba32::from_rgb(70, 72, 78)]),
     )?;
+    let grey = |r: f32| {
+        let v = (90.0 + 160.0 * r.clamp(0.0, 1.0)) as u8;
+        Rgba32::from_rgb(v, v, v)
+    };
     if !scene.patches.is_empty() {
-        let grey = |r: f32| {
-            let v = (90.0 + 160.0 * r.clamp(0.0, 1.0)) as u8;
-            Rgba32::from_rgb(v, v, v)
-        };
         rec.log_static(
             "world/patches",
             &rerun::Boxes3D::from_centers_and_half_sizes(
@@ -54,6 +54,30 @@ fn log_ground(rec: &RecordingStream, scene: &crate::world::Scene) -> Result<()> 
             .with_quaternions(scene.patches.iter().map(|p| yaw_quat(p.yaw_rad)))
             .with_fill_mode(FillMode::Solid)
             .with_colors(scene.patches.iter().map(|p| grey(p.remission))),
+        )?;
+    }
+    if !scene.areas.is_empty() {
+        // Paved areas (an airport's pavement and runways): their outlines and holes, closed,
+        // grey by remission, just above the ground.
+        let rings: Vec<(Vec<[f32; 3]>, f32)> = scene
+            .areas
+            .iter()
+            .flat_map(|a| {
+                std::iter::once(&a.outline)
+                    .chain(&a.holes)
+                    .map(move |ring| (ring, a.remission))
+            })
+            .map(|(ring, remission)| {
+                let mut strip: Vec<[f32; 3]> =
+                    ring.iter().map(|p| [p[0] as f32, p[1] as f32, -0.008]).collect();
+                strip.extend(strip.first().copied());
+                (strip, remission)
+            })
+            .collect();
+        rec.log_static(
+            "world/areas",
+            &rerun::LineStrips3D::new(rings.iter().map(|(s, _)| s.clone()))
+                .with_colors(rings.iter().map(|(_, r)| grey(*r))),
         )?;
     }
     Ok(())
