@@ -68,8 +68,10 @@ fn log_ground(rec: &RecordingStream, scene: &crate::world::Scene) -> Result<()> 
                     .map(move |ring| (ring, a.remission))
             })
             .map(|(ring, remission)| {
-                let mut strip: Vec<[f32; 3]> =
-                    ring.iter().map(|p| [p[0] as f32, p[1] as f32, -0.008]).collect();
+                let mut strip: Vec<[f32; 3]> = ring
+                    .iter()
+                    .map(|p| [p[0] as f32, p[1] as f32, -0.008])
+                    .collect();
                 strip.extend(strip.first().copied());
                 (strip, remission)
             })
