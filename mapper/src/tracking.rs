@@ -238,7 +238,7 @@ pub struct MovingObject {
     pub travel_m: f64,
 }
 
-/// A track whose motion can be predicted: what [`Tracker::movers`] gives.
+/// A tracked object's state: what [`Tracker::movers`] and [`Tracker::candidate_movers`] give.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrackState {
     /// Track id.
@@ -561,26 +561,48 @@ impl Tracker {
         self.tracks
             .iter()
             .filter(|t| t.predictable)
-            .map(|t| {
-                let bbox = t.last_bbox;
-                TrackState {
-                    bbox,
-                    size_m: [
-                        (bbox.1.0 - bbox.0.0 + 1) as f64 * self.resolution_m,
-                        (bbox.1.1 - bbox.0.1 + 1) as f64 * self.resolution_m,
-                    ],
-                    id: t.id,
-                    t_s: t.last_t_s,
-                    position: Point2::new(t.motion.x[0], t.motion.x[1]),
-                    velocity: t.motion.velocity(),
-                    covariance: t.motion.p,
-                    extent_m: t.max_extent_m,
-                    levels: t.levels,
-                    confirmed: t.moving,
-                    travel_m: (t.last - t.origin).norm(),
-                }
-            })
+            .map(|t| self.state(t))
             .collect()
+    }
+
+    /// The tracks seen this revolution that may be moving but are not yet predictable: seen
+    /// steadily for `predict_after_revolutions`, no larger than `max_object_m`, their centre
+    /// `predict_min_travel_m` from where it was first seen - not yet beyond what hiding or
+    /// revealing a static object's parts explains. A long truck crossing slowly along its own
+    /// length takes seconds to get there; what may move is worth slowing for meanwhile.
+    pub fn candidate_movers(&self) -> Vec<TrackState> {
+        let cfg = &self.config;
+        self.tracks
+            .iter()
+            .filter(|t| {
+                !t.predictable
+                    && t.bbox.is_some()
+                    && t.steady >= cfg.predict_after_revolutions
+                    && t.max_extent_m <= cfg.max_object_m
+                    && (t.last - t.first).norm() >= cfg.predict_min_travel_m
+            })
+            .map(|t| self.state(t))
+            .collect()
+    }
+
+    fn state(&self, t: &Track) -> TrackState {
+        let bbox = t.last_bbox;
+        TrackState {
+            bbox,
+            size_m: [
+                (bbox.1.0 - bbox.0.0 + 1) as f64 * self.resolution_m,
+                (bbox.1.1 - bbox.0.1 + 1) as f64 * self.resolution_m,
+            ],
+            id: t.id,
+            t_s: t.last_t_s,
+            position: Point2::new(t.motion.x[0], t.motion.x[1]),
+            velocity: t.motion.velocity(),
+            covariance: t.motion.p,
+            extent_m: t.max_extent_m,
+            levels: t.levels,
+            confirmed: t.moving,
+            travel_m: (t.last - t.origin).norm(),
+        }
     }
 
     /// When a revolution last hit `cell`, seconds (`None`: never, or pruned).
@@ -861,6 +883,37 @@ mod tests {
         }
         let first = first.expect("offered for prediction");
         assert!(first <= 12, "first offered at revolution {first}");
+    }
+
+    /// A 9.2 m truck driving along its length at 1.3 m/s is offered for prediction only after
+    /// it has travelled 0.6 times its extent (4.4 s), but is a candidate mover - worth slowing
+    /// for - from about a second, with the velocity it has; a candidate never once a mover.
+    #[test]
+    fn a_long_slow_truck_is_a_candidate_mover_seconds_before_it_is_predicted() {
+        let mut t = Tracker::new(TrackerConfig::default(), 0.2);
+        let (mut candidate, mut mover) = (None, None);
+        for k in 0..80 {
+            let y = -((k as f64 * 0.13 / 0.2).round() as i64); // 1.3 m/s towards -y at 10 Hz
+            t.update(k as f64 * 0.1, &block(0, y, 13, 46));
+            let (c, m) = (t.candidate_movers(), t.movers());
+            assert!(c.is_empty() || m.is_empty(), "{k}: both {c:?} {m:?}");
+            if let Some(c) = c.first() {
+                candidate.get_or_insert(k);
+                assert!(!c.confirmed);
+                if k >= 15 {
+                    assert!(
+                        (c.velocity - Vector2::new(0.0, -1.3)).norm() < 0.3,
+                        "{k}: {c:?}"
+                    );
+                }
+            }
+            if !m.is_empty() {
+                mover.get_or_insert(k);
+            }
+        }
+        let (candidate, mover) = (candidate.unwrap(), mover.unwrap());
+        assert!(candidate <= 12, "a candidate at revolution {candidate}");
+        assert!((42..=50).contains(&mover), "a mover at revolution {mover}");
     }
 
     /// A parked car revealed from one end (its visible part grows over 3 s, as a vehicle

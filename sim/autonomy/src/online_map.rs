@@ -185,6 +185,13 @@ impl OnlineMap {
         self.tracker.movers()
     }
 
+    /// The tracked objects that may be moving but are not yet predictable
+    /// ([`mapper::Tracker::candidate_movers`]), as of the last revolution; none made of hits
+    /// beside an offline-map obstacle either.
+    pub fn candidate_movers(&self) -> Vec<mapper::TrackState> {
+        self.tracker.candidate_movers()
+    }
+
     /// The multi-height map (occupancy and distance maps per level).
     pub fn map(&self) -> &MultiHeightMap {
         &self.map

@@ -106,6 +106,8 @@ pub struct Driver {
     conflict: Option<Conflict>,
     /// When a plan last found a conflict with a mover, seconds.
     last_conflict_s: Option<f64>,
+    /// When a plan last found a candidate mover's motion meeting the path, seconds.
+    last_caution_s: Option<f64>,
     /// The line the vehicle holds short of for a mover: its track, the route arc length,
     /// when the conflict was last found.
     hold: Option<(u32, f64, f64)>,
@@ -181,6 +183,7 @@ impl Driver {
             predictions: Vec::new(),
             conflict: None,
             last_conflict_s: None,
+            last_caution_s: None,
             hold: None,
             at_body: Vec::new(),
             streaks: Vec::new(),
@@ -232,6 +235,7 @@ impl Driver {
     pub fn restart(&mut self) {
         self.status = DriverStatus::Driving;
         self.last_conflict_s = None;
+        self.last_caution_s = None;
         self.at_body.clear();
         self.streaks.clear();
         self.hold = None;
@@ -283,6 +287,7 @@ impl Driver {
         );
         // The tracker's movers, once a plan: the space-time check and the body hold read them.
         let movers = map.movers();
+        let wanted = self.caution(&p, &map.candidate_movers(), wanted, estimate.t_s, &config);
         let mut conflict = self.traffic_conflict(&p, &movers, wanted, estimate.t_s, &config, false);
         let v0 = self.last_odometry.map_or(0.0, |o| o.speed_m_s.max(0.0));
         if conflict.is_some_and(|c| stopping_distance_m(v0, decel, &config) >= c.zone_m) {
@@ -329,6 +334,54 @@ impl Driver {
             distance_maps_s: (t1 - t0).as_secs_f64(),
             planning_s: t1.elapsed().as_secs_f64(),
         })
+    }
+
+    /// How the vehicle is expected to move: from its speed now to `wanted` m/s.
+    fn profile(&self, wanted: f64) -> SpeedProfile {
+        SpeedProfile {
+            speed_m_s: self.last_odometry.map_or(0.0, |o| o.speed_m_s.max(0.0)),
+            target_m_s: wanted,
+            acceleration_m_s2: self.vehicle.acceleration_m_s2,
+        }
+    }
+
+    /// `wanted` capped at the caution speed while the motion so far of a candidate mover (one
+    /// not yet predictable, [`mapper::Tracker::candidate_movers`]) would meet `p`'s chosen path,
+    /// and for `conflict_memory_s` after: by the time it is confirmed, the vehicle can stop
+    /// short of it; if it was a static object's parts coming into view, it only slowed.
+    fn caution(
+        &mut self,
+        p: &Plan,
+        candidates: &[TrackState],
+        wanted: f64,
+        now_s: f64,
+        config: &AutonomyConfig,
+    ) -> f64 {
+        let traffic = &config.traffic;
+        if !traffic.enabled {
+            return wanted;
+        }
+        let predictions = predict(candidates, now_s, traffic);
+        if !predictions.is_empty() {
+            let path = TimedPath {
+                poses: &p.chosen().poses,
+                step_m: config.step_m,
+                profile: self.profile(wanted),
+                now_s,
+                yielding: false,
+            };
+            if first_conflict(&path, &self.vehicle.collision, &predictions, traffic).is_some() {
+                self.last_caution_s = Some(now_s);
+            }
+        }
+        if self
+            .last_caution_s
+            .is_some_and(|t| now_s - t < traffic.conflict_memory_s)
+        {
+            wanted.min(traffic.caution_speed_m_s)
+        } else {
+            wanted
+        }
     }
 
     /// Where the vehicle must stop for movers, as a distance ahead of route progress `s`: before
@@ -400,15 +453,10 @@ impl Driver {
         if self.predictions.is_empty() {
             return None;
         }
-        let profile = SpeedProfile {
-            speed_m_s: self.last_odometry.map_or(0.0, |o| o.speed_m_s.max(0.0)),
-            target_m_s: wanted,
-            acceleration_m_s2: self.vehicle.acceleration_m_s2,
-        };
         let path = TimedPath {
             poses: &p.chosen().poses,
             step_m: config.step_m,
-            profile,
+            profile: self.profile(wanted),
             now_s,
             // Yielding, or slowing for a conflict found lately: the margin after grows, so a
             // prediction that flickers does not let the vehicle creep into the mover's path.

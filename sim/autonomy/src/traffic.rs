@@ -21,6 +21,9 @@
 //!   margin after grows by `resume_margin_s`, so the vehicle does not creep off and stop again.
 //! - Movers slower than `min_speed_m_s`, or than `sigmas` standard deviations of their speed,
 //!   are left to the map (their cells are obstacles there).
+//! - **Caution**: a candidate mover - seen to travel a metre, not yet beyond what revealing a
+//!   static object explains - checked the same way caps the speed at `caution_speed_m_s`
+//!   instead of stopping the vehicle: slow for what may move, stop for what does.
 //! - **A mover at the body** ([`at_body`]): one seen, or predicted while out of view, whose box
 //!   of hits, grown by what of it may be hidden, comes within `at_body_m` of a circle of a level
 //!   it occupies is where the map cannot hold it (returns
@@ -73,6 +76,13 @@ pub struct TrafficConfig {
     /// occupies) holds the vehicle ([`at_body`]), metres. Default 1 (the map drops returns
     /// within 0.8 m of a circle as the vehicle's own).
     pub at_body_m: f64,
+    /// A mover not yet predictable - one the tracker has seen travel a metre but not yet
+    /// beyond what revealing a static object's parts explains
+    /// ([`mapper::Tracker::candidate_movers`]) - whose motion so far would meet the path caps
+    /// the speed at this, m/s, until `conflict_memory_s` after it was last found: by the time
+    /// it is confirmed, the vehicle can stop short of it. Default 3 (a long truck crossing at
+    /// 1.3 m/s takes 4.4 s to confirm, 35 m at 8 m/s).
+    pub caution_speed_m_s: f64,
 }
 
 impl Default for TrafficConfig {
@@ -89,6 +99,7 @@ impl Default for TrafficConfig {
             hidden_m: 1.0,
             min_speed_m_s: 0.8,
             at_body_m: 1.0,
+            caution_speed_m_s: 3.0,
         }
     }
 }
@@ -107,6 +118,7 @@ impl TrafficConfig {
             ("hidden_m", self.hidden_m),
             ("min_speed_m_s", self.min_speed_m_s),
             ("at_body_m", self.at_body_m),
+            ("caution_speed_m_s", self.caution_speed_m_s),
         ];
         positive
             .into_iter()

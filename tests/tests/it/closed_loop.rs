@@ -231,6 +231,7 @@ fn a_run_is_identical_for_the_same_seed() {
 fn every_shipped_scenario_is_run_by_a_test() {
     let here = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let sources: String = [
+        "airports.rs",
         "closed_loop.rs",
         "experiments.rs",
         "overhead.rs",

@@ -144,6 +144,24 @@ fn a_truck_that_struck_the_standing_nose_holds_the_jet() {
     assert_eq!(r.end, sim::engine::EndReason::TimedOut);
 }
 
+/// Fixed: a 9 m fuel truck crossing at 1.3 m/s along its own length is offered for prediction
+/// only once it has travelled 0.6 times its extent - 4.4 s, 35 m of the jet's at 8 m/s - and
+/// the jet, 18.5 m short of where its wing would meet the truck, could not stop. Now a
+/// candidate mover whose motion so far would meet the path caps the speed at 3 m/s until it is
+/// confirmed or gone: the jet yields, the truck first. Without the cap (as it was) its left
+/// wing tip touches the truck while moving. Found by the traffic campaign (variant 428).
+#[test]
+fn a_slow_truck_not_yet_confirmed_slows_the_jet_in_time() {
+    let s = found("slow_fuel_truck_meets_the_wing_tip");
+    let r = run_found_with(&s, |_| {});
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts_judged);
+    let truck = r.obstacles.iter().find(|o| o.id == "fuel_truck_1").unwrap();
+    assert_eq!(truck.pet_mover_first, Some(true), "{truck:?}");
+    let was = run_found_with(&s, |c| c.autonomy.traffic.caution_speed_m_s = 100.0);
+    assert_eq!(was.contacts_at_fault, 1, "{:?}", was.contacts_judged);
+    assert_eq!(was.contacts_judged[0].contact.part, "wing_left");
+}
+
 /// FIXME (README, Known problems): a 0.104 m piece of debris 0.39 m left of the car's
 /// centreline, just over the obstacle height (0.1 m): the car starts round it too late, stops
 /// 0.15 m short of it, and with the debris hidden under its nose waits and calls for a pilot

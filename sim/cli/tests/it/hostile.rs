@@ -144,7 +144,7 @@ const CASES: &[Case] = &[
     Case {
         file: "vehicle_unknown_field.toml",
         args: FIT,
-        says: &[":11:1:", "unknown field `wingspan_m`"],
+        says: &[":11:1:", "unknown field `wing_span_m`"],
     },
     Case {
         file: "vehicle_heights_not_zero.toml",
