@@ -26,7 +26,10 @@ const MAX_PIECES: usize = 256;
 #[must_use]
 pub fn segment(a: LocalNode, b: LocalNode) -> Vec<Vector2<f64>> {
     let arrive = b.control.map(|c| 2.0 * b.at - c);
-    if a.control.is_none() && arrive.is_none() {
+    // Between two nodes at one place (WorldEditor writes a split node so) X-Plane draws nothing,
+    // unless both have handles (a loop).
+    let together = (b.at - a.at).norm() < 1e-6 && (a.control.is_none() || b.control.is_none());
+    if together || (a.control.is_none() && arrive.is_none()) {
         return vec![a.at];
     }
     let controls = [

@@ -21,5 +21,5 @@ pub use geodesy::{LatLon, LocalFrame};
 pub use model::{Airport, Pavement, Runway, Sign, Stand, Surface};
 pub use network::{Edge, EdgeClass, Network, Node};
 pub use path::{PathOptions, TaxiPath, smooth};
-pub use route::{NetworkRoute, Place, RouteRequest, find};
+pub use route::{NetworkRoute, Place, RouteRequest, find, hold_points};
 pub use size::SizeClass;

@@ -21,7 +21,13 @@ pub enum Surface {
     Concrete,
     /// 3 grass, 4 dirt, 5 gravel, 12 dry lakebed.
     Unpaved,
-    /// Anything else (13 water, 14 snow, 15 transparent).
+    /// 13.
+    Water,
+    /// 14.
+    Snow,
+    /// 15: an outline that carries markings only; the ground under it shows.
+    Transparent,
+    /// Anything else.
     Other,
 }
 
@@ -33,6 +39,9 @@ impl Surface {
             1 | 20..=38 => Self::Asphalt,
             2 | 50..=57 => Self::Concrete,
             3 | 4 | 5 | 12 => Self::Unpaved,
+            13 => Self::Water,
+            14 => Self::Snow,
+            15 => Self::Transparent,
             _ => Self::Other,
         }
     }

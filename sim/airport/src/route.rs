@@ -179,14 +179,36 @@ pub fn find(airport: &Airport, request: &RouteRequest) -> Result<NetworkRoute, A
             graph.add_arc(edge.to, edge.from, index);
         }
     }
-    let start = start_point(airport, &mut graph, &request.from, request.code).map_err(&fail)?;
-    let (targets, lead_in) =
+    let (start, start_on) =
+        start_point(airport, &mut graph, &request.from, request.code).map_err(&fail)?;
+    let (targets, lead_in, end_on) =
         end_points(airport, &mut graph, &request.to, request.code).map_err(&fail)?;
-    let allow_runway = matches!(request.from, Place::Runway(_));
+    if let (Some((edge, t0)), Some((end_edge, t1))) = (start_on, end_on)
+        && edge == end_edge
+        && (!network.edges[edge].one_way || t1 >= t0)
+    {
+        // Both stands on one taxilane edge: straight along it, not round the network.
+        graph.add_arc(start, targets[0], edge);
+    }
+    // Starting on a runway (vacating it), the route may drive along that runway only.
+    let left_runway = match &request.from {
+        Place::Runway(number) => runway_end(airport, number).map(|(r, _)| r),
+        _ => None,
+    };
+    let runway_ok = network
+        .edges
+        .iter()
+        .map(|e| {
+            e.class == EdgeClass::Runway
+                && left_runway.is_some_and(|r| {
+                    on_runway(r, &network.nodes[e.from].at) && on_runway(r, &network.nodes[e.to].at)
+                })
+        })
+        .collect();
     let search = Search {
         graph: &graph,
         via: &request.via,
-        allow_runway,
+        runway_ok,
     };
     let best = search.run(start, &targets, &request.to, airport).ok_or_else(|| {
         fail(format!(
@@ -201,44 +223,64 @@ pub fn find(airport: &Airport, request: &RouteRequest) -> Result<NetworkRoute, A
     Ok(route)
 }
 
+/// Whether `p` lies on runway `r` (within half its width of its centreline, ends included).
+fn on_runway(r: &crate::model::Runway, p: &Vector2<f64>) -> bool {
+    let (a, b) = (r.ends[0].at, r.ends[1].at);
+    let t = ((p - a).dot(&(b - a)) / (b - a).norm_squared().max(1e-12)).clamp(0.0, 1.0);
+    (a + (b - a) * t - p).norm() <= r.width_m / 2.0 + 1.0
+}
+
+/// The admitting taxiway edge nearest `at`: its index, the nearest point on it and where that
+/// lies along it (0 at its start node, 1 at its end). Edges of no length are passed over.
 fn nearest_on_edges(
     graph: &Graph,
     at: Vector2<f64>,
     code: SizeClass,
-) -> Option<(usize, Vector2<f64>)> {
+) -> Option<(usize, Vector2<f64>, f64)> {
     let network = graph.network;
     network
         .edges
         .iter()
         .enumerate()
         .filter(|(_, e)| e.class != EdgeClass::Runway && e.admits(code))
-        .map(|(i, e)| {
+        .filter_map(|(i, e)| {
             let (a, b) = (network.nodes[e.from].at, network.nodes[e.to].at);
-            let t = ((at - a).dot(&(b - a)) / (b - a).norm_squared()).clamp(0.0, 1.0);
-            let p = a + (b - a) * t;
-            (i, p, (p - at).norm())
+            let length2 = (b - a).norm_squared();
+            (length2 > 1e-6).then(|| {
+                let t = ((at - a).dot(&(b - a)) / length2).clamp(0.0, 1.0);
+                let p = a + (b - a) * t;
+                (i, p, t, (p - at).norm())
+            })
         })
-        .min_by(|x, y| x.2.total_cmp(&y.2))
-        .map(|(i, p, _)| (i, p))
+        .min_by(|x, y| x.3.total_cmp(&y.3))
+        .map(|(i, p, t, _)| (i, p, t))
 }
+
+/// A stand's place on the network: the edge it leaves or joins by, and where along it.
+type OnEdge = Option<(usize, f64)>;
+
+/// Where a route may end: the search graph's targets, the stand it leads into from the last
+/// (if it ends at one), and that stand's place on the network.
+type Ends = (Vec<usize>, Option<Vector2<f64>>, OnEdge);
 
 fn start_point(
     airport: &Airport,
     graph: &mut Graph,
     from: &Place,
     code: SizeClass,
-) -> Result<usize, String> {
+) -> Result<(usize, OnEdge), String> {
     match from {
         Place::Node(id) => graph
             .network
             .node_by_id(*id)
+            .map(|n| (n, None))
             .ok_or_else(|| format!("no network node has id {id}")),
-        Place::Runway(number) => runway_node_at_threshold(airport, number),
+        Place::Runway(number) => runway_node_at_threshold(airport, number).map(|n| (n, None)),
         Place::Stand(name) => {
             let stand = airport
                 .stand(name)
                 .ok_or_else(|| format!("no stand `{name}` (stands: {:?})", stand_names(airport)))?;
-            let (edge, p) = nearest_on_edges(graph, stand.at, code).ok_or_else(|| {
+            let (edge, p, t) = nearest_on_edges(graph, stand.at, code).ok_or_else(|| {
                 format!("no taxiway admitting code {code} to leave stand `{name}` by")
             })?;
             let e = graph.network.edges[edge].clone();
@@ -247,7 +289,7 @@ fn start_point(
             if !e.one_way {
                 graph.add_arc(s, e.from, edge);
             }
-            Ok(s)
+            Ok((s, Some((edge, t))))
         }
     }
 }
@@ -257,7 +299,7 @@ fn end_points(
     graph: &mut Graph,
     to: &Place,
     code: SizeClass,
-) -> Result<(Vec<usize>, Option<Vector2<f64>>), String> {
+) -> Result<Ends, String> {
     match to {
         Place::Node(id) => Ok((
             vec![
@@ -266,6 +308,7 @@ fn end_points(
                     .node_by_id(*id)
                     .ok_or_else(|| format!("no network node has id {id}"))?,
             ],
+            None,
             None,
         )),
         Place::Runway(number) => {
@@ -285,7 +328,7 @@ fn end_points(
                     "the network has no hold point of runway {number} (no edge in its zone, 1204)"
                 ));
             }
-            Ok((holds, None))
+            Ok((holds, None, None))
         }
         Place::Stand(name) => {
             let stand = airport
@@ -296,7 +339,7 @@ fn end_points(
                     "stand `{name}` takes aircraft up to code {class}, not {code}"
                 ));
             }
-            let (edge, p) = nearest_on_edges(graph, stand.at, code).ok_or_else(|| {
+            let (edge, p, t) = nearest_on_edges(graph, stand.at, code).ok_or_else(|| {
                 format!("no taxiway admitting code {code} to reach stand `{name}` by")
             })?;
             let e = graph.network.edges[edge].clone();
@@ -305,7 +348,7 @@ fn end_points(
             if !e.one_way {
                 graph.add_arc(e.to, end, edge);
             }
-            Ok((vec![end], Some(stand.at)))
+            Ok((vec![end], Some(stand.at), Some((edge, t))))
         }
     }
 }
@@ -342,30 +385,30 @@ fn runway_node_at_threshold(airport: &Airport, number: &str) -> Result<usize, St
         .ok_or_else(|| format!("the network has no runway edge on runway {}", runway.name()))
 }
 
-/// Nodes where an edge in the zone of runway end `number` meets one that is not: where an
-/// aircraft bound for that runway holds short.
+/// Nodes where an edge in the zone of runway end `number` meets a taxiway in no runway's zone:
+/// where an aircraft bound for that runway holds short (never on, or in the zone of, another
+/// runway).
 #[must_use]
 pub fn hold_points(network: &Network, number: &str) -> Vec<usize> {
     let mut inside = vec![false; network.nodes.len()];
     let mut outside = vec![false; network.nodes.len()];
     for edge in &network.edges {
-        let flags = if edge.in_zone_of(number) || edge.class == EdgeClass::Runway {
-            &mut inside
-        } else {
-            &mut outside
-        };
-        flags[edge.from] = true;
-        flags[edge.to] = true;
+        if edge.in_zone_of(number) {
+            inside[edge.from] = true;
+            inside[edge.to] = true;
+        } else if edge.class != EdgeClass::Runway && edge.zone_runways.is_empty() {
+            outside[edge.from] = true;
+            outside[edge.to] = true;
+        }
     }
+    let on_a_runway = |i: usize| {
+        network
+            .edges
+            .iter()
+            .any(|e| e.class == EdgeClass::Runway && (e.from == i || e.to == i))
+    };
     (0..network.nodes.len())
-        .filter(|&i| {
-            inside[i]
-                && outside[i]
-                && network
-                    .edges
-                    .iter()
-                    .any(|e| (e.from == i || e.to == i) && e.in_zone_of(number))
-        })
+        .filter(|&i| inside[i] && outside[i] && !on_a_runway(i))
         .collect()
 }
 
@@ -373,7 +416,9 @@ pub fn hold_points(network: &Network, number: &str) -> Vec<usize> {
 struct Search<'a> {
     graph: &'a Graph<'a>,
     via: &'a [String],
-    allow_runway: bool,
+    /// Per network edge: a runway edge the route may drive without naming it (the runway a
+    /// route starting on one leaves by).
+    runway_ok: Vec<bool>,
 }
 
 #[derive(PartialEq)]
@@ -400,22 +445,29 @@ impl PartialOrd for Entry {
 }
 
 impl Search<'_> {
-    /// The stage after driving an edge named `name` at `stage` (None: not allowed).
-    fn next_stage(&self, stage: usize, name: &str, runway: bool) -> Option<usize> {
+    /// The stage after driving network edge `edge` (named `name`) at `stage` (None: not
+    /// allowed). Stage 0: before the first taxiway of `via` (others may lead to it, not those
+    /// listed); stage s in 1..=k: on `via[s - 1]`, going on to `via[s]`; stage k + 1: the list
+    /// done, any taxiway to the end. A runway is driven only when listed, or when it is the one
+    /// the route starts on, before the list begins.
+    fn next_stage(&self, stage: usize, edge: usize, name: &str, runway: bool) -> Option<usize> {
         let k = self.via.len();
-        let named = self.via.iter().position(|v| v == name);
-        if runway && named.is_none() && !(self.allow_runway && stage == 0) {
+        let listed = self.via.iter().any(|v| v == name);
+        if runway && !listed && !(self.runway_ok[edge] && stage == 0) {
             return None;
         }
-        if name.is_empty() {
+        if name.is_empty() || k == 0 || stage == k + 1 {
             return Some(stage);
         }
-        match (stage, named) {
-            (_, None) if stage == 0 || stage == k + 1 || k == 0 => Some(stage),
-            (_, None) if stage == k => Some(k + 1),
-            (_, None) => None,
-            (s, Some(i)) if s >= 1 && s <= k && i == s - 1 => Some(s),
-            (s, Some(i)) if s < k && i == s => Some(s + 1),
+        if stage >= 1 && self.via[stage - 1] == name {
+            return Some(stage);
+        }
+        if stage < k && self.via[stage] == name {
+            return Some(stage + 1);
+        }
+        match stage {
+            0 if !listed => Some(0),
+            s if s == k => Some(k + 1),
             _ => None,
         }
     }
@@ -448,9 +500,12 @@ impl Search<'_> {
         let runway = |arc: &Arc| self.graph.network.edges[arc.edge].class == EdgeClass::Runway;
         for &a in &self.graph.leaving[start] {
             let arc = &arcs[a];
-            if let Some(stage) =
-                self.next_stage(0, &self.graph.network.edges[arc.edge].name, runway(arc))
-            {
+            if let Some(stage) = self.next_stage(
+                0,
+                arc.edge,
+                &self.graph.network.edges[arc.edge].name,
+                runway(arc),
+            ) {
                 let state = a * stages + stage;
                 cost[state] = arc.length_m;
                 heap.push(Entry {
@@ -477,6 +532,7 @@ impl Search<'_> {
                 }
                 let Some(s) = self.next_stage(
                     stage,
+                    next.edge,
                     &self.graph.network.edges[next.edge].name,
                     runway(next),
                 ) else {

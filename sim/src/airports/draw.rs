@@ -118,7 +118,8 @@ fn draw<DB: DrawingBackend>(
         let colour = match p.surface {
             Surface::Asphalt => ASPHALT,
             Surface::Concrete => CONCRETE,
-            Surface::Unpaved | Surface::Other => UNPAVED,
+            Surface::Unpaved | Surface::Other | Surface::Water | Surface::Snow => UNPAVED,
+            Surface::Transparent => continue,
         };
         plot.draw(&Polygon::new(
             p.outline.iter().map(xy).collect::<Vec<_>>(),

@@ -26,6 +26,9 @@ fn surface_name(surface: Surface) -> &'static str {
         Surface::Asphalt => "asphalt",
         Surface::Concrete => "concrete",
         Surface::Unpaved => "unpaved",
+        Surface::Water => "water",
+        Surface::Snow => "snow",
+        Surface::Transparent => "transparent",
         Surface::Other => "other",
     }
 }

@@ -38,7 +38,10 @@ fn surface_remission(surface: Surface) -> f32 {
         Surface::Asphalt => 0.2,
         Surface::Concrete => 0.35,
         Surface::Unpaved => 0.15,
-        Surface::Other => GRASS_REMISSION,
+        // Water reflects a 905 nm beam away from the sensor; snow sends much of it back.
+        Surface::Water => 0.03,
+        Surface::Snow => 0.8,
+        Surface::Other | Surface::Transparent => GRASS_REMISSION,
     }
 }
 
@@ -103,6 +106,10 @@ pub fn airport_world(airport: &Airport, furniture: Furniture) -> AirportWorld {
     let xy = |p: &Vector2<f64>| [p.x, p.y];
     let mut out = AirportWorld::default();
     for (i, p) in airport.pavements.iter().enumerate() {
+        if p.surface == Surface::Transparent {
+            // It carries markings only: the pavement (or grass) under it stays as drawn.
+            continue;
+        }
         out.areas.push(Area {
             id: format!("pavement_{}", i + 1),
             outline: p.outline.iter().map(xy).collect(),

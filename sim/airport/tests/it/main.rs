@@ -6,3 +6,4 @@ mod fixture;
 mod malformed;
 mod routes;
 mod shared_data;
+mod small_airports;

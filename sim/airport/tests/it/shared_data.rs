@@ -112,3 +112,45 @@ fn ksyr_routes_from_a_gate_to_runway_28() {
         path.tightest_radius_m
     );
 }
+
+/// Vacating runway 28 to the B stands drives along 10/28 only, never along 15/33; two gates on
+/// one taxilane edge are joined along it (134 m, not 978 m round by S and B); and runway 33's
+/// hold points are on no runway, where a taxiway in no runway's zone begins.
+#[test]
+#[ignore = "reads ../shared/data"]
+fn ksyr_routes_keep_off_other_runways_and_join_neighbouring_gates() {
+    let a = ksyr();
+    let request = |from: &str, to: &str| RouteRequest {
+        from: Place::parse(from),
+        to: Place::parse(to),
+        via: Vec::new(),
+        code: SizeClass::B,
+    };
+    let vacate = airport::find(&a, &request("runway 28", "B21")).expect("vacating 28");
+    assert_eq!(vacate.taxiways.first().map(String::as_str), Some("10/28"));
+    assert!(
+        !vacate.taxiways.iter().any(|t| t == "15/33"),
+        "{:?}",
+        vacate.taxiways
+    );
+    let next_door = airport::find(&a, &request("B21", "B22")).expect("B21 to B22");
+    assert!(next_door.length_m < 150.0, "{}", next_door.length_m);
+    let holds = airport::hold_points(&a.network, "33");
+    assert!(!holds.is_empty());
+    for &h in &holds {
+        let edges: Vec<_> = a
+            .network
+            .edges
+            .iter()
+            .filter(|e| e.from == h || e.to == h)
+            .collect();
+        assert!(
+            edges.iter().all(|e| e.class != airport::EdgeClass::Runway),
+            "hold node {h} on a runway"
+        );
+        assert!(
+            edges.iter().any(|e| e.zone_runways.is_empty()),
+            "hold node {h} is not where a taxiway in no runway's zone begins"
+        );
+    }
+}
