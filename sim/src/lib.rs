@@ -15,6 +15,7 @@
 //! - [`engine`]: one run - the rig, the loop, the schedule, pose sources, the judge, the
 //!   observer hook and the report;
 //! - [`replay`]: the Rerun recording and live view of a run (the only module that names Rerun);
+//! - [`rosbag`]: a run as a ROS 2 bag (MCAP with `metadata.yaml`);
 //! - [`studies`]: the mapping demo and the small-obstacle sweep;
 //! - [`campaign`]: scenario families sampled, run in parallel, searched for failures;
 //! - [`tune`]: collision-model tuning on the campaign engine;
@@ -35,6 +36,8 @@ pub mod offline_map;
 pub mod engine;
 
 pub mod replay;
+
+pub mod rosbag;
 
 pub mod studies;
 

@@ -22,7 +22,7 @@ mod schedule;
 mod traffic;
 
 pub use judge::{DEVIATION_M, Judge, StepVerdict, Verdict};
-pub use observer::{NoObserver, Observer, RevolutionFrame, RunStart, StepFrame};
+pub use observer::{NoObserver, Observer, Observers, RevolutionFrame, RunStart, StepFrame};
 pub use outcome::{
     AT_FAULT_SPEED_M_S, EndReason, Event, JudgedContact, ObstacleReport, Pass, PassOutcome, Stop,
 };

@@ -113,3 +113,24 @@ pub struct StepFrame<'a> {
     /// The world (ground truth: object poses, which ones are active).
     pub world: &'a World,
 }
+
+/// Several observers, shown everything in turn (a Rerun recording and a ROS 2 bag of one run).
+pub struct Observers<'a>(pub Vec<&'a mut (dyn Observer + Send)>);
+
+impl Observer for Observers<'_> {
+    fn start(&mut self, run: &RunStart<'_>) -> Result<()> {
+        self.0.iter_mut().try_for_each(|o| o.start(run))
+    }
+    fn revolution(&mut self, frame: &RevolutionFrame<'_>) -> Result<()> {
+        self.0.iter_mut().try_for_each(|o| o.revolution(frame))
+    }
+    fn step(&mut self, frame: &StepFrame<'_>) -> Result<()> {
+        self.0.iter_mut().try_for_each(|o| o.step(frame))
+    }
+    fn event(&mut self, t_s: f64, event: &Event) -> Result<()> {
+        self.0.iter_mut().try_for_each(|o| o.event(t_s, event))
+    }
+    fn finish(&mut self, report: &RunReport) -> Result<()> {
+        self.0.iter_mut().try_for_each(|o| o.finish(report))
+    }
+}

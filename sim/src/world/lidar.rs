@@ -261,6 +261,11 @@ impl Lidar {
         })
     }
 
+    /// Where the sensor is mounted: its pose in the vehicle's frame.
+    pub fn vehicle_from_sensor(&self) -> Isometry3<f64> {
+        self.vehicle_from_sensor
+    }
+
     /// The configuration.
     pub fn config(&self) -> &LidarConfig {
         &self.config

@@ -9,6 +9,7 @@ mod campaign;
 mod fuzz;
 mod map_files;
 mod replay;
+mod rosbag;
 mod scenario;
 mod short_obstacles;
 mod small_obstacles;

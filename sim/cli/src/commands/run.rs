@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::Context as _;
 use sim::engine::EndReason;
 use sim::engine::RunReport;
-use sim::engine::{NoObserver, Observer};
+use sim::engine::{NoObserver, Observer, Observers};
 use sim::engine::{RunHandles, RunSetup, run_with};
 use sim::offline_map::{default_map_dir, fresh_manifest};
 use sim::replay::{Replay, ReplayOptions};
@@ -59,9 +59,11 @@ pub struct RunArgs {
     /// while the LiDAR takes the next one.
     #[arg(long)]
     pub sequential_sensing: bool,
-    /// Write a Rerun recording of the run here (.rrd; open it with `rerun FILE`, viewer 0.36).
+    /// Record the run here: a Rerun recording (.rrd; open it with `rerun FILE`, viewer 0.36)
+    /// or a ROS 2 bag (.mcap, with `metadata.yaml` beside it: `ros2 bag play DIR`, Foxglove,
+    /// rosbags); may be given twice, once each.
     #[arg(long, value_name = "FILE")]
-    pub record: Option<PathBuf>,
+    pub record: Vec<PathBuf>,
     /// Start a Rerun viewer (`rerun` on the PATH) and stream the run to it.
     #[arg(long)]
     pub spawn: bool,
@@ -88,7 +90,11 @@ pub struct RunArgs {
 impl RunArgs {
     fn replay_options(&self) -> ReplayOptions {
         ReplayOptions {
-            record: self.record.clone(),
+            record: self
+                .record
+                .iter()
+                .find(|p| p.extension().is_some_and(|e| e == "rrd"))
+                .cloned(),
             spawn: self.spawn,
             connect: self.connect.clone(),
             scan_every: self.replay_scan_every,
@@ -110,6 +116,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<bool> {
     let config = run_config(args, &scenario)?;
     let replay_options = args.replay_options();
     replay_options.validate()?;
+    let bag_path = bag_file(&args.record)?;
     let dir = args
         .map_dir
         .clone()
@@ -136,10 +143,24 @@ pub fn run(args: &RunArgs) -> anyhow::Result<bool> {
     } else {
         None
     };
+    let mut bag = bag_path
+        .map(|f| sim::rosbag::RosBag::create(&f))
+        .transpose()?;
     let mut no_observer = NoObserver;
-    let observer: &mut (dyn Observer + Send) = match replay.as_mut() {
-        Some(r) => r,
-        None => &mut no_observer,
+    let mut observers: Vec<&mut (dyn Observer + Send)> = Vec::new();
+    if let Some(r) = replay.as_mut() {
+        observers.push(r);
+    }
+    if let Some(b) = bag.as_mut() {
+        observers.push(b);
+    }
+    let mut both;
+    let observer: &mut (dyn Observer + Send) = match observers.len() {
+        0 => &mut no_observer,
+        _ => {
+            both = Observers(observers);
+            &mut both
+        }
     };
     let progress = crate::bar(1000, "running");
     let report = run_with(
@@ -176,12 +197,48 @@ pub fn run(args: &RunArgs) -> anyhow::Result<bool> {
             eprintln!("replay: streamed to {url}");
         }
     }
+    if let Some(summary) = bag.as_ref().and_then(|b| b.summary()) {
+        let messages: u64 = summary.topics.iter().map(|t| t.1).sum();
+        eprintln!(
+            "ROS 2 bag: wrote {} ({:.1} MB, {messages} messages on {} topics) and metadata.yaml beside it",
+            summary.file.display(),
+            summary.bytes as f64 / 1e6,
+            summary.topics.len()
+        );
+    }
     if let Some(path) = &args.report {
         mapper::write_atomically(path, serde_json::to_string_pretty(&report)?.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
     }
     crate::emit(&table(&report))?;
     Ok(report.expectations_met)
+}
+
+/// The `.mcap` of `--record`, if one is asked for; every file must be `.rrd` or `.mcap`, each
+/// kind at most once.
+fn bag_file(record: &[PathBuf]) -> anyhow::Result<Option<PathBuf>> {
+    let ext = |p: &PathBuf| p.extension().map(|e| e.to_string_lossy().into_owned());
+    for p in record {
+        anyhow::ensure!(
+            matches!(ext(p).as_deref(), Some("rrd" | "mcap")),
+            "--record {}: a Rerun recording (.rrd) or a ROS 2 bag (.mcap)",
+            p.display()
+        );
+    }
+    for kind in ["rrd", "mcap"] {
+        anyhow::ensure!(
+            record
+                .iter()
+                .filter(|p| ext(p).as_deref() == Some(kind))
+                .count()
+                <= 1,
+            "--record: one .{kind} file at most"
+        );
+    }
+    Ok(record
+        .iter()
+        .find(|p| ext(p).as_deref() == Some("mcap"))
+        .cloned())
 }
 
 /// The run's configuration: the file's (or the defaults), with the flags' overrides.

@@ -1,0 +1,142 @@
+#!/usr/bin/env python3
+"""A run's ROS 2 bag read by three readers nobody here wrote: rosbags (its own MCAP and CDR
+code; the bag directory with metadata.yaml, whose type hashes it recomputes from the embedded
+schemas), Foxglove's mcap + mcap-ros2-support, and rosbags again on the bare .mcap. Every
+message is decoded by each; the counts must agree with each other and with metadata.yaml; the
+schema texts must be what rosbags' own ROS 2 Jazzy type store generates; and the messages must
+agree with each other and with the run's JSON report.
+
+usage: check_bag.py BAG_DIR RUN_NAME.mcap REPORT.json
+"""
+import json
+import math
+import sys
+from collections import Counter
+from pathlib import Path
+
+from mcap.reader import make_reader
+from mcap_ros2.decoder import DecoderFactory
+from rosbags.highlevel import AnyReader
+from rosbags.rosbag2 import Reader as Rosbag2Reader
+from rosbags.typesys import Stores, get_typestore
+
+EXPECTED = {
+    "/tf_static": "tf2_msgs/msg/TFMessage",
+    "/tf": "tf2_msgs/msg/TFMessage",
+    "/clock": "rosgraph_msgs/msg/Clock",
+    "/velodyne_points": "sensor_msgs/msg/PointCloud2",
+    "/localization/pose": "geometry_msgs/msg/PoseWithCovarianceStamped",
+    "/ground_truth/odom": "nav_msgs/msg/Odometry",
+    "/cmd_drive": "ackermann_msgs/msg/AckermannDriveStamped",
+    "/planner/path": "nav_msgs/msg/Path",
+    "/events": "std_msgs/msg/String",
+}
+
+
+def fail(msg):
+    print(f"check_bag: FAIL: {msg}")
+    sys.exit(1)
+
+
+def ns(stamp):
+    return stamp.sec * 1_000_000_000 + stamp.nanosec
+
+
+def with_rosbags(path):
+    """Every message decoded by rosbags; per topic, the decoded messages in order."""
+    out = {}
+    with AnyReader([path]) as reader:
+        for conn, t, raw in reader.messages():
+            out.setdefault(conn.topic, []).append((t, reader.deserialize(raw, conn.msgtype)))
+    return out
+
+
+def main():
+    bag_dir, mcap_name, report_path = Path(sys.argv[1]), sys.argv[2], Path(sys.argv[3])
+    report = json.loads(report_path.read_text())
+    mcap_file = bag_dir / mcap_name
+
+    # 1. rosbag2 metadata, as ros2 bag info would read it.
+    meta = Rosbag2Reader(bag_dir)
+    meta.open()
+    meta_counts = {c.topic: c.msgcount for c in meta.connections}
+    types = {c.topic: c.msgtype for c in meta.connections}
+    meta.close()
+    if types != EXPECTED:
+        fail(f"topics and types {types} are not {EXPECTED}")
+
+    # 2. Three readers decode every message.
+    by_dir = with_rosbags(bag_dir)
+    by_file = with_rosbags(mcap_file)
+    foxglove = {}
+    with open(mcap_file, "rb") as f:
+        reader = make_reader(f, validate_crcs=True, decoder_factories=[DecoderFactory()])
+        if reader.get_header().profile != "ros2":
+            fail("the MCAP profile is not ros2")
+        schemas = {}
+        for schema, channel, message, ros_msg in reader.iter_decoded_messages():
+            foxglove.setdefault(channel.topic, []).append((message.log_time, ros_msg))
+            schemas[schema.name] = schema.data.decode()
+    counts = [
+        ("metadata.yaml", meta_counts),
+        ("rosbags (directory)", {k: len(v) for k, v in by_dir.items()}),
+        ("rosbags (.mcap)", {k: len(v) for k, v in by_file.items()}),
+        ("mcap-ros2-support", {k: len(v) for k, v in foxglove.items()}),
+    ]
+    for name, c in counts[1:]:
+        if c != counts[0][1]:
+            fail(f"{name} counts {c} differ from metadata.yaml's {counts[0][1]}")
+
+    # 3. The schema texts are rosbags' own for ROS 2 Jazzy.
+    store = get_typestore(Stores.ROS2_JAZZY)
+    for name, text in schemas.items():
+        if name.startswith("ackermann_msgs"):
+            continue  # not in the Jazzy base type store
+        want, _ = store.generate_msgdef(name, ros_version=2)
+        if text.strip() != want.strip():
+            fail(f"schema of {name} differs from rosbags':\n{text}\n---\n{want}")
+
+    # 4. The messages agree with each other and with the report.
+    revolutions = len(by_dir["/velodyne_points"])
+    sim_time = report["sim_time_s"]
+    if abs(revolutions - sim_time * 10) > 5:  # the first few, taken before the stack starts, are not shown
+        fail(f"{revolutions} clouds for {sim_time} s of simulated time (10 Hz)")
+    if len(by_dir["/tf"]) != revolutions or len(by_dir["/planner/path"]) != revolutions:
+        fail("/tf and /planner/path are not one per revolution")
+    for (t, cloud), (_, fox) in zip(by_dir["/velodyne_points"], foxglove["/velodyne_points"]):
+        names = [f.name for f in cloud.fields]
+        if names != ["x", "y", "z", "intensity", "ring", "time"] or cloud.point_step != 22:
+            fail(f"cloud fields {names}, point_step {cloud.point_step}")
+        if cloud.width < 1000 or len(cloud.data) != cloud.width * 22 or fox.width != cloud.width:
+            fail(f"cloud at {t}: width {cloud.width}, {len(cloud.data)} bytes")
+        if ns(cloud.header.stamp) != t:
+            fail(f"a cloud stamped {ns(cloud.header.stamp)} is logged at {t}")
+    # Odometry at 20 Hz, revolutions at 10 Hz: the same instants to within a millisecond.
+    truth = {round(t / 1e6): m for t, m in by_dir["/ground_truth/odom"]}
+    matched = 0
+    for t, tf in by_dir["/tf"]:
+        gt = [x for x in tf.transforms if x.child_frame_id == "ground_truth/base_link"]
+        if len(gt) != 1 or round(t / 1e6) not in truth:
+            continue
+        p, q = truth[round(t / 1e6)].pose.pose.position, gt[0].transform.translation
+        if math.hypot(p.x - q.x, p.y - q.y) > 1e-6:
+            fail(f"at {t} the true pose in /tf and /ground_truth/odom differ")
+        matched += 1
+    if matched < revolutions // 2:
+        fail(f"only {matched} of {revolutions} revolutions have the true pose in both /tf and /ground_truth/odom")
+    clock = [ns(m.clock) for _, m in by_dir["/clock"]]
+    if clock != sorted(clock) or abs((clock[-1] - clock[0]) / 1e9 - sim_time) > 0.1:
+        fail(f"/clock spans {(clock[-1] - clock[0]) / 1e9} s, the run {sim_time} s")
+    stops = sum(json.loads(m.data)["kind"] == "Stop" for _, m in by_dir["/events"])
+    if stops != len(report["stops"]):
+        fail(f"{stops} Stop events against the report's {len(report['stops'])} stops")
+    total = sum(meta_counts.values())
+    print(
+        f"ok: {total} messages on {len(meta_counts)} topics decoded by rosbags (directory and .mcap) "
+        f"and mcap-ros2-support; {revolutions} clouds, {matched} true poses matched, "
+        f"schemas as rosbags generates them, {stops} stops as the report"
+    )
+
+
+if __name__ == "__main__":
+    main()

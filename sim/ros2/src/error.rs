@@ -1,0 +1,58 @@
+//! What can go wrong writing or reading a bag: every error names the file, and a message's
+//! errors the field and the byte offset.
+
+use std::path::PathBuf;
+
+/// A message's bytes could not be read as its type.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("field `{field}` at byte {offset}: {what}")]
+pub struct CdrError {
+    /// The field being read.
+    pub field: &'static str,
+    /// Where it starts in the message (bytes, header included).
+    pub offset: usize,
+    /// What is wrong.
+    pub what: String,
+}
+
+impl CdrError {
+    /// An error reading `field` at `offset`.
+    pub fn new(field: &'static str, offset: usize, what: impl Into<String>) -> Self {
+        Self {
+            field,
+            offset,
+            what: what.into(),
+        }
+    }
+}
+
+/// A bag could not be written or read.
+#[derive(Debug, thiserror::Error)]
+pub enum BagError {
+    /// The file system refused.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The MCAP layer refused.
+    #[error("{path}: MCAP: {source}")]
+    Mcap {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: mcap::McapError,
+    },
+    /// A topic was used wrongly (written before it was added, added twice with two types).
+    #[error("{path}: topic {topic}: {what}")]
+    Topic {
+        /// The file.
+        path: PathBuf,
+        /// The topic.
+        topic: String,
+        /// What is wrong.
+        what: String,
+    },
+}

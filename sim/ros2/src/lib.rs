@@ -1,0 +1,11 @@
+//! ROS 2 bags for taxi-sim: CDR ([`cdr`]), the standard message types a run is written as
+//! ([`msgs`]), and rosbag2 bags in MCAP with their `metadata.yaml` ([`bag`]) - what `ros2 bag`,
+//! Foxglove and `rosbags` read.
+
+pub mod bag;
+pub mod cdr;
+pub mod error;
+pub mod msgs;
+
+pub use bag::{BagSummary, BagWriter, Qos, TopicId};
+pub use error::{BagError, CdrError};

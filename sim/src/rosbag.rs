@@ -1,0 +1,266 @@
+//! A run as a ROS 2 bag (MCAP, with `metadata.yaml` beside it): an [`Observer`] that writes the
+//! standard messages a ROS stack would log (crate `ros2`). Simulated time `t` is stamped as
+//! 2024-01-01T00:00:00Z plus `t` (a stamp of 0 means "latest" to tf2).
+//!
+//! | topic | type | when |
+//! | --- | --- | --- |
+//! | `/tf_static` | `tf2_msgs/msg/TFMessage`: `map` -> `odom` (identity), `base_link` -> `velodyne` (the mount) | once, transient local |
+//! | `/tf` | `odom` -> `base_link` (the stack's estimate) and `map` -> `ground_truth/base_link` (the truth), kept apart | every revolution |
+//! | `/clock` | `rosgraph_msgs/msg/Clock` | 20 Hz |
+//! | `/velodyne_points` | `sensor_msgs/msg/PointCloud2`, frame `velodyne`, the ROS Velodyne driver's fields (x, y, z, intensity 0-255, ring, time) | every revolution, stamped at its start |
+//! | `/localization/pose` | `geometry_msgs/msg/PoseWithCovarianceStamped` in `map` (x, y, yaw covariance) | every revolution |
+//! | `/ground_truth/odom` | `nav_msgs/msg/Odometry`: the true pose and speed | 20 Hz |
+//! | `/cmd_drive` | `ackermann_msgs/msg/AckermannDriveStamped`: the command followed | 20 Hz |
+//! | `/planner/path` | `nav_msgs/msg/Path`: the chosen path | every revolution |
+//! | `/events` | `std_msgs/msg/String`: JSON `{"t_s": 14.31, "kind": "Stop", "event": "Stop { route_s_m: 28.3 }"}` (the kinds of `engine::Event`) | as they happen |
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::{Isometry2, Isometry3, UnitQuaternion};
+use ros2::msgs::{self, Pose, Time, Transform, VelodynePoint};
+use ros2::{BagWriter, Qos, TopicId};
+
+use crate::engine::{Event, Observer, RevolutionFrame, RunReport, RunStart, StepFrame};
+use crate::error::{Error, Result};
+
+/// Stamps start here: 2024-01-01T00:00:00Z, nanoseconds.
+pub const EPOCH_NS: u64 = 1_704_067_200_000_000_000;
+
+/// Steps between `/clock`, `/ground_truth/odom` and `/cmd_drive` messages (100 Hz physics).
+const STEP_EVERY: u64 = 5;
+
+/// The stamp of simulated time `t_s`.
+#[must_use]
+pub fn stamp_ns(t_s: f64) -> u64 {
+    EPOCH_NS + (t_s.max(0.0) * 1e9).round() as u64
+}
+
+struct Topics {
+    tf_static: TopicId,
+    tf: TopicId,
+    clock: TopicId,
+    cloud: TopicId,
+    pose: TopicId,
+    truth: TopicId,
+    cmd: TopicId,
+    path: TopicId,
+    events: TopicId,
+}
+
+/// Writes a run's bag (see the module's table).
+pub struct RosBag {
+    bag: Option<BagWriter>,
+    topics: Topics,
+    file: PathBuf,
+    steps: u64,
+    /// The LiDAR's revolution period, seconds (from the run's start).
+    period_s: f64,
+    written: Option<ros2::BagSummary>,
+}
+
+fn bag_error(e: ros2::BagError) -> Error {
+    Error::Invalid(format!("ROS 2 bag: {e}"))
+}
+
+impl RosBag {
+    /// A bag to be written at `file` (a `.mcap`).
+    ///
+    /// # Errors
+    /// The file cannot be created.
+    pub fn create(file: &Path) -> Result<Self> {
+        let mut bag = BagWriter::create(file).map_err(bag_error)?;
+        let mut add = |name, msg, qos| bag.add_topic(name, msg, qos).map_err(bag_error);
+        let topics = Topics {
+            tf_static: add("/tf_static", msgs::TF_MESSAGE, Qos::Latched)?,
+            tf: add("/tf", msgs::TF_MESSAGE, Qos::Stream)?,
+            clock: add("/clock", msgs::CLOCK, Qos::Stream)?,
+            cloud: add("/velodyne_points", msgs::POINT_CLOUD2, Qos::Stream)?,
+            pose: add(
+                "/localization/pose",
+                msgs::POSE_WITH_COVARIANCE_STAMPED,
+                Qos::Stream,
+            )?,
+            truth: add("/ground_truth/odom", msgs::ODOMETRY, Qos::Stream)?,
+            cmd: add("/cmd_drive", msgs::ACKERMANN_DRIVE_STAMPED, Qos::Stream)?,
+            path: add("/planner/path", msgs::PATH, Qos::Stream)?,
+            events: add("/events", msgs::STRING, Qos::Stream)?,
+        };
+        Ok(Self {
+            bag: Some(bag),
+            topics,
+            file: file.to_path_buf(),
+            steps: 0,
+            period_s: 0.1,
+            written: None,
+        })
+    }
+
+    /// What was written, once the run has finished.
+    #[must_use]
+    pub fn summary(&self) -> Option<&ros2::BagSummary> {
+        self.written.as_ref()
+    }
+
+    fn write(&mut self, topic: fn(&Topics) -> TopicId, t_s: f64, cdr: &[u8]) -> Result<()> {
+        let id = topic(&self.topics);
+        match self.bag.as_mut() {
+            Some(bag) => bag.write(id, stamp_ns(t_s), cdr).map_err(bag_error),
+            None => Err(Error::Invalid(format!(
+                "ROS 2 bag {}: written after it was finished",
+                self.file.display()
+            ))),
+        }
+    }
+}
+
+fn planar(p: &Isometry2<f64>, z: f64) -> Pose {
+    Pose::planar(p.translation.x, p.translation.y, z, p.rotation.angle())
+}
+
+fn pose3(p: &Isometry3<f64>) -> Pose {
+    let q: &UnitQuaternion<f64> = &p.rotation;
+    Pose {
+        position: [p.translation.x, p.translation.y, p.translation.z],
+        orientation: [q.i, q.j, q.k, q.w],
+    }
+}
+
+fn transform(t_s: f64, parent: &str, child: &str, pose: Pose) -> Transform {
+    Transform {
+        stamp: Time::from_ns(stamp_ns(t_s)),
+        parent: parent.to_string(),
+        child: child.to_string(),
+        pose,
+    }
+}
+
+/// The revolution's returns in the sensor frame (each column's own pose at its firing time),
+/// with their beam and their time after the revolution's start.
+fn cloud_points(frame: &RevolutionFrame<'_>, period_s: f64) -> Vec<VelodynePoint> {
+    let scan = &frame.revolution.scan;
+    let columns = scan.column_count().max(1);
+    let mut points = Vec::with_capacity(scan.returns().len());
+    for c in 0..scan.column_count() {
+        let Some((column, returns)) = scan.column(c) else {
+            continue;
+        };
+        let sensor_from_world = column.world_from_sensor.inverse();
+        let time = (c as f64 / columns as f64 * period_s) as f32;
+        for (beam, r) in returns.iter().enumerate() {
+            if let Some(r) = r {
+                let p = sensor_from_world * r.point_in_world;
+                points.push(VelodynePoint {
+                    xyz: [p.x as f32, p.y as f32, p.z as f32],
+                    intensity: r.intensity * 255.0,
+                    ring: beam as u16,
+                    time,
+                });
+            }
+        }
+    }
+    points
+}
+
+/// A planar covariance (x, y, yaw) as ROS's 6x6 over (x, y, z, roll, pitch, yaw).
+fn covariance6(c: &nalgebra::Matrix3<f64>) -> [f64; 36] {
+    let mut out = [0.0; 36];
+    let index = [0, 1, 5];
+    for (i, &r) in index.iter().enumerate() {
+        for (j, &k) in index.iter().enumerate() {
+            out[r * 6 + k] = c[(i, j)];
+        }
+    }
+    out
+}
+
+impl Observer for RosBag {
+    fn start(&mut self, run: &RunStart<'_>) -> Result<()> {
+        self.period_s = 1.0 / run.lidar.config().rotation_frequency_hz;
+        let mount = run.lidar.vehicle_from_sensor();
+        let tf = msgs::tf_message(&[
+            transform(0.0, "map", "odom", Pose::planar(0.0, 0.0, 0.0, 0.0)),
+            transform(0.0, "base_link", "velodyne", pose3(&mount)),
+        ]);
+        self.write(|t| t.tf_static, 0.0, &tf)
+    }
+
+    fn revolution(&mut self, frame: &RevolutionFrame<'_>) -> Result<()> {
+        // Stamped when it was taken (the stack sees it a revolution later when it plans while
+        // the next is taken).
+        let t = frame.revolution.t_s;
+        let tf = msgs::tf_message(&[
+            transform(t, "odom", "base_link", planar(&frame.estimate, 0.0)),
+            transform(
+                t,
+                "map",
+                "ground_truth/base_link",
+                planar(&frame.truth, 0.0),
+            ),
+        ]);
+        self.write(|t| t.tf, t, &tf)?;
+        let stamp = Time::from_ns(stamp_ns(t));
+        let cloud = msgs::velodyne_cloud(stamp, "velodyne", &cloud_points(frame, self.period_s));
+        self.write(|t| t.cloud, t, &cloud)?;
+        if let Some(e) = &frame.pose_estimate {
+            let pose = msgs::pose_with_covariance(
+                stamp,
+                "map",
+                &planar(&e.world_from_vehicle, 0.0),
+                &covariance6(&e.covariance),
+            );
+            self.write(|t| t.pose, t, &pose)?;
+        }
+        let poses: Vec<(f64, f64, f64)> = frame
+            .plan
+            .chosen()
+            .poses
+            .iter()
+            .map(|p| (p.translation.x, p.translation.y, p.rotation.angle()))
+            .collect();
+        self.write(|t| t.path, t, &msgs::path(stamp, "map", &poses))
+    }
+
+    fn step(&mut self, frame: &StepFrame<'_>) -> Result<()> {
+        self.steps += 1;
+        if !self.steps.is_multiple_of(STEP_EVERY) {
+            return Ok(());
+        }
+        let t = frame.t_s;
+        let stamp = Time::from_ns(stamp_ns(t));
+        self.write(|t| t.clock, t, &msgs::clock(stamp))?;
+        let s = frame.state;
+        let odom = msgs::odometry(
+            stamp,
+            "map",
+            "ground_truth/base_link",
+            &Pose::planar(s.x_m, s.y_m, 0.0, s.yaw_rad),
+            &[0.0; 36],
+            [[s.speed_m_s, 0.0, 0.0], [0.0; 3]],
+        );
+        self.write(|t| t.truth, t, &odom)?;
+        let cmd = msgs::ackermann(
+            stamp,
+            "base_link",
+            frame.command.steering_rad as f32,
+            frame.command.speed_m_s as f32,
+        );
+        self.write(|t| t.cmd, t, &cmd)
+    }
+
+    fn event(&mut self, t_s: f64, event: &Event) -> Result<()> {
+        let text = format!("{event:?}");
+        let kind = text
+            .split(|c: char| !c.is_alphanumeric())
+            .next()
+            .unwrap_or("");
+        let json = serde_json::json!({ "t_s": t_s, "kind": kind, "event": text });
+        self.write(|t| t.events, t_s, &msgs::string(&json.to_string()))
+    }
+
+    fn finish(&mut self, _report: &RunReport) -> Result<()> {
+        if let Some(bag) = self.bag.take() {
+            self.written = Some(bag.finish().map_err(bag_error)?);
+        }
+        Ok(())
+    }
+}
