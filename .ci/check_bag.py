@@ -62,8 +62,11 @@ def main():
     meta_counts = {c.topic: c.msgcount for c in meta.connections}
     types = {c.topic: c.msgtype for c in meta.connections}
     meta.close()
-    if types != EXPECTED:
-        fail(f"topics and types {types} are not {EXPECTED}")
+    levels = sorted(t for t in types if t.startswith("/map/level_"))
+    if {t: types[t] for t in types if t not in levels} != EXPECTED or not levels:
+        fail(f"topics and types {types} are not {EXPECTED} and /map/level_<k>")
+    if any(types[t] != "nav_msgs/msg/OccupancyGrid" for t in levels):
+        fail(f"level maps of types {[types[t] for t in levels]}")
 
     # 2. Three readers decode every message.
     by_dir = with_rosbags(bag_dir)
@@ -124,6 +127,18 @@ def main():
         matched += 1
     if matched < revolutions // 2:
         fail(f"only {matched} of {revolutions} revolutions have the true pose in both /tf and /ground_truth/odom")
+    for topic in levels:
+        grids = by_dir[topic]
+        if abs(len(grids) - sim_time) > 2:
+            fail(f"{len(grids)} {topic} grids for {sim_time} s (1 Hz)")
+        for t, g in grids:
+            cells = list(g.data)
+            if len(cells) != g.info.width * g.info.height or g.info.resolution <= 0:
+                fail(f"{topic} at {t}: {len(cells)} cells for {g.info.width} x {g.info.height}")
+            if any(not (v == -1 or 0 <= v <= 100) for v in cells):
+                fail(f"{topic} at {t}: values outside -1, 0..100")
+        if not any(v >= 65 for _, g in grids for v in g.data):
+            fail(f"{topic}: no occupied cell in any grid")
     clock = [ns(m.clock) for _, m in by_dir["/clock"]]
     if clock != sorted(clock) or abs((clock[-1] - clock[0]) / 1e9 - sim_time) > 0.1:
         fail(f"/clock spans {(clock[-1] - clock[0]) / 1e9} s, the run {sim_time} s")
@@ -133,7 +148,7 @@ def main():
     total = sum(meta_counts.values())
     print(
         f"ok: {total} messages on {len(meta_counts)} topics decoded by rosbags (directory and .mcap) "
-        f"and mcap-ros2-support; {revolutions} clouds, {matched} true poses matched, "
+        f"and mcap-ros2-support; {revolutions} clouds, {len(levels)} level maps, {matched} true poses matched, "
         f"schemas as rosbags generates them, {stops} stops as the report"
     )
 

@@ -42,7 +42,8 @@ pub use error::{MapError, Result};
 pub use grid::{Cell, Grid, GridGeometry};
 pub use levels::{HeightClass, LevelMode, Levels};
 pub use map::{
-    FreeSpaceStop, FreeSpaceWalks, InsertStats, MapConfig, MergeMode, MultiHeightMap, WorldCell,
+    FreeSpaceStop, FreeSpaceWalks, InsertStats, MapConfig, MergeMode, MultiHeightMap, RosOccupancy,
+    WorldCell,
 };
 pub use occupancy::{ObstacleTestParams, OccupancyParams};
 pub use odm::{DistanceMap, DistanceMaps};

@@ -12,6 +12,7 @@
 //! | `/ground_truth/odom` | `nav_msgs/msg/Odometry`: the true pose and speed | 20 Hz |
 //! | `/cmd_drive` | `ackermann_msgs/msg/AckermannDriveStamped`: the command followed | 20 Hz |
 //! | `/planner/path` | `nav_msgs/msg/Path`: the chosen path | every revolution |
+//! | `/map/level_<k>` | `nav_msgs/msg/OccupancyGrid`: each level's merged occupancy, 60 m around the estimate (transient local) | 1 Hz |
 //! | `/events` | `std_msgs/msg/String`: JSON `{"t_s": 14.31, "kind": "Stop", "event": "Stop { route_s_m: 28.3 }"}` (the kinds of `engine::Event`) | as they happen |
 
 use std::path::{Path, PathBuf};
@@ -28,6 +29,10 @@ pub const EPOCH_NS: u64 = 1_704_067_200_000_000_000;
 
 /// Steps between `/clock`, `/ground_truth/odom` and `/cmd_drive` messages (100 Hz physics).
 const STEP_EVERY: u64 = 5;
+
+/// Seconds between the level maps, and the half side of the square written, metres.
+const MAP_EVERY_S: f64 = 1.0;
+const MAP_HALF_M: f64 = 30.0;
 
 /// The stamp of simulated time `t_s`.
 #[must_use]
@@ -55,6 +60,9 @@ pub struct RosBag {
     steps: u64,
     /// The LiDAR's revolution period, seconds (from the run's start).
     period_s: f64,
+    /// `/map/level_<k>`, added at the first revolution; when they were last written.
+    maps: Vec<TopicId>,
+    last_map_s: Option<f64>,
     written: Option<ros2::BagSummary>,
 }
 
@@ -91,6 +99,8 @@ impl RosBag {
             file: file.to_path_buf(),
             steps: 0,
             period_s: 0.1,
+            maps: Vec::new(),
+            last_map_s: None,
             written: None,
         })
     }
@@ -173,6 +183,49 @@ fn covariance6(c: &nalgebra::Matrix3<f64>) -> [f64; 36] {
     out
 }
 
+impl RosBag {
+    /// Each level's occupancy around `at`, the topics added the first time.
+    fn write_maps(
+        &mut self,
+        map: &mapper::MultiHeightMap,
+        at: &Isometry2<f64>,
+        t: f64,
+    ) -> Result<()> {
+        let levels = map.levels().count();
+        if let Some(bag) = self.bag.as_mut()
+            && self.maps.len() < levels
+        {
+            for k in self.maps.len()..levels {
+                let name = format!("/map/level_{k}");
+                self.maps.push(
+                    bag.add_topic(&name, msgs::OCCUPANCY_GRID, Qos::Latched)
+                        .map_err(bag_error)?,
+                );
+            }
+        }
+        let center = nalgebra::Point2::from(at.translation.vector);
+        let stamp = Time::from_ns(stamp_ns(t));
+        for k in 0..levels {
+            let Some(crop) = map.ros_occupancy_around(k, &center, MAP_HALF_M) else {
+                continue;
+            };
+            let grid = msgs::occupancy_grid(
+                stamp,
+                "map",
+                crop.resolution_m as f32,
+                (crop.width as u32, crop.height as u32),
+                &Pose::planar(crop.corner.x, crop.corner.y, 0.0, 0.0),
+                &crop.cells,
+            );
+            let topic = self.maps[k];
+            if let Some(bag) = self.bag.as_mut() {
+                bag.write(topic, stamp_ns(t), &grid).map_err(bag_error)?;
+            }
+        }
+        Ok(())
+    }
+}
+
 impl Observer for RosBag {
     fn start(&mut self, run: &RunStart<'_>) -> Result<()> {
         self.period_s = 1.0 / run.lidar.config().rotation_frequency_hz;
@@ -217,7 +270,15 @@ impl Observer for RosBag {
             .iter()
             .map(|p| (p.translation.x, p.translation.y, p.rotation.angle()))
             .collect();
-        self.write(|t| t.path, t, &msgs::path(stamp, "map", &poses))
+        self.write(|t| t.path, t, &msgs::path(stamp, "map", &poses))?;
+        if self
+            .last_map_s
+            .is_none_or(|last| t - last >= MAP_EVERY_S - 1e-9)
+        {
+            self.last_map_s = Some(t);
+            self.write_maps(frame.map, &frame.estimate, t)?;
+        }
+        Ok(())
     }
 
     fn step(&mut self, frame: &StepFrame<'_>) -> Result<()> {

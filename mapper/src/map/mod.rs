@@ -50,7 +50,7 @@ mod window;
 
 pub use config::{FreeSpaceStop, FreeSpaceWalks, MapConfig, MergeMode};
 pub use insert::InsertStats;
-pub use query::merge_log_odds;
+pub use query::{RosOccupancy, merge_log_odds};
 
 use foldhash::HashMap;
 use nalgebra::Point2;

@@ -192,6 +192,52 @@ impl MultiHeightMap {
         Grid::from_vec(self.geometry, data).ok()
     }
 
+    /// The merged occupancy of a level within `half_m` of `center` (clamped to the window), as
+    /// ROS `OccupancyGrid` values: the probability in percent, -1 unknown; row 0 at the lowest y.
+    /// `None` past the last level or when nothing of the window is left.
+    pub fn ros_occupancy_around(
+        &self,
+        level: usize,
+        center: &Point2<f64>,
+        half_m: f64,
+    ) -> Option<RosOccupancy> {
+        let (live, prior) = (self.live.get(level)?, self.prior.get(level)?);
+        let g = self.geometry;
+        let res = g.resolution_m();
+        let half = (half_m / res).round() as i64;
+        let (cx, cy) = g.cell_coords(center);
+        let clamp_x = |v: i64| v.clamp(0, g.width() as i64) as usize;
+        let clamp_y = |v: i64| v.clamp(0, g.height() as i64) as usize;
+        let (x0, x1, y0, y1) = (
+            clamp_x(cx - half),
+            clamp_x(cx + half),
+            clamp_y(cy - half),
+            clamp_y(cy + half),
+        );
+        if x1 <= x0 || y1 <= y0 {
+            return None;
+        }
+        let mut cells = Vec::with_capacity((x1 - x0) * (y1 - y0));
+        for y in y0..y1 {
+            let row = y * g.width();
+            let (l, p) = (
+                &live.data()[row + x0..row + x1],
+                &prior.data()[row + x0..row + x1],
+            );
+            cells.extend(l.iter().zip(p).map(|(l, p)| {
+                merge_log_odds(*l, *p, self.config.merge)
+                    .map_or(-1, |lo| (probability(lo) * 100.0).round() as i8)
+            }));
+        }
+        Some(RosOccupancy {
+            corner: g.origin_m() + nalgebra::Vector2::new(x0 as f64 * res, y0 as f64 * res),
+            width: x1 - x0,
+            height: y1 - y0,
+            resolution_m: res,
+            cells,
+        })
+    }
+
     /// The live log-odds of a level (NaN = unknown).
     pub fn live_log_odds(&self, level: usize) -> Option<&Grid<f32>> {
         self.live.get(level)
@@ -235,4 +281,20 @@ pub fn merge_log_odds(live: f32, prior: f32, mode: MergeMode) -> Option<f32> {
             }
         },
     }
+}
+
+/// A square of a level's merged occupancy in ROS `OccupancyGrid` values
+/// ([`MultiHeightMap::ros_occupancy_around`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RosOccupancy {
+    /// The lower-left corner of its first cell, metres.
+    pub corner: Point2<f64>,
+    /// Cells across.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// Metres per cell.
+    pub resolution_m: f64,
+    /// Row-major from the lowest row: probability in percent, -1 unknown.
+    pub cells: Vec<i8>,
 }

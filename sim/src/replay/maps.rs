@@ -1,5 +1,6 @@
 //! The maps around the vehicle, `maps_hz` times a second: each level's merged occupancy (a
-//! `GridMap` at the level's height) and its obstacle distance map (a `DepthImage`).
+//! `GridMap` at the level's height, from `MultiHeightMap::ros_occupancy_around`) and its obstacle
+//! distance map (a `DepthImage`).
 
 use mapper::MultiHeightMap;
 use nalgebra::Point2;
@@ -16,9 +17,6 @@ struct Crop {
     h: usize,
     /// The grid's width (row stride).
     stride: usize,
-    resolution_m: f64,
-    /// Lower-left corner of the crop, metres.
-    corner: Point2<f64>,
 }
 
 impl Crop {
@@ -37,8 +35,6 @@ impl Crop {
             w: x1 - x0,
             h: y1 - y0,
             stride: g.width(),
-            resolution_m: res,
-            corner: g.origin_m() + nalgebra::Vector2::new(x0 as f64 * res, y0 as f64 * res),
         })
     }
 
@@ -53,23 +49,11 @@ impl Replay {
     /// Each level's merged occupancy and distance map within `map_half_m` of `center`.
     pub(super) fn log_maps(&mut self, map: &MultiHeightMap, center: Point2<f64>) -> Result<()> {
         let half_m = self.options.map_half_m;
-        let merge = map.config().merge;
         for k in 0..map.levels().count() {
-            let (Some(live), Some(prior)) = (map.live_log_odds(k), map.prior_log_odds(k)) else {
-                continue;
-            };
             // ROS OccupancyGrid values: 0..100 = probability in percent, 255 (-1) = unknown;
             // row 0 at the lowest y, like the grid.
-            if let Some(crop) = Crop::around(live.geometry(), center, half_m) {
-                let mut occupancy = Vec::with_capacity(crop.w * crop.h);
-                for y in crop.y0..crop.y0 + crop.h {
-                    let (l, p) = (crop.row(live.data(), y), crop.row(prior.data(), y));
-                    occupancy.extend(l.iter().zip(p).map(|(l, p)| {
-                        mapper::map::merge_log_odds(*l, *p, merge).map_or(255u8, |lo| {
-                            (mapper::occupancy::probability(lo) * 100.0).round() as u8
-                        })
-                    }));
-                }
+            if let Some(crop) = map.ros_occupancy_around(k, &center, half_m) {
+                let occupancy: Vec<u8> = crop.cells.iter().map(|&v| v as u8).collect();
                 let z = self
                     .level_heights_m
                     .get(k)
@@ -81,7 +65,7 @@ impl Replay {
                     &rerun::GridMap::new(
                         occupancy,
                         rerun::components::ImageFormat::from_color_model(
-                            [crop.w as u32, crop.h as u32],
+                            [crop.width as u32, crop.height as u32],
                             ColorModel::L,
                             ChannelDatatype::U8,
                         ),
