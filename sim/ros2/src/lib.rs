@@ -1,11 +1,13 @@
 //! ROS 2 bags for taxi-sim: CDR ([`cdr`]), the standard message types a run is written as
-//! ([`msgs`]), and rosbag2 bags in MCAP with their `metadata.yaml` ([`bag`]) - what `ros2 bag`,
-//! Foxglove and `rosbags` read.
+//! ([`msgs`]), rosbag2 bags in MCAP with their `metadata.yaml` ([`bag`]) - what `ros2 bag`,
+//! Foxglove and `rosbags` read - and point clouds read by field name from any driver ([`cloud`]).
 
 pub mod bag;
 pub mod cdr;
+pub mod cloud;
 pub mod error;
 pub mod msgs;
 
 pub use bag::{BagSummary, BagWriter, Qos, TopicId};
+pub use cloud::{Cloud, CloudError, read_cloud};
 pub use error::{BagError, CdrError};

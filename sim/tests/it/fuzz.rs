@@ -3,7 +3,7 @@
 //! never hang, and never load a non-finite number (map blocks excepted, where NaN means unknown:
 //! their reader refuses infinities itself). Parsers: scenarios (with the pose files they name),
 //! vehicle sidecars, URDFs, campaign files, run configurations, map blocks, map manifests and
-//! ROS map YAML + PGM. `TAXI_SIM_FUZZ_CASES` sets the cases per parser (default 64, the quick
+//! ROS map YAML + PGM, ROS 2 point clouds. `TAXI_SIM_FUZZ_CASES` sets the cases per parser (default 64, the quick
 //! budget CI runs; README "Hostile input" has the long run).
 
 use std::path::{Path, PathBuf};
@@ -326,5 +326,23 @@ fn map_blocks_manifests_and_ros_maps() {
         mapper::export::read_ros_map(&pgm_yaml)
             .ok()
             .map(|g| format!("{:?}", g.geometry()))
+    });
+}
+
+/// ROS 2 point clouds (`ros2::read_cloud`): arbitrary bytes and byte edits of a valid cloud are
+/// read or refused, never a panic (the cloud's numbers are binary: NaN is a driver's "no return").
+#[test]
+fn ros2_point_clouds() {
+    let points: Vec<ros2::msgs::VelodynePoint> = (0..12)
+        .map(|i| ros2::msgs::VelodynePoint {
+            xyz: [i as f32, 1.0, -2.0],
+            intensity: 7.0,
+            ring: i as u16,
+            time: 0.001 * i as f32,
+        })
+        .collect();
+    let seed = ros2::msgs::velodyne_cloud(ros2::msgs::Time::from_ns(1), "velodyne", &points);
+    fuzz("point cloud", seed, false, |b| {
+        ros2::read_cloud(b).ok().map(|c| format!("{}", c.xyz.len()))
     });
 }
