@@ -7,7 +7,7 @@
 //! | `/tf_static` | `tf2_msgs/msg/TFMessage`: `map` -> `odom` (identity), `base_link` -> `velodyne` (the mount) | once, transient local |
 //! | `/tf` | `odom` -> `base_link` (the stack's estimate) and `map` -> `ground_truth/base_link` (the truth), kept apart | every revolution |
 //! | `/clock` | `rosgraph_msgs/msg/Clock` | 20 Hz |
-//! | `/velodyne_points` | `sensor_msgs/msg/PointCloud2`, frame `velodyne`, the ROS Velodyne driver's fields (x, y, z, intensity 0-255, ring, time) | every revolution, stamped at its start |
+//! | `/velodyne_points` | `sensor_msgs/msg/PointCloud2`, frame `velodyne`, the ROS Velodyne driver's fields (x, y, z, intensity 0-255, ring, time 0: the loop takes a revolution at one instant) | every revolution, stamped when taken |
 //! | `/localization/pose` | `geometry_msgs/msg/PoseWithCovarianceStamped` in `map` (x, y, yaw covariance) | every revolution |
 //! | `/ground_truth/odom` | `nav_msgs/msg/Odometry`: the true pose and speed | 20 Hz |
 //! | `/cmd_drive` | `ackermann_msgs/msg/AckermannDriveStamped`: the command followed | 20 Hz |
@@ -58,8 +58,6 @@ pub struct RosBag {
     topics: Topics,
     file: PathBuf,
     steps: u64,
-    /// The LiDAR's revolution period, seconds (from the run's start).
-    period_s: f64,
     /// `/map/level_<k>`, added at the first revolution; when they were last written.
     maps: Vec<TopicId>,
     last_map_s: Option<f64>,
@@ -98,7 +96,6 @@ impl RosBag {
             topics,
             file: file.to_path_buf(),
             steps: 0,
-            period_s: 0.1,
             maps: Vec::new(),
             last_map_s: None,
             written: None,
@@ -144,18 +141,17 @@ fn transform(t_s: f64, parent: &str, child: &str, pose: Pose) -> Transform {
     }
 }
 
-/// The revolution's returns in the sensor frame (each column's own pose at its firing time),
-/// with their beam and their time after the revolution's start.
-fn cloud_points(frame: &RevolutionFrame<'_>, period_s: f64) -> Vec<VelodynePoint> {
+/// The revolution's returns in the sensor frame (each column's own pose), with their beam. Their
+/// `time` is 0: the closed loop takes a revolution at one instant (a consumer that deskews by
+/// it moves nothing).
+fn cloud_points(frame: &RevolutionFrame<'_>) -> Vec<VelodynePoint> {
     let scan = &frame.revolution.scan;
-    let columns = scan.column_count().max(1);
     let mut points = Vec::with_capacity(scan.returns().len());
     for c in 0..scan.column_count() {
         let Some((column, returns)) = scan.column(c) else {
             continue;
         };
         let sensor_from_world = column.world_from_sensor.inverse();
-        let time = (c as f64 / columns as f64 * period_s) as f32;
         for (beam, r) in returns.iter().enumerate() {
             if let Some(r) = r {
                 let p = sensor_from_world * r.point_in_world;
@@ -163,7 +159,7 @@ fn cloud_points(frame: &RevolutionFrame<'_>, period_s: f64) -> Vec<VelodynePoint
                     xyz: [p.x as f32, p.y as f32, p.z as f32],
                     intensity: r.intensity * 255.0,
                     ring: beam as u16,
-                    time,
+                    time: 0.0,
                 });
             }
         }
@@ -228,7 +224,6 @@ impl RosBag {
 
 impl Observer for RosBag {
     fn start(&mut self, run: &RunStart<'_>) -> Result<()> {
-        self.period_s = 1.0 / run.lidar.config().rotation_frequency_hz;
         let mount = run.lidar.vehicle_from_sensor();
         let tf = msgs::tf_message(&[
             transform(0.0, "map", "odom", Pose::planar(0.0, 0.0, 0.0, 0.0)),
@@ -252,7 +247,7 @@ impl Observer for RosBag {
         ]);
         self.write(|t| t.tf, t, &tf)?;
         let stamp = Time::from_ns(stamp_ns(t));
-        let cloud = msgs::velodyne_cloud(stamp, "velodyne", &cloud_points(frame, self.period_s));
+        let cloud = msgs::velodyne_cloud(stamp, "velodyne", &cloud_points(frame));
         self.write(|t| t.cloud, t, &cloud)?;
         if let Some(e) = &frame.pose_estimate {
             let pose = msgs::pose_with_covariance(
