@@ -172,15 +172,13 @@ impl Resolver<'_> {
                 "`airport.occupancy`".into(),
                 "",
             )?;
-            let mut here = parked_parts(&id, &description, stand.at, stand.yaw_rad);
-            if spec.get_ref().ground_equipment {
-                here.extend(ground_equipment(
-                    &id,
-                    description.span_m(),
-                    stand.at,
-                    stand.yaw_rad,
-                ));
-            }
+            let here = stand_solids(
+                &id,
+                &description,
+                stand.at,
+                stand.yaw_rad,
+                spec.get_ref().ground_equipment,
+            );
             // A drawn aircraft that would touch the vehicle at its start leaves its stand empty.
             let start = crate::scenario::overlap::start_overlap;
             if here.iter().any(|s| {
@@ -222,15 +220,13 @@ impl Resolver<'_> {
                 format!("`{field}`"),
                 "",
             )?;
-            let mut here = parked_parts(&id, &description, stand.at, stand.yaw_rad);
-            if spec.get_ref().ground_equipment {
-                here.extend(ground_equipment(
-                    &id,
-                    description.span_m(),
-                    stand.at,
-                    stand.yaw_rad,
-                ));
-            }
+            let here = stand_solids(
+                &id,
+                &description,
+                stand.at,
+                stand.yaw_rad,
+                spec.get_ref().ground_equipment,
+            );
             for solid in here {
                 self.inside_world(world, &field, p.stand.span(), solid.x_m, solid.y_m)?;
                 self.no_start_overlap(vehicle, &solid, &field, p.stand.span())?;
@@ -300,6 +296,21 @@ impl Resolver<'_> {
 }
 
 /// A parked aircraft's collision parts at a stand (its vehicle frame on the stand's point).
+/// An aircraft parked at a stand, with a tug and a cart beside it when `equipment`.
+fn stand_solids(
+    id: &str,
+    vehicle: &aircraft::Vehicle,
+    at: Vector2<f64>,
+    yaw_rad: f64,
+    equipment: bool,
+) -> Vec<Solid> {
+    let mut solids = parked_parts(id, vehicle, at, yaw_rad);
+    if equipment {
+        solids.extend(ground_equipment(id, vehicle.span_m(), at, yaw_rad));
+    }
+    solids
+}
+
 fn parked_parts(
     id: &str,
     vehicle: &aircraft::Vehicle,
