@@ -8,7 +8,8 @@
 //! - [`levels`]: heights of interest, cumulative or banded.
 //! - [`edt`], [`odm`]: exact Euclidean distance transform and per-level obstacle distance maps.
 //! - [`collision`]: circle models and pose / trajectory checks.
-//! - [`scan`], [`occupancy`]: the LiDAR revolution as input and the obstacle test.
+//! - [`scan`], [`occupancy`]: the LiDAR revolution as input and the obstacle test; [`organise`]:
+//!   a driver's unorganised cloud into a scan's columns x beams.
 //! - [`map`]: `MultiHeightMap`, the local window: insertion, offline/online merge, re-centring.
 //! - [`blocks`]: the map block file format and the directory store.
 //! - [`remission`]: per-cell intensity statistics.
@@ -27,6 +28,7 @@ pub mod levels;
 pub mod map;
 pub mod occupancy;
 pub mod odm;
+pub mod organise;
 pub mod remission;
 pub mod scan;
 pub mod self_hits;
@@ -47,6 +49,7 @@ pub use map::{
 };
 pub use occupancy::{ObstacleTestParams, OccupancyParams};
 pub use odm::{DistanceMap, DistanceMaps};
+pub use organise::{ColumnLayout, SensorPoint, organise};
 pub use remission::RemissionCell;
 pub use scan::{Return, Scan, ScanColumn};
 pub use self_hits::SelfHitFilter;

@@ -55,4 +55,26 @@ pub enum BagError {
         /// What is wrong.
         what: String,
     },
+    /// A bag could not be read: where (after which message of which topic) and why.
+    #[error("{path}: {at}{what}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Where: `after message 41 of /velodyne_points: `, or empty.
+        at: String,
+        /// What is wrong.
+        what: String,
+    },
+    /// A message could not be used: its topic, its index on it, and why.
+    #[error("{path}: topic {topic}, message {index}: {what}")]
+    Message {
+        /// The file.
+        path: PathBuf,
+        /// The topic.
+        topic: String,
+        /// Its index among the topic's messages (0 first).
+        index: u64,
+        /// What is wrong (a field of it, where it is one).
+        what: String,
+    },
 }

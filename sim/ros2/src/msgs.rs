@@ -2,7 +2,8 @@
 //! type's definition, then every type it uses after a line of 80 `=` and `MSG: pkg/Type`, as
 //! rosbag2 embeds them), their RIHS01 type hashes, and their CDR encoders.
 
-use crate::cdr::CdrWriter;
+use crate::cdr::{CdrReader, CdrWriter};
+use crate::error::CdrError;
 
 /// A message type: its name, its schema text and its type hash.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -484,6 +485,82 @@ pub fn string(data: &str) -> Vec<u8> {
     let mut w = CdrWriter::new();
     w.string(data);
     w.finish()
+}
+
+fn read_time(r: &mut CdrReader<'_>) -> Result<Time, CdrError> {
+    let at = r.offset();
+    let sec = r.i32("header.stamp.sec")?;
+    let nanosec = r.u32("header.stamp.nanosec")?;
+    if sec < 0 || nanosec >= 1_000_000_000 {
+        return Err(CdrError::new(
+            "header.stamp",
+            at,
+            format!("{sec} s {nanosec} ns is not a time after the epoch"),
+        ));
+    }
+    Ok(Time { sec, nanosec })
+}
+
+fn read_pose(r: &mut CdrReader<'_>, field: &'static str) -> Result<Pose, CdrError> {
+    let at = r.offset();
+    let mut v = [0.0; 7];
+    for x in &mut v {
+        *x = r.f64(field)?;
+    }
+    let q = [v[3], v[4], v[5], v[6]];
+    let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if !v.iter().all(|x| x.is_finite()) || (norm - 1.0).abs() > 1e-3 {
+        return Err(CdrError::new(
+            field,
+            at,
+            format!("{v:?} is not a finite position and a unit quaternion"),
+        ));
+    }
+    Ok(Pose {
+        position: [v[0], v[1], v[2]],
+        orientation: q.map(|x| x / norm),
+    })
+}
+
+/// Reads a `tf2_msgs/msg/TFMessage`.
+///
+/// # Errors
+/// The message is malformed, a pose is not finite or its quaternion not of unit length.
+pub fn read_tf_message(cdr: &[u8]) -> Result<Vec<Transform>, CdrError> {
+    let mut r = CdrReader::new(cdr)?;
+    let n = r.count("transforms", 60)?;
+    let mut out = Vec::with_capacity(n);
+    for _ in 0..n {
+        let stamp = read_time(&mut r)?;
+        let parent = r.string("header.frame_id")?;
+        let child = r.string("child_frame_id")?;
+        let pose = read_pose(&mut r, "transform")?;
+        out.push(Transform {
+            stamp,
+            parent,
+            child,
+            pose,
+        });
+    }
+    Ok(out)
+}
+
+/// Reads a `nav_msgs/msg/Odometry`'s stamp and pose: the child frame's pose in the header's frame.
+///
+/// # Errors
+/// The message is malformed, or its pose is not finite or its quaternion not of unit length.
+pub fn read_odometry(cdr: &[u8]) -> Result<Transform, CdrError> {
+    let mut r = CdrReader::new(cdr)?;
+    let stamp = read_time(&mut r)?;
+    let parent = r.string("header.frame_id")?;
+    let child = r.string("child_frame_id")?;
+    let pose = read_pose(&mut r, "pose.pose")?;
+    Ok(Transform {
+        stamp,
+        parent,
+        child,
+        pose,
+    })
 }
 
 #[cfg(test)]

@@ -25,6 +25,10 @@ use crate::scenario::Scenario;
 use crate::world::World;
 use crate::world::{Lidar, SweepPoses};
 
+/// One revolution of the mapping drive as it is inserted: when (simulated seconds), the
+/// vehicle's pose, the scan.
+pub type DriveRevolution<'a> = (f64, &'a Isometry2<f64>, &'a mapper::Scan);
+
 /// Drives the route once with the LiDAR and map settings of `config` and writes the offline map
 /// into `out`. `progress(done, total)` after each scan.
 pub fn map_drive(
@@ -33,17 +37,35 @@ pub fn map_drive(
     out: &Path,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<MapManifest> {
+    map_drive_with(scenario, config, out, progress, &mut |_| Ok(()))
+}
+
+/// Removes a map directory's old blocks.
+pub(crate) fn clear_blocks(blocks_dir: &Path) -> Result<()> {
+    if blocks_dir.exists() {
+        std::fs::remove_dir_all(blocks_dir).map_err(|source| Error::Io {
+            what: "clearing the old map blocks",
+            path: blocks_dir.to_path_buf(),
+            source,
+        })?;
+    }
+    Ok(())
+}
+
+/// [`map_drive`], showing `revolution` each revolution before it is inserted (the bag of
+/// `taxi-sim map --record`).
+pub fn map_drive_with(
+    scenario: &Scenario,
+    config: &RunConfig,
+    out: &Path,
+    progress: &mut dyn FnMut(usize, usize),
+    revolution: &mut dyn FnMut(DriveRevolution<'_>) -> Result<()>,
+) -> Result<MapManifest> {
     let vehicle = &scenario.vehicle.vehicle;
     let self_filter = self_filter_model(vehicle)?;
     let levels = levels_of(scenario, config)?;
     let blocks_dir = out.join("blocks");
-    if blocks_dir.exists() {
-        std::fs::remove_dir_all(&blocks_dir).map_err(|source| Error::Io {
-            what: "clearing the old map blocks",
-            path: blocks_dir.clone(),
-            source,
-        })?;
-    }
+    clear_blocks(&blocks_dir)?;
     let route = RoutePath::new(&scenario.route.waypoints_m, scenario.route.closed);
     let start = scenario.vehicle.world_from_start;
     let scene = crate::world::stale_scene(
@@ -71,26 +93,29 @@ pub fn map_drive(
     let scans = (route.length_m() / spacing).ceil() as usize + 1;
     // Each revolution is cast beside the insertion of the one before (the same insertions, in
     // the same order: the same map).
-    let mut taken: Option<(Point2<f64>, mapper::Scan)> = None;
+    let mut taken: Option<(Isometry2<f64>, mapper::Scan)> = None;
     for k in 0..=scans {
+        if let Some((pose, scan)) = &taken {
+            revolution(((k - 1) as f64 * 0.1, pose, scan))?;
+        }
         let cast = (k < scans).then(|| {
             let s = (k as f64 * spacing).min(route.length_m());
             let (p, heading) = route.at(s);
             let pose = Isometry2::new(p.coords, heading);
             world.set_vehicle_pose(&pose, k as f64 * 0.1);
-            (p, pose)
+            pose
         });
         let (scan, inserted) = rayon::join(
             || {
-                cast.map(|(p, pose)| {
+                cast.map(|pose| {
                     let scan =
                         lidar.scan(&world, &SweepPoses::still(pose), k as u64, scenario.seed);
-                    (p, scan.scan)
+                    (pose, scan.scan)
                 })
             },
             || -> Result<()> {
-                if let Some((p, scan)) = taken.take() {
-                    map.recenter(p)?;
+                if let Some((pose, scan)) = taken.take() {
+                    map.recenter(Point2::from(pose.translation.vector))?;
                     map.insert_scan(&scan, Some(&self_filter))?;
                 }
                 Ok(())
@@ -103,14 +128,35 @@ pub fn map_drive(
         taken = scan;
     }
     map.flush()?;
-    let store = BlockStore::open(&blocks_dir, map.block_spec().clone())?;
+    finish_map(
+        &map,
+        &levels,
+        out,
+        (
+            fingerprint(scenario, config)?,
+            scenario.name.clone(),
+            scans,
+            route.length_m(),
+        ),
+    )
+}
+
+/// Exports a flushed map's levels from its blocks in `out` and writes its manifest, made of
+/// `(fingerprint, scenario, scans, route_m)` and what the export counted.
+pub(crate) fn finish_map(
+    map: &MultiHeightMap,
+    levels: &Levels,
+    out: &Path,
+    (fingerprint, scenario, scans, route_m): (String, String, usize, f64),
+) -> Result<MapManifest> {
+    let store = BlockStore::open(out.join("blocks"), map.block_spec().clone())?;
     let blocks = store.list()?.len();
-    let occupied_cells = export_levels(&store, &levels, out)?;
+    let occupied_cells = export_levels(&store, levels, out)?;
     let manifest = MapManifest {
-        fingerprint: fingerprint(scenario, config)?,
-        scenario: scenario.name.clone(),
+        fingerprint,
+        scenario,
         scans,
-        route_m: route.length_m(),
+        route_m,
         blocks,
         level_heights_m: levels.heights_m().to_vec(),
         occupied_cells,

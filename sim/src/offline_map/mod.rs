@@ -8,7 +8,8 @@ mod manifest;
 mod settings;
 
 pub use crate::error::ManifestError;
-pub use drive::map_drive;
+pub use drive::{DriveRevolution, map_drive, map_drive_with};
+pub(crate) use drive::{clear_blocks, finish_map};
 pub(crate) use manifest::MAP_FORMAT;
 pub use manifest::{MapManifest, default_map_dir, fingerprint, fresh_manifest};
 pub use settings::{levels_of, map_config, self_filter_model};

@@ -346,3 +346,57 @@ fn ros2_point_clouds() {
         ros2::read_cloud(b).ok().map(|c| format!("{}", c.xyz.len()))
     });
 }
+
+/// Whole bags (`taxi-sim map --from-bag`): byte edits of a small sound bag (transforms and
+/// clouds, LZ4 chunks) and arbitrary bytes are mapped or refused, never a panic; and the
+/// transform and odometry messages the poses come from, alone.
+#[test]
+fn ros2_bags_and_their_poses() {
+    let dir = tempfile::tempdir().unwrap();
+    let sound = dir.path().join("sound.mcap");
+    crate::rosbag::hostile_bag(&sound, crate::rosbag::Hostile::default());
+    let seed = std::fs::read(&sound).unwrap();
+    let levels = mapper::Levels::cumulative(vec![0.0, 0.7]).unwrap();
+    let file = dir.path().join("fuzzed.mcap");
+    fuzz("bag", seed, false, |b| {
+        std::fs::write(&file, b).unwrap();
+        sim::rosbag::map_from_bag(
+            &file,
+            &sim::rosbag::BagMapOptions::default(),
+            &levels,
+            mapper::MapConfig::default(),
+            None,
+            &dir.path().join("map"),
+            &mut |_, _| {},
+        )
+        .ok()
+        .map(|r| format!("{:?}", r.manifest.occupied_cells))
+    });
+    let t = ros2::msgs::Transform {
+        stamp: ros2::msgs::Time::from_ns(7),
+        parent: "map".into(),
+        child: "base_link".into(),
+        pose: ros2::msgs::Pose::planar(1.0, 2.0, 0.0, 0.3),
+    };
+    fuzz(
+        "transforms",
+        ros2::msgs::tf_message(&[t.clone(), t.clone()]),
+        true,
+        |b| {
+            ros2::msgs::read_tf_message(b)
+                .ok()
+                .map(|t| format!("{t:?}"))
+        },
+    );
+    let odom = ros2::msgs::odometry(
+        t.stamp,
+        "map",
+        "base_link",
+        &t.pose,
+        &[0.0; 36],
+        [[1.0; 3]; 2],
+    );
+    fuzz("odometry", odom, true, |b| {
+        ros2::msgs::read_odometry(b).ok().map(|t| format!("{t:?}"))
+    });
+}

@@ -1,22 +1,62 @@
-//! `taxi-sim map`: the mapping drive that builds a scenario's offline multi-height map, with a
+//! `taxi-sim map`: the mapping drive that builds a scenario's offline multi-height map (optionally
+//! recorded as a ROS 2 bag), or the same map built from a bag's point clouds and poses, with a
 //! progress bar.
 
 use std::path::PathBuf;
 
-use sim::offline_map::{default_map_dir, map_drive};
+use anyhow::Context as _;
+use sim::offline_map::{default_map_dir, levels_of, map_config, map_drive, self_filter_model};
+use sim::rosbag::{BagMapOptions, DriveBag, PoseSource, map_from_bag};
 use sim::scenario::{RunConfig, Scenario};
+
+/// Where `--from-bag` takes poses from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PoseFrom {
+    /// The transform tree (`/tf`, `/tf_static`).
+    Tf,
+    /// An odometry topic (`--odom-topic`), the sensor's mount from `/tf_static`.
+    Odom,
+}
 
 /// Arguments of `taxi-sim map`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct MapArgs {
-    /// The scenario file.
+    /// The scenario file: its vehicle's levels and self-hit filter (and, without `--from-bag`,
+    /// the route driven).
     pub scenario: PathBuf,
-    /// Output directory (default: out/maps/<scenario file name>).
+    /// Output directory (default: out/maps/<scenario file name>, or out/maps/<bag name>-bag).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Run configuration (TOML) whose LiDAR and mapping settings the map is built with.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
+    /// Record the mapping drive as a ROS 2 bag (.mcap, `metadata.yaml` beside it): /tf_static,
+    /// /tf, /velodyne_points, /clock.
+    #[arg(long, value_name = "FILE.mcap", conflicts_with = "from_bag")]
+    pub record: Option<PathBuf>,
+    /// Build the map from this bag's point clouds (an .mcap file or a rosbag2 directory) instead
+    /// of driving the route.
+    #[arg(long, value_name = "BAG")]
+    pub from_bag: Option<PathBuf>,
+    /// The bag's point cloud topic (sensor_msgs/msg/PointCloud2 with x, y, z, intensity 0-255,
+    /// ring).
+    #[arg(long, default_value = "/velodyne_points", requires = "from_bag")]
+    pub cloud_topic: String,
+    /// Where each cloud's pose comes from.
+    #[arg(long, value_enum, default_value = "tf", requires = "from_bag")]
+    pub pose_source: PoseFrom,
+    /// The odometry topic of `--pose-source odom` (nav_msgs/msg/Odometry).
+    #[arg(long, default_value = "/odom", requires = "from_bag")]
+    pub odom_topic: String,
+    /// The map's frame in the transform tree.
+    #[arg(long, default_value = "map", requires = "from_bag")]
+    pub fixed_frame: String,
+    /// The vehicle's frame (its origin the vehicle file's: the rear axle).
+    #[arg(long, default_value = "base_link", requires = "from_bag")]
+    pub base_frame: String,
+    /// Firings a revolution (default: found in each cloud from its azimuths).
+    #[arg(long, requires = "from_bag")]
+    pub columns: Option<usize>,
 }
 
 pub(crate) fn build_map(
@@ -33,15 +73,122 @@ pub(crate) fn build_map(
     Ok(manifest)
 }
 
+/// The mapping drive, recorded into `bag`.
+fn build_and_record(
+    scenario: &Scenario,
+    config: &RunConfig,
+    dir: &std::path::Path,
+    bag: &std::path::Path,
+) -> anyhow::Result<sim::offline_map::MapManifest> {
+    anyhow::ensure!(
+        bag.extension().is_some_and(|e| e == "mcap"),
+        "--record {}: a ROS 2 bag is an .mcap file",
+        bag.display()
+    );
+    let mount = scenario.vehicle.vehicle.vehicle_from_lidar();
+    let mut writer = DriveBag::create(bag, &mount)?;
+    let progress = crate::bar(0, "mapping");
+    let manifest = sim::offline_map::map_drive_with(
+        scenario,
+        config,
+        dir,
+        &mut |done, total| {
+            progress.set_length(total as u64);
+            progress.set_position(done as u64);
+        },
+        &mut |(t, pose, scan)| writer.revolution(t, pose, scan),
+    )?;
+    progress.finish_and_clear();
+    let summary = writer.finish()?;
+    crate::emit(&format!(
+        "recorded {} ({} messages)\n",
+        bag.display(),
+        summary.topics.iter().map(|(_, n)| n).sum::<u64>()
+    ))?;
+    Ok(manifest)
+}
+
+/// `--from-bag`.
+fn from_bag(
+    args: &MapArgs,
+    bag: &std::path::Path,
+    scenario: &Scenario,
+    config: &RunConfig,
+) -> anyhow::Result<()> {
+    let options = BagMapOptions {
+        cloud_topic: args.cloud_topic.clone(),
+        pose_source: match args.pose_source {
+            PoseFrom::Tf => PoseSource::Tf,
+            PoseFrom::Odom => PoseSource::Odom(args.odom_topic.clone()),
+        },
+        fixed_frame: args.fixed_frame.clone(),
+        base_frame: args.base_frame.clone(),
+        columns: args.columns,
+    };
+    let dir = args.out.clone().unwrap_or_else(|| {
+        let stem = bag
+            .file_stem()
+            .map_or_else(|| "bag".into(), |s| s.to_string_lossy().into_owned());
+        PathBuf::from("out")
+            .join("maps")
+            .join(format!("{stem}-bag"))
+    });
+    let levels = levels_of(scenario, config)?;
+    let filter = self_filter_model(&scenario.vehicle.vehicle)?;
+    let progress = crate::bar(0, "mapping from the bag");
+    let report = map_from_bag(
+        bag,
+        &options,
+        &levels,
+        map_config(config),
+        Some(&filter),
+        &dir,
+        &mut |done, total| {
+            progress.set_length(total);
+            progress.set_position(done);
+        },
+    )
+    .with_context(|| format!("taxi-sim map --from-bag {}", bag.display()))?;
+    progress.finish_and_clear();
+    let m = &report.manifest;
+    let skipped = match &report.first_without_pose {
+        Some(why) => format!(
+            "; {} clouds skipped without a pose (the first: {why})",
+            report.without_pose
+        ),
+        None => String::new(),
+    };
+    let layout = report.layout.map_or(String::new(), |l| {
+        format!(", {} firings a revolution", l.columns)
+    });
+    crate::emit(&format!(
+        "{}: mapped {:.0} m with {} of {} clouds{layout} into {} blocks; occupied cells per level {:?} (levels at {:?} m){skipped}\nwrote {}\n",
+        bag.display(),
+        m.route_m,
+        m.scans,
+        report.clouds,
+        m.blocks,
+        m.occupied_cells,
+        m.level_heights_m,
+        dir.display()
+    ))
+}
+
 /// Runs `taxi-sim map`.
 pub fn run(args: &MapArgs) -> anyhow::Result<()> {
     let scenario = Scenario::from_file(&args.scenario)?;
     let config = RunConfig::for_scenario(&scenario, args.config.as_deref())?;
+    if let Some(bag) = &args.from_bag {
+        return from_bag(args, bag, &scenario, &config);
+    }
     let dir = args
         .out
         .clone()
         .unwrap_or_else(|| default_map_dir(&scenario, &config));
-    let m = build_map(&scenario, &config, &dir)?;
+    let m = match &args.record {
+        Some(bag) => build_and_record(&scenario, &config, &dir, bag)?,
+        None => build_map(&scenario, &config, &dir)?,
+    };
     crate::emit(&format!(
         "{}: mapped {:.0} m with {} revolutions into {} blocks; occupied cells per level {:?} (levels at {:?} m)\nwrote {}\n",
         scenario.name,

@@ -1,5 +1,7 @@
 //! A run as a ROS 2 bag (MCAP, with `metadata.yaml` beside it): an [`Observer`] that writes the
-//! standard messages a ROS stack would log (crate `ros2`). Simulated time `t` is stamped as
+//! standard messages a ROS stack would log (crate `ros2`); the mapping drive's bag
+//! ([`DriveBag`]); a bag's clouds and poses read back into the offline map ([`map_from_bag`],
+//! through the transform tree of [`tf`]). Simulated time `t` is stamped as
 //! 2024-01-01T00:00:00Z plus `t` (a stamp of 0 means "latest" to tf2).
 //!
 //! | topic | type | when |
@@ -14,6 +16,13 @@
 //! | `/planner/path` | `nav_msgs/msg/Path`: the chosen path | every revolution |
 //! | `/map/level_<k>` | `nav_msgs/msg/OccupancyGrid`: each level's merged occupancy, 60 m around the estimate (transient local) | 1 Hz |
 //! | `/events` | `std_msgs/msg/String`: JSON `{"t_s": 14.31, "kind": "Stop", "event": "Stop { route_s_m: 28.3 }"}` (the kinds of `engine::Event`) | as they happen |
+
+mod drive;
+pub mod from_bag;
+pub mod tf;
+
+pub use drive::DriveBag;
+pub use from_bag::{BagMapOptions, BagMapReport, PoseSource, map_from_bag};
 
 use std::path::{Path, PathBuf};
 
@@ -64,7 +73,7 @@ pub struct RosBag {
     written: Option<ros2::BagSummary>,
 }
 
-fn bag_error(e: ros2::BagError) -> Error {
+pub(crate) fn bag_error(e: ros2::BagError) -> Error {
     Error::Invalid(format!("ROS 2 bag: {e}"))
 }
 
@@ -120,11 +129,11 @@ impl RosBag {
     }
 }
 
-fn planar(p: &Isometry2<f64>, z: f64) -> Pose {
+pub(crate) fn planar(p: &Isometry2<f64>, z: f64) -> Pose {
     Pose::planar(p.translation.x, p.translation.y, z, p.rotation.angle())
 }
 
-fn pose3(p: &Isometry3<f64>) -> Pose {
+pub(crate) fn pose3(p: &Isometry3<f64>) -> Pose {
     let q: &UnitQuaternion<f64> = &p.rotation;
     Pose {
         position: [p.translation.x, p.translation.y, p.translation.z],
@@ -132,7 +141,7 @@ fn pose3(p: &Isometry3<f64>) -> Pose {
     }
 }
 
-fn transform(t_s: f64, parent: &str, child: &str, pose: Pose) -> Transform {
+pub(crate) fn transform(t_s: f64, parent: &str, child: &str, pose: Pose) -> Transform {
     Transform {
         stamp: Time::from_ns(stamp_ns(t_s)),
         parent: parent.to_string(),
@@ -144,8 +153,7 @@ fn transform(t_s: f64, parent: &str, child: &str, pose: Pose) -> Transform {
 /// The revolution's returns in the sensor frame (each column's own pose), with their beam. Their
 /// `time` is 0: the closed loop takes a revolution at one instant (a consumer that deskews by
 /// it moves nothing).
-fn cloud_points(frame: &RevolutionFrame<'_>) -> Vec<VelodynePoint> {
-    let scan = &frame.revolution.scan;
+pub(crate) fn cloud_points(scan: &mapper::Scan) -> Vec<VelodynePoint> {
     let mut points = Vec::with_capacity(scan.returns().len());
     for c in 0..scan.column_count() {
         let Some((column, returns)) = scan.column(c) else {
@@ -247,7 +255,7 @@ impl Observer for RosBag {
         ]);
         self.write(|t| t.tf, t, &tf)?;
         let stamp = Time::from_ns(stamp_ns(t));
-        let cloud = msgs::velodyne_cloud(stamp, "velodyne", &cloud_points(frame));
+        let cloud = msgs::velodyne_cloud(stamp, "velodyne", &cloud_points(&frame.revolution.scan));
         self.write(|t| t.cloud, t, &cloud)?;
         if let Some(e) = &frame.pose_estimate {
             let pose = msgs::pose_with_covariance(
