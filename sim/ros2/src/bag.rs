@@ -42,6 +42,13 @@ impl Qos {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TopicId(usize);
 
+impl TopicId {
+    /// The `n`th topic added (0 first).
+    pub(crate) fn nth(n: usize) -> Self {
+        Self(n)
+    }
+}
+
 #[derive(Debug)]
 struct Topic {
     name: String,
@@ -76,7 +83,7 @@ pub struct BagWriter {
 impl BagWriter {
     /// Starts the bag `file` (a `.mcap`; `metadata.yaml` goes beside it when it is finished).
     /// Chunks are lz4-compressed on the calling thread (zstd's workers would compete with the
-    /// run for the cores).
+    /// run for the cores); [`crate::BagThread`] moves the writer to a thread of its own.
     ///
     /// # Errors
     /// The file cannot be created.
@@ -105,6 +112,17 @@ impl BagWriter {
             first_ns: None,
             last_ns: 0,
         })
+    }
+
+    /// The topics added so far.
+    pub(crate) fn topic_names(&self) -> Vec<String> {
+        self.topics.iter().map(|t| t.name.clone()).collect()
+    }
+
+    /// The file it writes (renamed into place when finished).
+    #[must_use]
+    pub fn file(&self) -> &Path {
+        &self.file
     }
 
     fn mcap_error(&self, source: mcap::McapError) -> BagError {

@@ -9,8 +9,10 @@ pub mod cloud;
 pub mod error;
 pub mod msgs;
 pub mod read;
+pub mod thread;
 
 pub use bag::{BagSummary, BagWriter, Qos, TopicId};
 pub use cloud::{Cloud, CloudError, read_cloud};
 pub use error::{BagError, CdrError};
 pub use read::{BagMessage, BagReader, TopicInfo};
+pub use thread::BagThread;

@@ -45,6 +45,7 @@ fn in_process(campaign: &Campaign, n: u64, jobs: usize, dir: &Path) -> Result<f6
             jobs,
             runs: Some(n),
             stop: &stop,
+            record_failures: false,
             progress: &|_| {},
         },
     )?;

@@ -34,6 +34,9 @@ pub struct RunOptions<'a> {
     pub runs: Option<u64>,
     /// Set from outside (Ctrl-C) to stop: runs in flight end and are not recorded.
     pub stop: &'a AtomicBool,
+    /// Run each failure again (runs are reproducible from their seed) writing it as a ROS 2
+    /// bag, `failures/<index>/<index>.mcap` with its `metadata.yaml`: only failures pay for it.
+    pub record_failures: bool,
     /// Told of every recorded run.
     pub progress: &'a (dyn Fn(&RunRecord) + Sync),
 }
@@ -111,7 +114,7 @@ fn run_variant(
     campaign: &Campaign,
     v: &Variant,
     maps: &MapCache,
-    dir: &Path,
+    (dir, record_failures): (&Path, bool),
     stop: &AtomicBool,
     pool: &rayon::ThreadPool,
 ) -> Result<Option<RunRecord>> {
@@ -144,8 +147,61 @@ fn run_variant(
     let rec = record(campaign, v, &scenario, &report);
     if let Some(f) = &rec.failure_file {
         mapper::write_atomically(&dir.join(f), v.text.as_bytes())?;
+        if record_failures {
+            let bag = dir
+                .join("failures")
+                .join(v.index.to_string())
+                .join(format!("{}.mcap", v.index));
+            record_again(&scenario, &setup, &bag, stop, pool, &report)?;
+        }
     }
     Ok(Some(rec))
+}
+
+/// Runs a failed variant again into a ROS 2 bag at `bag`; the run must end as it did (it is
+/// reproducible from its seed), or the bag is refused as not that failure's.
+fn record_again(
+    scenario: &Scenario,
+    setup: &RunSetup,
+    bag: &Path,
+    stop: &AtomicBool,
+    pool: &rayon::ThreadPool,
+    first: &crate::engine::RunReport,
+) -> Result<()> {
+    if let Some(parent) = bag.parent() {
+        std::fs::create_dir_all(parent).map_err(|source| Error::Io {
+            what: "creating a failure's bag directory",
+            path: parent.to_path_buf(),
+            source,
+        })?;
+    }
+    let mut writer = crate::rosbag::RosBag::create(bag)?;
+    let again = pool.install(|| {
+        run_with(
+            scenario,
+            setup,
+            RunHandles {
+                stop: Some(stop),
+                progress: &mut |_| {},
+                observer: &mut writer,
+            },
+        )
+    })?;
+    let same = |r: &crate::engine::RunReport| (r.end, r.contacts.len(), r.stops.len());
+    if again.end != EndReason::Interrupted && same(&again) != same(first) {
+        return Err(Error::Invalid(format!(
+            "{}: the failure ran again ended {:?} with {} contacts and {} stops, not {:?} with \
+             {} and {} as it first did: not reproducible from its seed",
+            bag.display(),
+            again.end,
+            again.contacts.len(),
+            again.stops.len(),
+            first.end,
+            first.contacts.len(),
+            first.stops.len()
+        )));
+    }
+    Ok(())
 }
 
 /// Runs `each` over `todo` on `jobs` worker threads, each pulling the next variant; a worker
@@ -260,7 +316,14 @@ pub fn run_campaign(campaign: &Campaign, opts: &RunOptions<'_>) -> Result<Outcom
             .map(|i| variant(campaign, i, &records))
             .collect();
         let fresh = run_parallel(&todo, opts.jobs.max(1), opts.stop, &|v, pool| {
-            let rec = run_variant(campaign, v, &maps, dir, opts.stop, pool)?;
+            let rec = run_variant(
+                campaign,
+                v,
+                &maps,
+                (dir, opts.record_failures),
+                opts.stop,
+                pool,
+            )?;
             if let Some(r) = &rec {
                 out.push(r)?;
                 (opts.progress)(r);

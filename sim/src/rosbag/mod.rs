@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Isometry2, Isometry3, UnitQuaternion};
 use ros2::msgs::{self, Pose, Time, Transform, VelodynePoint};
-use ros2::{BagWriter, Qos, TopicId};
+use ros2::{BagThread, BagWriter, Qos, TopicId};
 
 use crate::engine::{Event, Observer, RevolutionFrame, RunReport, RunStart, StepFrame};
 use crate::error::{Error, Result};
@@ -63,7 +63,7 @@ struct Topics {
 
 /// Writes a run's bag (see the module's table).
 pub struct RosBag {
-    bag: Option<BagWriter>,
+    bag: Option<BagThread>,
     topics: Topics,
     file: PathBuf,
     steps: u64,
@@ -101,7 +101,8 @@ impl RosBag {
             events: add("/events", msgs::STRING, Qos::Stream)?,
         };
         Ok(Self {
-            bag: Some(bag),
+            // Compressed and written beside the run.
+            bag: Some(BagThread::spawn(bag).map_err(bag_error)?),
             topics,
             file: file.to_path_buf(),
             steps: 0,
@@ -117,7 +118,7 @@ impl RosBag {
         self.written.as_ref()
     }
 
-    fn write(&mut self, topic: fn(&Topics) -> TopicId, t_s: f64, cdr: &[u8]) -> Result<()> {
+    fn write(&mut self, topic: fn(&Topics) -> TopicId, t_s: f64, cdr: Vec<u8>) -> Result<()> {
         let id = topic(&self.topics);
         match self.bag.as_mut() {
             Some(bag) => bag.write(id, stamp_ns(t_s), cdr).map_err(bag_error),
@@ -223,7 +224,7 @@ impl RosBag {
             );
             let topic = self.maps[k];
             if let Some(bag) = self.bag.as_mut() {
-                bag.write(topic, stamp_ns(t), &grid).map_err(bag_error)?;
+                bag.write(topic, stamp_ns(t), grid).map_err(bag_error)?;
             }
         }
         Ok(())
@@ -237,7 +238,7 @@ impl Observer for RosBag {
             transform(0.0, "map", "odom", Pose::planar(0.0, 0.0, 0.0, 0.0)),
             transform(0.0, "base_link", "velodyne", pose3(&mount)),
         ]);
-        self.write(|t| t.tf_static, 0.0, &tf)
+        self.write(|t| t.tf_static, 0.0, tf)
     }
 
     fn revolution(&mut self, frame: &RevolutionFrame<'_>) -> Result<()> {
@@ -253,10 +254,10 @@ impl Observer for RosBag {
                 planar(&frame.truth, 0.0),
             ),
         ]);
-        self.write(|t| t.tf, t, &tf)?;
+        self.write(|t| t.tf, t, tf)?;
         let stamp = Time::from_ns(stamp_ns(t));
         let cloud = msgs::velodyne_cloud(stamp, "velodyne", &cloud_points(&frame.revolution.scan));
-        self.write(|t| t.cloud, t, &cloud)?;
+        self.write(|t| t.cloud, t, cloud)?;
         if let Some(e) = &frame.pose_estimate {
             let pose = msgs::pose_with_covariance(
                 stamp,
@@ -264,7 +265,7 @@ impl Observer for RosBag {
                 &planar(&e.world_from_vehicle, 0.0),
                 &covariance6(&e.covariance),
             );
-            self.write(|t| t.pose, t, &pose)?;
+            self.write(|t| t.pose, t, pose)?;
         }
         let poses: Vec<(f64, f64, f64)> = frame
             .plan
@@ -273,7 +274,7 @@ impl Observer for RosBag {
             .iter()
             .map(|p| (p.translation.x, p.translation.y, p.rotation.angle()))
             .collect();
-        self.write(|t| t.path, t, &msgs::path(stamp, "map", &poses))?;
+        self.write(|t| t.path, t, msgs::path(stamp, "map", &poses))?;
         if self
             .last_map_s
             .is_none_or(|last| t - last >= MAP_EVERY_S - 1e-9)
@@ -291,7 +292,7 @@ impl Observer for RosBag {
         }
         let t = frame.t_s;
         let stamp = Time::from_ns(stamp_ns(t));
-        self.write(|t| t.clock, t, &msgs::clock(stamp))?;
+        self.write(|t| t.clock, t, msgs::clock(stamp))?;
         let s = frame.state;
         let odom = msgs::odometry(
             stamp,
@@ -301,14 +302,14 @@ impl Observer for RosBag {
             &[0.0; 36],
             [[s.speed_m_s, 0.0, 0.0], [0.0; 3]],
         );
-        self.write(|t| t.truth, t, &odom)?;
+        self.write(|t| t.truth, t, odom)?;
         let cmd = msgs::ackermann(
             stamp,
             "base_link",
             frame.command.steering_rad as f32,
             frame.command.speed_m_s as f32,
         );
-        self.write(|t| t.cmd, t, &cmd)
+        self.write(|t| t.cmd, t, cmd)
     }
 
     fn event(&mut self, t_s: f64, event: &Event) -> Result<()> {
@@ -318,7 +319,7 @@ impl Observer for RosBag {
             .next()
             .unwrap_or("");
         let json = serde_json::json!({ "t_s": t_s, "kind": kind, "event": text });
-        self.write(|t| t.events, t_s, &msgs::string(&json.to_string()))
+        self.write(|t| t.events, t_s, msgs::string(&json.to_string()))
     }
 
     fn finish(&mut self, _report: &RunReport) -> Result<()> {

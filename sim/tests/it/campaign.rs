@@ -34,11 +34,39 @@ fn the_smoke_campaign_runs_every_variant_under_every_setting() {
         summary.contains("| autonomy.planner_safety_m = 0.6 | 10 |"),
         "{summary}"
     );
-    // Every failing variant and only those has a failure file, listed in the error table.
+    // Every failing variant and only those has a failure file, listed in the error table, and
+    // its bag (run again: `record_failures`) with the run's clouds and its events.
     let files = std::fs::read_dir(dir.path().join("failures"))
         .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .path()
+                .extension()
+                .is_some_and(|x| x == "toml")
+        })
         .count();
     assert_eq!(files, records.iter().filter(|r| r.failed).count());
+    assert!(files > 0);
+    for r in records.iter().filter(|r| r.failed) {
+        let bag = dir.path().join(format!("failures/{0}/{0}.mcap", r.index));
+        assert!(
+            bag.with_file_name("metadata.yaml").exists(),
+            "{}",
+            bag.display()
+        );
+        let topics = ros2::BagReader::open(&bag).unwrap().topics().unwrap();
+        let count = |name: &str| {
+            topics
+                .iter()
+                .find(|t| t.name == name)
+                .map_or(0, |t| t.count)
+        };
+        assert!(
+            count("/velodyne_points") > 10 && count("/events") > 0,
+            "{topics:?}"
+        );
+    }
     for r in records.iter().filter(|r| r.failed) {
         assert!(
             !r.failures.is_empty() && (r.contacts > 0 || !r.expectations_met),
@@ -93,6 +121,7 @@ fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
             jobs: 2,
             runs: Some(5),
             stop: &stop,
+            record_failures: false,
             progress: &|_| {},
         },
     )
@@ -130,6 +159,7 @@ fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
             jobs: 1,
             runs: Some(1),
             stop: &stop,
+            record_failures: false,
             progress: &|_| {},
         },
     )
@@ -156,6 +186,7 @@ fn a_stop_keeps_only_whole_runs_and_the_rest_runs_later() {
             jobs: 1,
             runs: Some(4),
             stop: &stop,
+            record_failures: false,
             progress: &|_| stop.store(true, Ordering::Relaxed),
         },
     )
@@ -348,6 +379,7 @@ fn the_falsifier_cannot_be_sharded() {
             jobs: 1,
             runs: Some(2),
             stop: &stop,
+            record_failures: false,
             progress: &|_| {},
         },
     )

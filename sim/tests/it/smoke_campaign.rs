@@ -23,7 +23,19 @@ pub fn smoke() -> Campaign {
 }
 
 /// Runs `campaign` into `out` on `jobs` workers (the first `runs` variants, or all): its records.
+#[allow(dead_code)] // the `taxi-sim` test binary, which includes this file, uses only `full`
 pub fn run(campaign: &Campaign, out: &Path, jobs: usize, runs: Option<u64>) -> Vec<RunRecord> {
+    run_recording(campaign, out, jobs, runs, false)
+}
+
+/// [`run`], each failure recorded again as a bag when `record_failures`.
+pub fn run_recording(
+    campaign: &Campaign,
+    out: &Path,
+    jobs: usize,
+    runs: Option<u64>,
+    record_failures: bool,
+) -> Vec<RunRecord> {
     let stop = AtomicBool::new(false);
     run_campaign(
         campaign,
@@ -34,6 +46,7 @@ pub fn run(campaign: &Campaign, out: &Path, jobs: usize, runs: Option<u64>) -> V
             jobs,
             runs,
             stop: &stop,
+            record_failures,
             progress: &|_| {},
         },
     )
@@ -41,12 +54,13 @@ pub fn run(campaign: &Campaign, out: &Path, jobs: usize, runs: Option<u64>) -> V
     .records
 }
 
-/// The whole smoke campaign on two workers, once for every test of the binary.
+/// The whole smoke campaign on two workers, its failures recorded as bags, once for every test
+/// of the binary.
 pub fn full() -> &'static (tempfile::TempDir, Vec<RunRecord>) {
     static FULL: OnceLock<(tempfile::TempDir, Vec<RunRecord>)> = OnceLock::new();
     FULL.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();
-        let records = run(&smoke(), dir.path(), 2, None);
+        let records = run_recording(&smoke(), dir.path(), 2, None, true);
         (dir, records)
     })
 }

@@ -65,6 +65,10 @@ pub struct CampaignRunArgs {
     /// with no results).
     #[arg(long)]
     pub only_missing: bool,
+    /// Run each failure again writing it as a ROS 2 bag (`failures/<i>/<i>.mcap`, for Foxglove,
+    /// `ros2 bag play`, `taxi-sim map --from-bag`); runs are reproducible, so only failures pay.
+    #[arg(long)]
+    pub record_failures: bool,
 }
 
 /// Runs `taxi-sim campaign ...`; returns whether no run failed.
@@ -160,6 +164,7 @@ pub(crate) fn run_args(args: &CampaignRunArgs) -> anyhow::Result<(usize, bool)> 
             jobs,
             runs,
             stop: &stop,
+            record_failures: args.record_failures,
             progress: &|r| {
                 let f = failures.fetch_add(usize::from(r.failed), Ordering::Relaxed)
                     + usize::from(r.failed);

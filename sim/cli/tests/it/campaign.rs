@@ -79,6 +79,7 @@ fn run_shard(campaign: &Campaign, out: &Path, maps: &Path, shard: Shard) -> Vec<
             jobs: 1,
             runs: None,
             stop: &stop,
+            record_failures: false,
             progress: &|_| {},
         },
     )
@@ -120,6 +121,7 @@ fn shards_merged_equal_the_single_machine_run_and_a_lost_shard_is_named_and_reru
             jobs: 1,
             runs: None,
             stop: &stop,
+            record_failures: false,
             progress: &|_| {},
         },
     )
