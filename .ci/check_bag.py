@@ -30,6 +30,9 @@ EXPECTED = {
     "/cmd_drive": "ackermann_msgs/msg/AckermannDriveStamped",
     "/planner/path": "nav_msgs/msg/Path",
     "/events": "std_msgs/msg/String",
+    "/collision_model": "visualization_msgs/msg/MarkerArray",
+    "/objects": "visualization_msgs/msg/MarkerArray",
+    "/obstacles": "visualization_msgs/msg/MarkerArray",
 }
 
 
@@ -62,11 +65,15 @@ def main():
     meta_counts = {c.topic: c.msgcount for c in meta.connections}
     types = {c.topic: c.msgtype for c in meta.connections}
     meta.close()
-    levels = sorted(t for t in types if t.startswith("/map/level_"))
-    if {t: types[t] for t in types if t not in levels} != EXPECTED or not levels:
-        fail(f"topics and types {types} are not {EXPECTED} and /map/level_<k>")
-    if any(types[t] != "nav_msgs/msg/OccupancyGrid" for t in levels):
-        fail(f"level maps of types {[types[t] for t in levels]}")
+    grids = sorted(t for t in types if t.startswith("/map/level_"))
+    levels = [t for t in grids if not t.endswith("/distance")]
+    distances = [t for t in grids if t.endswith("/distance")]
+    if {t: types[t] for t in types if t not in grids} != EXPECTED or not levels:
+        fail(f"topics and types {types} are not {EXPECTED} and /map/level_<k>[/distance]")
+    if distances != [t + "/distance" for t in levels]:
+        fail(f"distance maps {distances} for the levels {levels}")
+    if any(types[t] != "nav_msgs/msg/OccupancyGrid" for t in grids):
+        fail(f"level maps of types {[types[t] for t in grids]}")
 
     # 2. Three readers decode every message.
     by_dir = with_rosbags(bag_dir)
@@ -139,17 +146,50 @@ def main():
                 fail(f"{topic} at {t}: values outside -1, 0..100")
         if not any(v >= 65 for _, g in grids for v in g.data):
             fail(f"{topic}: no occupied cell in any grid")
+    for topic in distances:
+        values = [v for _, g in by_dir[topic] for v in g.data]
+        if abs(len(by_dir[topic]) - sim_time) > 2 or any(not 0 <= v <= 100 for v in values):
+            fail(f"{topic}: {len(by_dir[topic])} grids, values outside 0..100 (percent of the cap)")
+        if 0 not in values or 100 not in values:
+            fail(f"{topic}: no obstacle (0) or no free space at the cap (100)")
+    # Markers: the circles once (flat cylinders, frame-locked to base_link), the world's solids
+    # once, the run-time obstacles every revolution after a DELETEALL (the crossing vehicle).
+    (_, model), = by_dir["/collision_model"]
+    if not model.markers or any(
+        m.type != 3 or not m.frame_locked or m.header.frame_id != "base_link" or m.scale.x <= 0
+        for m in model.markers
+    ):
+        fail("/collision_model is not flat cylinders locked to base_link")
+    (_, objects), = by_dir["/objects"]
+    if not objects.markers or any(m.header.frame_id != "map" for m in objects.markers):
+        fail("/objects: no solids in map")
+    obstacles = by_dir["/obstacles"]
+    if len(obstacles) != revolutions or any(a.markers[0].action != 3 for _, a in obstacles):
+        fail(f"/obstacles: {len(obstacles)} arrays for {revolutions} revolutions, each opening with DELETEALL")
+    if not any(len(a.markers) > 1 for _, a in obstacles):
+        fail("/obstacles: the crossing vehicle is never drawn")
     clock = [ns(m.clock) for _, m in by_dir["/clock"]]
     if clock != sorted(clock) or abs((clock[-1] - clock[0]) / 1e9 - sim_time) > 0.1:
         fail(f"/clock spans {(clock[-1] - clock[0]) / 1e9} s, the run {sim_time} s")
     stops = sum(json.loads(m.data)["kind"] == "Stop" for _, m in by_dir["/events"])
     if stops != len(report["stops"]):
         fail(f"{stops} Stop events against the report's {len(report['stops'])} stops")
+    # The Foxglove layout shipped in docs/ shows topics this bag has.
+    layout = json.loads((Path(__file__).parent.parent / "docs/foxglove-layout.json").read_text())
+    shown = set()
+    for panel in layout["configById"].values():
+        shown.update(panel.get("topics", {}))
+        shown.update(p["value"].split(".")[0] for p in panel.get("paths", []))
+        if "topicPath" in panel:
+            shown.add(panel["topicPath"])
+    if shown - set(types):
+        fail(f"docs/foxglove-layout.json shows topics the bag has not: {sorted(shown - set(types))}")
     total = sum(meta_counts.values())
     print(
         f"ok: {total} messages on {len(meta_counts)} topics decoded by rosbags (directory and .mcap) "
-        f"and mcap-ros2-support; {revolutions} clouds, {len(levels)} level maps, {matched} true poses matched, "
-        f"schemas as rosbags generates them, {stops} stops as the report"
+        f"and mcap-ros2-support; {revolutions} clouds, {len(levels)} level maps and their distance maps, "
+        f"{matched} true poses matched, {len(model.markers)} circles, {len(objects.markers)} solids, "
+        f"schemas as rosbags generates them, {stops} stops as the report, the Foxglove layout's {len(shown)} topics there"
     )
 
 

@@ -96,6 +96,24 @@ impl GridGeometry {
         false
     }
 
+    /// The cells within `half_m` (rounded to cells) of `center` along each axis, clamped to the
+    /// grid: columns and rows; `None` when none is left.
+    pub fn cells_around(
+        &self,
+        center: &Point2<f64>,
+        half_m: f64,
+    ) -> Option<(std::ops::Range<usize>, std::ops::Range<usize>)> {
+        let half = (half_m / self.resolution_m()).round() as i64;
+        let (cx, cy) = self.cell_coords(center);
+        let clamp_x = |v: i64| v.clamp(0, self.width() as i64) as usize;
+        let clamp_y = |v: i64| v.clamp(0, self.height() as i64) as usize;
+        let (xs, ys) = (
+            clamp_x(cx.saturating_sub(half))..clamp_x(cx.saturating_add(half)),
+            clamp_y(cy.saturating_sub(half))..clamp_y(cy.saturating_add(half)),
+        );
+        (!xs.is_empty() && !ys.is_empty()).then_some((xs, ys))
+    }
+
     /// Signed cell coordinates of a world point (may be outside the grid).
     #[inline]
     pub fn cell_coords(&self, point_m: &Point2<f64>) -> (i64, i64) {

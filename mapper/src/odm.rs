@@ -145,6 +145,36 @@ impl DistanceMap {
     pub fn grid(&self) -> &Grid<f32> {
         &self.grid
     }
+    /// The distances within `half_m` of `center` (clamped to the grid) in ROS `OccupancyGrid`
+    /// values, as costmaps are shown: the distance in percent of the cap (0 at an obstacle, 100
+    /// at the cap or beyond); row 0 at the lowest y. `None` when nothing is left.
+    pub fn ros_distance_around(
+        &self,
+        center: &Point2<f64>,
+        half_m: f64,
+    ) -> Option<crate::map::RosOccupancy> {
+        let g = self.grid.geometry();
+        let (xs, ys) = g.cells_around(center, half_m)?;
+        let cap = self.max_distance_m().max(f32::MIN_POSITIVE);
+        let mut cells = Vec::with_capacity(xs.len() * ys.len());
+        for y in ys.clone() {
+            let row = &self.grid.data()[y * g.width() + xs.start..y * g.width() + xs.end];
+            cells.extend(
+                row.iter()
+                    .map(|d| (d / cap * 100.0).round().clamp(0.0, 100.0) as i8),
+            );
+        }
+        let res = g.resolution_m();
+        Some(crate::map::RosOccupancy {
+            corner: g.origin_m()
+                + nalgebra::Vector2::new(xs.start as f64 * res, ys.start as f64 * res),
+            width: xs.len(),
+            height: ys.len(),
+            resolution_m: res,
+            cells,
+        })
+    }
+
     /// The cap.
     pub fn max_distance_m(&self) -> f32 {
         self.max_distance_m
@@ -348,5 +378,35 @@ mod tests {
         // Everything changed: the whole map.
         let all = vec![true; 300 * 300];
         assert_eq!(map.update(&new, &all, &mut scratch), 300 * 300);
+    }
+
+    /// The ROS view of a distance map: percent of the cap, 0 on the obstacle, 50 at half the
+    /// cap, 100 beyond; the square clamped to the grid, its corner the first cell's.
+    #[test]
+    fn the_ros_view_is_the_distance_in_percent_of_the_cap() {
+        let g = GridGeometry::new(Point2::new(-10.0, -10.0), 0.5, 40, 40).unwrap();
+        let obstacle = 20 * 40 + 20; // the cell whose corner is (0, 0)
+        let mut scratch = EdtScratch::default();
+        let map = DistanceMap::compute(g, 2.0, |i| i == obstacle, &mut scratch);
+        let view = map
+            .ros_distance_around(&Point2::new(0.25, 0.25), 3.0)
+            .unwrap();
+        assert_eq!((view.width, view.height), (12, 12));
+        assert_eq!(view.corner, Point2::new(-3.0, -3.0));
+        let at = |x: usize, y: usize| view.cells[y * view.width + x];
+        assert_eq!(at(6, 6), 0);
+        assert_eq!(at(8, 6), 50);
+        assert_eq!(at(0, 0), 100);
+        let edge = map
+            .ros_distance_around(&Point2::new(-9.9, -9.9), 3.0)
+            .unwrap();
+        assert_eq!(
+            (edge.width, edge.height, edge.corner),
+            (6, 6, Point2::new(-10.0, -10.0))
+        );
+        assert!(
+            map.ros_distance_around(&Point2::new(100.0, 0.0), 3.0)
+                .is_none()
+        );
     }
 }

@@ -204,19 +204,8 @@ impl MultiHeightMap {
         let (live, prior) = (self.live.get(level)?, self.prior.get(level)?);
         let g = self.geometry;
         let res = g.resolution_m();
-        let half = (half_m / res).round() as i64;
-        let (cx, cy) = g.cell_coords(center);
-        let clamp_x = |v: i64| v.clamp(0, g.width() as i64) as usize;
-        let clamp_y = |v: i64| v.clamp(0, g.height() as i64) as usize;
-        let (x0, x1, y0, y1) = (
-            clamp_x(cx - half),
-            clamp_x(cx + half),
-            clamp_y(cy - half),
-            clamp_y(cy + half),
-        );
-        if x1 <= x0 || y1 <= y0 {
-            return None;
-        }
+        let (xs, ys) = g.cells_around(center, half_m)?;
+        let (x0, x1, y0, y1) = (xs.start, xs.end, ys.start, ys.end);
         let mut cells = Vec::with_capacity((x1 - x0) * (y1 - y0));
         for y in y0..y1 {
             let row = y * g.width();

@@ -217,6 +217,57 @@ pub const PATH: MsgType = MsgType {
         QUATERNION,
     ],
 };
+/// `visualization_msgs/msg/MarkerArray` (ROS 2 Jazzy's Marker: with texture, UV and mesh file
+/// fields).
+pub const MARKER_ARRAY: MsgType = MsgType {
+    name: "visualization_msgs/msg/MarkerArray",
+    hash: "RIHS01_86cb8800b6fb05b5eff1abd7a56f62a5641d3ae9a1c29e78e67e704f1d067dcf",
+    defs: &[
+        Def {
+            name: "visualization_msgs/MarkerArray",
+            text: "visualization_msgs/Marker[] markers\n",
+        },
+        Def {
+            name: "visualization_msgs/Marker",
+            text: "int32 ARROW=0\nint32 CUBE=1\nint32 SPHERE=2\nint32 CYLINDER=3\nint32 LINE_STRIP=4\n\
+                   int32 LINE_LIST=5\nint32 CUBE_LIST=6\nint32 SPHERE_LIST=7\nint32 POINTS=8\n\
+                   int32 TEXT_VIEW_FACING=9\nint32 MESH_RESOURCE=10\nint32 TRIANGLE_LIST=11\n\
+                   int32 ARROW_STRIP=12\nint32 ADD=0\nint32 MODIFY=0\nint32 DELETE=2\nint32 DELETEALL=3\n\
+                   std_msgs/Header header\nstring ns\nint32 id\nint32 type\nint32 action\n\
+                   geometry_msgs/Pose pose\ngeometry_msgs/Vector3 scale\nstd_msgs/ColorRGBA color\n\
+                   builtin_interfaces/Duration lifetime\nbool frame_locked\ngeometry_msgs/Point[] points\n\
+                   std_msgs/ColorRGBA[] colors\nstring texture_resource\nsensor_msgs/CompressedImage texture\n\
+                   visualization_msgs/UVCoordinate[] uv_coordinates\nstring text\nstring mesh_resource\n\
+                   visualization_msgs/MeshFile mesh_file\nbool mesh_use_embedded_materials\n",
+        },
+        HEADER,
+        TIME,
+        POSE,
+        POINT,
+        QUATERNION,
+        VECTOR3,
+        Def {
+            name: "std_msgs/ColorRGBA",
+            text: "float32 r\nfloat32 g\nfloat32 b\nfloat32 a\n",
+        },
+        Def {
+            name: "builtin_interfaces/Duration",
+            text: "int32 sec\nuint32 nanosec\n",
+        },
+        Def {
+            name: "sensor_msgs/CompressedImage",
+            text: "std_msgs/Header header\nstring format\nuint8[] data\n",
+        },
+        Def {
+            name: "visualization_msgs/UVCoordinate",
+            text: "float32 u\nfloat32 v\n",
+        },
+        Def {
+            name: "visualization_msgs/MeshFile",
+            text: "string filename\nuint8[] data\n",
+        },
+    ],
+};
 /// `std_msgs/msg/String` (the run's events, as JSON).
 pub const STRING: MsgType = MsgType {
     name: "std_msgs/msg/String",
@@ -484,6 +535,84 @@ pub fn path(stamp: Time, frame_id: &str, poses: &[(f64, f64, f64)]) -> Vec<u8> {
 pub fn string(data: &str) -> Vec<u8> {
     let mut w = CdrWriter::new();
     w.string(data);
+    w.finish()
+}
+
+/// One shape of a `visualization_msgs/Marker` (the types taxi-sim draws).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MarkerShape {
+    /// `CUBE`: scale is the full size.
+    Cube = 1,
+    /// `CYLINDER`: scale x, y the diameters, z the height.
+    Cylinder = 3,
+}
+
+/// A marker: a shape added (or replaced: the same `ns` and `id`) with no lifetime limit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Marker {
+    /// Namespace.
+    pub ns: String,
+    /// Id within the namespace.
+    pub id: i32,
+    /// Shape.
+    pub shape: MarkerShape,
+    /// Pose of its centre in the array's frame.
+    pub pose: Pose,
+    /// Size, metres.
+    pub scale: [f64; 3],
+    /// Colour r, g, b, a in 0..1.
+    pub color: [f32; 4],
+    /// Whether it follows its frame's later transforms (a vehicle's own circles).
+    pub frame_locked: bool,
+}
+
+fn marker(w: &mut CdrWriter, stamp: Time, frame_id: &str, m: &Marker, action: i32) {
+    header(w, stamp, frame_id);
+    w.string(&m.ns);
+    w.i32(m.id);
+    w.i32(m.shape as i32);
+    w.i32(action);
+    m.pose.write(w);
+    m.scale.iter().for_each(|&v| w.f64(v));
+    m.color.iter().for_each(|&v| w.f32(v));
+    w.i32(0); // lifetime: forever
+    w.u32(0);
+    w.bool(m.frame_locked);
+    w.count(0); // points
+    w.count(0); // colors
+    w.string(""); // texture_resource
+    header(w, stamp, frame_id); // texture: none
+    w.string("");
+    w.count(0);
+    w.count(0); // uv_coordinates
+    w.string(""); // text
+    w.string(""); // mesh_resource
+    w.string(""); // mesh_file
+    w.count(0);
+    w.bool(false);
+}
+
+/// `visualization_msgs/msg/MarkerArray`: with `clear`, a `DELETEALL` first (what was drawn
+/// before goes), then `markers` added.
+#[must_use]
+pub fn marker_array(stamp: Time, frame_id: &str, clear: bool, markers: &[Marker]) -> Vec<u8> {
+    let mut w = CdrWriter::with_capacity(256 * (markers.len() + 1));
+    w.count(markers.len() + usize::from(clear));
+    if clear {
+        let none = Marker {
+            ns: String::new(),
+            id: 0,
+            shape: MarkerShape::Cube,
+            pose: Pose::planar(0.0, 0.0, 0.0, 0.0),
+            scale: [1.0; 3],
+            color: [0.0; 4],
+            frame_locked: false,
+        };
+        marker(&mut w, stamp, frame_id, &none, 3);
+    }
+    for m in markers {
+        marker(&mut w, stamp, frame_id, m, 0);
+    }
     w.finish()
 }
 

@@ -15,10 +15,15 @@
 //! | `/cmd_drive` | `ackermann_msgs/msg/AckermannDriveStamped`: the command followed | 20 Hz |
 //! | `/planner/path` | `nav_msgs/msg/Path`: the chosen path | every revolution |
 //! | `/map/level_<k>` | `nav_msgs/msg/OccupancyGrid`: each level's merged occupancy, 60 m around the estimate (transient local) | 1 Hz |
+//! | `/map/level_<k>/distance` | `nav_msgs/msg/OccupancyGrid`: each level's distance map as a costmap is shown, the distance in percent of its cap (0 at an obstacle, 100 at the cap or beyond) | 1 Hz |
+//! | `/collision_model` | `visualization_msgs/msg/MarkerArray` in `base_link` (frame-locked): a flat cylinder per circle at its level's height, coloured by level | once, transient local |
+//! | `/objects` | `visualization_msgs/msg/MarkerArray` in `map`: the world's solids (a parked aircraft's parts as their boxes) | once, transient local |
+//! | `/obstacles` | `visualization_msgs/msg/MarkerArray` in `map`: the run-time obstacles where they are (ground truth), after a DELETEALL | every revolution |
 //! | `/events` | `std_msgs/msg/String`: JSON `{"t_s": 14.31, "kind": "Stop", "event": "Stop { route_s_m: 28.3 }"}` (the kinds of `engine::Event`) | as they happen |
 
 mod drive;
 pub mod from_bag;
+mod markers;
 pub mod tf;
 
 pub use drive::DriveBag;
@@ -59,6 +64,9 @@ struct Topics {
     cmd: TopicId,
     path: TopicId,
     events: TopicId,
+    model: TopicId,
+    objects: TopicId,
+    obstacles: TopicId,
 }
 
 /// Writes a run's bag (see the module's table).
@@ -67,10 +75,13 @@ pub struct RosBag {
     topics: Topics,
     file: PathBuf,
     steps: u64,
-    /// `/map/level_<k>`, added at the first revolution; when they were last written.
-    maps: Vec<TopicId>,
+    /// `/map/level_<k>` and `/map/level_<k>/distance`, added at the first revolution; when they
+    /// were last written.
+    maps: Vec<(TopicId, TopicId)>,
     last_map_s: Option<f64>,
     written: Option<ros2::BagSummary>,
+    /// Index of the first run-time obstacle among the scene's solids.
+    first_obstacle: usize,
 }
 
 pub(crate) fn bag_error(e: ros2::BagError) -> Error {
@@ -99,6 +110,9 @@ impl RosBag {
             cmd: add("/cmd_drive", msgs::ACKERMANN_DRIVE_STAMPED, Qos::Stream)?,
             path: add("/planner/path", msgs::PATH, Qos::Stream)?,
             events: add("/events", msgs::STRING, Qos::Stream)?,
+            model: add("/collision_model", msgs::MARKER_ARRAY, Qos::Latched)?,
+            objects: add("/objects", msgs::MARKER_ARRAY, Qos::Latched)?,
+            obstacles: add("/obstacles", msgs::MARKER_ARRAY, Qos::Stream)?,
         };
         Ok(Self {
             // Compressed and written beside the run.
@@ -109,6 +123,7 @@ impl RosBag {
             maps: Vec::new(),
             last_map_s: None,
             written: None,
+            first_obstacle: 0,
         })
     }
 
@@ -201,30 +216,41 @@ impl RosBag {
             && self.maps.len() < levels
         {
             for k in self.maps.len()..levels {
-                let name = format!("/map/level_{k}");
-                self.maps.push(
+                let mut add = |name: String| {
                     bag.add_topic(&name, msgs::OCCUPANCY_GRID, Qos::Latched)
-                        .map_err(bag_error)?,
+                        .map_err(bag_error)
+                };
+                let topics = (
+                    add(format!("/map/level_{k}"))?,
+                    add(format!("/map/level_{k}/distance"))?,
                 );
+                self.maps.push(topics);
             }
         }
         let center = nalgebra::Point2::from(at.translation.vector);
         let stamp = Time::from_ns(stamp_ns(t));
         for k in 0..levels {
-            let Some(crop) = map.ros_occupancy_around(k, &center, MAP_HALF_M) else {
-                continue;
-            };
-            let grid = msgs::occupancy_grid(
-                stamp,
-                "map",
-                crop.resolution_m as f32,
-                (crop.width as u32, crop.height as u32),
-                &Pose::planar(crop.corner.x, crop.corner.y, 0.0, 0.0),
-                &crop.cells,
-            );
-            let topic = self.maps[k];
-            if let Some(bag) = self.bag.as_mut() {
-                bag.write(topic, stamp_ns(t), grid).map_err(bag_error)?;
+            let occupancy = map.ros_occupancy_around(k, &center, MAP_HALF_M);
+            let distance = map
+                .distance_maps()
+                .level(k)
+                .and_then(|d| d.ros_distance_around(&center, MAP_HALF_M));
+            let (occupancy_topic, distance_topic) = self.maps[k];
+            for (topic, crop) in [(occupancy_topic, occupancy), (distance_topic, distance)] {
+                let Some(crop) = crop else {
+                    continue;
+                };
+                let grid = msgs::occupancy_grid(
+                    stamp,
+                    "map",
+                    crop.resolution_m as f32,
+                    (crop.width as u32, crop.height as u32),
+                    &Pose::planar(crop.corner.x, crop.corner.y, 0.0, 0.0),
+                    &crop.cells,
+                );
+                if let Some(bag) = self.bag.as_mut() {
+                    bag.write(topic, stamp_ns(t), grid).map_err(bag_error)?;
+                }
             }
         }
         Ok(())
@@ -238,7 +264,23 @@ impl Observer for RosBag {
             transform(0.0, "map", "odom", Pose::planar(0.0, 0.0, 0.0, 0.0)),
             transform(0.0, "base_link", "velodyne", pose3(&mount)),
         ]);
-        self.write(|t| t.tf_static, 0.0, tf)
+        self.write(|t| t.tf_static, 0.0, tf)?;
+        let stamp = Time::from_ns(stamp_ns(0.0));
+        let heights = crate::offline_map::levels_of(run.scenario, run.config)?;
+        let circles = markers::collision_model(run.model, heights.heights_m());
+        let model = msgs::marker_array(stamp, "base_link", false, &circles);
+        self.write(|t| t.model, 0.0, model)?;
+        let objects: Vec<msgs::Marker> = run.scene.solids[..run.first_obstacle]
+            .iter()
+            .enumerate()
+            .map(|(i, s)| markers::solid(s, i, "objects"))
+            .collect();
+        self.first_obstacle = run.first_obstacle;
+        self.write(
+            |t| t.objects,
+            0.0,
+            msgs::marker_array(stamp, "map", false, &objects),
+        )
     }
 
     fn revolution(&mut self, frame: &RevolutionFrame<'_>) -> Result<()> {
@@ -275,6 +317,14 @@ impl Observer for RosBag {
             .map(|p| (p.translation.x, p.translation.y, p.rotation.angle()))
             .collect();
         self.write(|t| t.path, t, msgs::path(stamp, "map", &poses))?;
+        // The run-time obstacles where they are (ground truth): what was drawn before goes.
+        let world = frame.world;
+        let obstacles: Vec<msgs::Marker> = (self.first_obstacle..world.scene().solids.len())
+            .filter(|&i| world.object_active(i))
+            .map(|i| markers::solid(&world.scene().solids[i], i, "obstacles"))
+            .collect();
+        let array = msgs::marker_array(stamp, "map", true, &obstacles);
+        self.write(|t| t.obstacles, t, array)?;
         if self
             .last_map_s
             .is_none_or(|last| t - last >= MAP_EVERY_S - 1e-9)
