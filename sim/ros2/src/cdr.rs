@@ -88,6 +88,11 @@ impl CdrWriter {
         self.buf.extend_from_slice(b);
     }
 
+    /// Appends bytes as they are (a sequence's elements after its [`CdrWriter::count`]).
+    pub fn raw(&mut self, b: &[u8]) {
+        self.buf.extend_from_slice(b);
+    }
+
     /// The message's bytes, header included.
     #[must_use]
     pub fn finish(self) -> Vec<u8> {

@@ -11,7 +11,7 @@ use crate::error::BagError;
 use crate::msgs::MsgType;
 
 /// Messages queued at most before `write` waits for the writer.
-pub const QUEUE: usize = 64;
+pub const QUEUE: usize = 256;
 
 enum Command {
     Add(String, MsgType, Qos, TopicId),
@@ -44,12 +44,27 @@ impl BagThread {
     /// # Errors
     /// The thread cannot be started.
     pub fn spawn(bag: BagWriter) -> Result<Self, BagError> {
+        Self::spawn_with(bag, || {})
+    }
+
+    /// [`BagThread::spawn`], running `prepare` first on the new thread (to lower its priority:
+    /// the caller knows its platform).
+    ///
+    /// # Errors
+    /// The thread cannot be started.
+    pub fn spawn_with(
+        bag: BagWriter,
+        prepare: impl FnOnce() + Send + 'static,
+    ) -> Result<Self, BagError> {
         let names = bag.topic_names();
         let file = bag.file().to_path_buf();
         let (tx, rx) = sync_channel(QUEUE);
         let handle = std::thread::Builder::new()
             .name("bag writer".into())
-            .spawn(move || serve(bag, &rx))
+            .spawn(move || {
+                prepare();
+                serve(bag, &rx)
+            })
             .map_err(|source| BagError::Io { path: file, source })?;
         Ok(Self {
             tx: Some(tx),

@@ -84,6 +84,18 @@ pub struct RosBag {
     first_obstacle: usize,
 }
 
+/// Lowers the calling thread's priority (nice 10, Linux: per thread): the bag's writer then
+/// works in the time the loop leaves idle instead of taking it from the loop.
+#[allow(unsafe_code)] // two libc calls; std has no thread priority
+fn lower_priority() {
+    #[cfg(target_os = "linux")]
+    // SAFETY: gettid and setpriority take and return plain integers and touch no memory of ours.
+    unsafe {
+        let tid = libc::gettid();
+        let _ = libc::setpriority(libc::PRIO_PROCESS, tid as libc::id_t, 10);
+    }
+}
+
 pub(crate) fn bag_error(e: ros2::BagError) -> Error {
     Error::Invalid(format!("ROS 2 bag: {e}"))
 }
@@ -116,7 +128,7 @@ impl RosBag {
         };
         Ok(Self {
             // Compressed and written beside the run.
-            bag: Some(BagThread::spawn(bag).map_err(bag_error)?),
+            bag: Some(BagThread::spawn_with(bag, lower_priority).map_err(bag_error)?),
             topics,
             file: file.to_path_buf(),
             steps: 0,
