@@ -1,7 +1,7 @@
 //! A [`BagWriter`] on its own thread: the caller hands each message over (a bounded queue of
 //! [`QUEUE`] messages) and goes on; chunks are compressed and written there, beside the caller's
-//! work - a closed loop leaves most of a second core idle, and compressing a revolution's cloud
-//! (1.5 MB) on the loop's thread cost it 45 % of its speed.
+//! work, in whatever time the caller's threads leave (compressing a revolution's 1.5 MB cloud on
+//! the loop's own thread put it on the loop's critical path).
 
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
