@@ -38,6 +38,26 @@ pub enum Shape {
     },
 }
 
+impl Shape {
+    /// Half extents of the box around the primitive, in its own frame (what pictures and markers
+    /// draw for it).
+    #[must_use]
+    pub fn half_extents_m(&self) -> Vector3<f64> {
+        match *self {
+            Shape::Box { half_extents_m } => half_extents_m,
+            Shape::Cylinder {
+                radius_m,
+                half_length_m,
+            } => Vector3::new(radius_m, radius_m, half_length_m),
+            Shape::Capsule {
+                radius_m,
+                half_length_m,
+            } => Vector3::new(radius_m, radius_m, half_length_m + radius_m),
+            Shape::Sphere { radius_m } => Vector3::repeat(radius_m),
+        }
+    }
+}
+
 /// One `<collision>` element of a link, placed in the vehicle frame.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Part {

@@ -37,6 +37,10 @@ pub struct ColumnLayout {
 /// Columns a revolution may have (a 0.01 degree step).
 pub const MAX_COLUMNS: usize = 36_000;
 
+/// Returns a scan may have room for (a 128-beam sensor at 0.05 degrees is 0.9 million): a cloud
+/// whose highest ring and firing count ask for more is refused, not allocated.
+pub const MAX_CELLS: usize = 1 << 22;
+
 fn azimuth(p: &SensorPoint) -> f64 {
     p.xyz[1].atan2(p.xyz[0]).rem_euclid(std::f64::consts::TAU)
 }
@@ -107,6 +111,15 @@ pub fn organise(
         return Err(MapError::invalid(
             "cloud",
             format!("{beams} beams (1 to {MAX_BEAMS})"),
+        ));
+    }
+    if layout.columns.saturating_mul(beams) > MAX_CELLS {
+        return Err(MapError::invalid(
+            "cloud",
+            format!(
+                "{} columns x {beams} beams: over {MAX_CELLS} returns a revolution",
+                layout.columns
+            ),
         ));
     }
     let mut returns: Vec<Option<Return>> = vec![None; layout.columns * beams];
@@ -247,5 +260,18 @@ mod tests {
             .is_err()
         );
         assert!(ColumnLayout::estimate(&points[..5], None).is_none());
+        // A ring far above the others on a fine layout asks for 147 million returns: refused.
+        let fine = ColumnLayout {
+            columns: MAX_COLUMNS,
+            phase_rad: 0.0,
+        };
+        let e = organise(
+            &points,
+            MAX_BEAMS,
+            &fine,
+            &Isometry3::identity(),
+            &Isometry2::identity(),
+        );
+        assert!(e.is_err_and(|e| e.to_string().contains("returns a revolution")));
     }
 }

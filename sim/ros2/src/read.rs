@@ -212,6 +212,11 @@ impl FileState<'_> {
                     let Some(end) = end else {
                         return Err(self.error(format!("a chunk's record claims {len} bytes")));
                     };
+                    // A chunk holds schemas, channels and messages (the MCAP spec): a chunk in
+                    // a chunk would be followed without end.
+                    if head[0] == mcap::records::op::CHUNK {
+                        return Err(self.error("a chunk inside a chunk".into()));
+                    }
                     self.record(head[0], &body[at + 9..end], limit, counts, wanted, f)?;
                     at = end;
                 }
@@ -222,6 +227,9 @@ impl FileState<'_> {
     }
 }
 
+/// The largest chunk read, uncompressed (rosbag2 writes chunks of a few MB).
+const MAX_CHUNK: usize = 1 << 30;
+
 /// A chunk's records: decompressed here (at most `limit` bytes, the size and CRC its header
 /// gives checked) - not by the MCAP reader, whose LZ4 loop spins forever on some corrupt chunks.
 fn decompress_chunk(
@@ -231,9 +239,11 @@ fn decompress_chunk(
 ) -> Result<Vec<u8>, String> {
     let size = usize::try_from(header.uncompressed_size)
         .ok()
-        .filter(|&n| n <= limit)
+        .filter(|&n| n <= limit.min(MAX_CHUNK))
         .ok_or_else(|| format!("a chunk of {} bytes uncompressed", header.uncompressed_size))?;
-    let mut body = Vec::with_capacity(size);
+    let mut body = Vec::new();
+    body.try_reserve_exact(size)
+        .map_err(|e| format!("a chunk of {size} bytes uncompressed: {e}"))?;
     let bounded = |r: &mut dyn Read, body: &mut Vec<u8>| {
         r.take(size as u64 + 1).read_to_end(body).map_err(|e| {
             format!(

@@ -23,6 +23,7 @@ pub struct BagThread {
     tx: Option<SyncSender<Command>>,
     handle: Option<JoinHandle<Result<BagSummary, BagError>>>,
     names: Vec<String>,
+    file: std::path::PathBuf,
 }
 
 fn serve(mut bag: BagWriter, rx: &Receiver<Command>) -> Result<BagSummary, BagError> {
@@ -65,12 +66,29 @@ impl BagThread {
                 prepare();
                 serve(bag, &rx)
             })
-            .map_err(|source| BagError::Io { path: file, source })?;
+            .map_err(|source| BagError::Io {
+                path: file.clone(),
+                source,
+            })?;
         Ok(Self {
             tx: Some(tx),
             handle: Some(handle),
             names,
+            file,
         })
+    }
+
+    /// The error of a writer thread that panicked, its message kept.
+    fn panicked(&self, panic: &(dyn std::any::Any + Send)) -> BagError {
+        let text = panic
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        BagError::Io {
+            path: self.file.clone(),
+            source: std::io::Error::other(format!("the bag writer panicked: {text}")),
+        }
     }
 
     /// The writer's error, once its thread has stopped (a send failed).
@@ -78,9 +96,10 @@ impl BagThread {
         self.tx = None;
         match self.handle.take().map(JoinHandle::join) {
             Some(Ok(Err(e))) => e,
-            _ => BagError::Io {
-                path: std::path::PathBuf::from("(bag writer thread)"),
-                source: std::io::Error::other("the bag writer stopped"),
+            Some(Err(panic)) => self.panicked(panic.as_ref()),
+            Some(Ok(Ok(_))) | None => BagError::Io {
+                path: self.file.clone(),
+                source: std::io::Error::other("the bag writer had already stopped"),
             },
         }
     }
@@ -102,7 +121,7 @@ impl BagThread {
     pub fn add_topic(&mut self, name: &str, msg: MsgType, qos: Qos) -> Result<TopicId, BagError> {
         if self.names.iter().any(|n| n == name) {
             return Err(BagError::Topic {
-                path: std::path::PathBuf::from("(bag writer thread)"),
+                path: self.file.clone(),
                 topic: name.to_string(),
                 what: "added twice".to_string(),
             });
@@ -129,7 +148,8 @@ impl BagThread {
         self.tx = None;
         match self.handle.take().map(JoinHandle::join) {
             Some(Ok(result)) => result,
-            _ => Err(self.stopped()),
+            Some(Err(panic)) => Err(self.panicked(panic.as_ref())),
+            None => Err(self.stopped()),
         }
     }
 }

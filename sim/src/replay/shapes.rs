@@ -67,18 +67,7 @@ pub(super) fn log_solid(
             vehicle_from_part,
         } => {
             // Drawn as the box around the primitive, turned as it is.
-            let half = match shape {
-                aircraft::Shape::Box { half_extents_m } => half_extents_m,
-                aircraft::Shape::Cylinder {
-                    radius_m,
-                    half_length_m,
-                } => nalgebra::Vector3::new(radius_m, radius_m, half_length_m),
-                aircraft::Shape::Capsule {
-                    radius_m,
-                    half_length_m,
-                } => nalgebra::Vector3::new(radius_m, radius_m, half_length_m + radius_m),
-                aircraft::Shape::Sphere { radius_m } => nalgebra::Vector3::repeat(radius_m),
-            };
+            let half = shape.half_extents_m();
             let world_from_vehicle = Isometry3::from_parts(
                 nalgebra::Translation3::new(x, y, 0.0),
                 nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), yaw),

@@ -65,10 +65,10 @@ pub struct BagMapReport {
     pub manifest: MapManifest,
     /// Clouds on the topic.
     pub clouds: u64,
-    /// Clouds skipped for want of a pose at their stamp, and why the first was.
-    pub without_pose: u64,
-    /// Why the first cloud without a pose had none.
-    pub first_without_pose: Option<String>,
+    /// Clouds skipped: no pose at their stamp, or too few points to organise.
+    pub skipped: u64,
+    /// Why the first was skipped.
+    pub first_skipped: Option<String>,
     /// The layout of the last cloud inserted.
     pub layout: Option<ColumnLayout>,
 }
@@ -88,8 +88,10 @@ fn message_error(m: &BagMessage<'_>, what: impl Into<String>) -> Error {
 /// The bag's poses.
 struct Poses {
     tf: TfBuffer,
-    /// With [`PoseSource::Odom`]: the base frame's samples, and their frame.
+    /// With [`PoseSource::Odom`]: the samples of the odometry's child frame.
     odom: Vec<(u64, Isometry3<f64>)>,
+    /// The odometry's child frame (the first message's).
+    odom_child: String,
 }
 
 impl Poses {
@@ -104,14 +106,23 @@ impl Poses {
         let world_from_base = match options.pose_source {
             PoseSource::Tf => self.tf.lookup(&options.fixed_frame, base, t_ns)?,
             PoseSource::Odom(_) => {
-                sample_at(&self.odom, t_ns, TfBuffer::tolerance_ns()).map_err(|(first, last)| {
-                    format!(
-                        "{:.3} s is outside the odometry, {:.3} to {:.3} s",
-                        t_ns as f64 * 1e-9,
-                        first as f64 * 1e-9,
-                        last as f64 * 1e-9
-                    )
-                })?
+                let world_from_child = sample_at(&self.odom, t_ns, TfBuffer::tolerance_ns())
+                    .map_err(|(first, last)| {
+                        format!(
+                            "{:.3} s is outside the odometry, {:.3} to {:.3} s",
+                            t_ns as f64 * 1e-9,
+                            first as f64 * 1e-9,
+                            last as f64 * 1e-9
+                        )
+                    })?;
+                // The odometry's child is the base frame, or linked to it in the tree (a
+                // base_footprint); a frame the tree does not know is taken as the base frame
+                // under another name (`ground_truth/base_link`).
+                match self.tf.lookup(&self.odom_child, base, t_ns) {
+                    Ok(child_from_base) => world_from_child * child_from_base,
+                    Err(_) if !self.tf.knows(&self.odom_child) => world_from_child,
+                    Err(e) => return Err(e),
+                }
             }
         };
         let world_from_sensor = match options.pose_source {
@@ -133,6 +144,7 @@ fn read_poses(reader: &BagReader, options: &BagMapOptions) -> Result<(Poses, u64
     let mut poses = Poses {
         tf: TfBuffer::default(),
         odom: Vec::new(),
+        odom_child: String::new(),
     };
     let mut clouds = 0u64;
     let mut types: Vec<(String, String)> = Vec::new();
@@ -174,6 +186,9 @@ fn read_poses(reader: &BagReader, options: &BagMapOptions) -> Result<(Poses, u64
                     index: m.index,
                     what: e.to_string(),
                 })?;
+                if poses.odom.is_empty() {
+                    poses.odom_child.clone_from(&o.child);
+                }
                 poses.odom.push((o.stamp.ns(), isometry(&o.pose)));
             }
             Ok(())
@@ -291,6 +306,14 @@ pub fn map_from_bag(
     out: &Path,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<BagMapReport> {
+    if let Some(c) = options.columns
+        && !(1..=mapper::organise::MAX_COLUMNS).contains(&c)
+    {
+        return Err(Error::Invalid(format!(
+            "--columns {c}: firings a revolution are 1 to {}",
+            mapper::organise::MAX_COLUMNS
+        )));
+    }
     let reader = BagReader::open(bag).map_err(bag_error)?;
     let (poses, clouds) = read_poses(&reader, options)?;
     let blocks_dir = out.join("blocks");
@@ -299,8 +322,8 @@ pub fn map_from_bag(
     let mut report = BagMapReport {
         manifest: empty_manifest(bag, levels),
         clouds,
-        without_pose: 0,
-        first_without_pose: None,
+        skipped: 0,
+        first_skipped: None,
         layout: None,
     };
     let (mut inserted, mut route_m, mut last) = (0usize, 0.0, None::<Point2<f64>>);
@@ -339,9 +362,9 @@ pub fn map_from_bag(
                 pending = Some((vehicle, scan));
             }
             Ok(Err(why)) => {
-                report.without_pose += 1;
+                report.skipped += 1;
                 report
-                    .first_without_pose
+                    .first_skipped
                     .get_or_insert(format!("{} message {}: {why}", m.topic, m.index));
             }
             Err(e) => {
@@ -366,11 +389,11 @@ pub fn map_from_bag(
     }
     let Some(map) = map else {
         return Err(Error::Invalid(format!(
-            "{}: no poses for any of the {clouds} clouds of {}{}",
+            "{}: none of the {clouds} clouds of {} could be mapped (no pose at its stamp, or too few points){}",
             bag.display(),
             options.cloud_topic,
             report
-                .first_without_pose
+                .first_skipped
                 .as_ref()
                 .map_or(String::new(), |w| format!(" (the first: {w})"))
         )));

@@ -65,18 +65,7 @@ pub(crate) fn solid(solid: &Solid, id: usize, ns: &str) -> Marker {
             shape,
             vehicle_from_part,
         } => {
-            let half = match shape {
-                aircraft::Shape::Box { half_extents_m } => half_extents_m,
-                aircraft::Shape::Cylinder {
-                    radius_m,
-                    half_length_m,
-                } => Vector3::new(radius_m, radius_m, half_length_m),
-                aircraft::Shape::Capsule {
-                    radius_m,
-                    half_length_m,
-                } => Vector3::new(radius_m, radius_m, half_length_m + radius_m),
-                aircraft::Shape::Sphere { radius_m } => Vector3::repeat(radius_m),
-            };
+            let half = shape.half_extents_m();
             let on_ground = Isometry3::from_parts(
                 Translation3::new(solid.x_m, solid.y_m, 0.0),
                 world_from_solid.rotation,

@@ -120,6 +120,12 @@ impl TfBuffer {
         self.sorted = true;
     }
 
+    /// Whether the frame is in the tree (as a child or a parent).
+    #[must_use]
+    pub fn knows(&self, frame: &str) -> bool {
+        self.links.contains_key(frame) || self.links.values().any(|l| l.parent == frame)
+    }
+
     /// Whether the tree has any transform.
     #[must_use]
     pub fn is_empty(&self) -> bool {

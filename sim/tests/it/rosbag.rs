@@ -137,7 +137,7 @@ fn a_runs_bag_holds_every_revolutions_returns_in_the_sensor_frame() {
         )
         .unwrap();
         assert_eq!(
-            (report.clouds, report.without_pose),
+            (report.clouds, report.skipped),
             (clouds.len() as u64, 0),
             "{source:?}"
         );
@@ -234,10 +234,7 @@ fn the_map_from_a_recorded_drive_equals_the_drives_map() {
         &mut |_, _| {},
     )
     .unwrap();
-    assert_eq!(
-        (report.clouds, report.without_pose),
-        (drive.scans as u64, 0)
-    );
+    assert_eq!((report.clouds, report.skipped), (drive.scans as u64, 0));
     assert_eq!(report.manifest.scans, drive.scans);
     assert_eq!(report.layout.map(|l| l.columns), Some(2187));
     assert!((report.manifest.route_m - drive.route_m).abs() < 0.2);
@@ -363,33 +360,38 @@ pub(crate) fn hostile_bag(file: &std::path::Path, h: Hostile) {
 }
 
 /// Bags that cannot be mapped are errors that say which file, topic, message and field - a
-/// bag cut short, a cloud topic of another type or missing, a cloud whose `point_step` cannot
+/// cloud topic of another type or missing, a cloud whose `point_step` cannot
 /// hold its fields or that has no `ring`, a bag with no poses - and a sound one of the same
 /// make maps.
-#[test]
-fn hostile_bags_are_located_errors() {
+/// Maps the bag at `file` for the car of `straight_cone_under_wing`: its revolutions, or the
+/// error's text.
+fn map_bag(file: &std::path::Path, options: &sim::rosbag::BagMapOptions) -> Result<usize, String> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../scenarios/straight_cone_under_wing.toml");
     let s = Scenario::from_file(&path).unwrap();
     let config = RunConfig::default();
     let levels = sim::offline_map::levels_of(&s, &config).unwrap();
+    sim::rosbag::map_from_bag(
+        file,
+        options,
+        &levels,
+        sim::offline_map::map_config(&config),
+        None,
+        &file.with_extension("map"),
+        &mut |_, _| {},
+    )
+    .map(|r| r.manifest.scans)
+    .map_err(|e| e.to_string())
+}
+
+#[test]
+fn hostile_bags_are_located_errors() {
     let dir = tempfile::tempdir().unwrap();
     let map = |name: &str, h: Hostile, options: sim::rosbag::BagMapOptions| {
         let file = dir.path().join(name).join(format!("{name}.mcap"));
         std::fs::create_dir_all(file.parent().unwrap()).unwrap();
         hostile_bag(&file, h);
-        let out = dir.path().join(name).join("map");
-        sim::rosbag::map_from_bag(
-            &file,
-            &options,
-            &levels,
-            sim::offline_map::map_config(&config),
-            None,
-            &out,
-            &mut |_, _| {},
-        )
-        .map(|r| r.manifest.scans)
-        .map_err(|e| e.to_string())
+        map_bag(&file, &options)
     };
     let default = sim::rosbag::BagMapOptions::default;
     assert_eq!(map("sound", Hostile::default(), default()), Ok(10));
@@ -468,21 +470,23 @@ fn hostile_bags_are_located_errors() {
     )
     .unwrap_err();
     assert!(e.contains("no topic /odom"), "{e}");
-    // The sound bag cut short.
-    let sound = dir.path().join("sound/sound.mcap");
+}
+
+/// A bag cut short, and a firing count no sensor has, are located errors too.
+#[test]
+fn a_truncated_bag_and_a_bad_column_count_are_located_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let sound = dir.path().join("sound.mcap");
+    hostile_bag(&sound, Hostile::default());
+    let columns = sim::rosbag::BagMapOptions {
+        columns: Some(0),
+        ..sim::rosbag::BagMapOptions::default()
+    };
+    let e = map_bag(&sound, &columns).unwrap_err();
+    assert!(e.contains("--columns 0"), "{e}");
     let bytes = std::fs::read(&sound).unwrap();
     let cut = dir.path().join("cut.mcap");
     std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
-    let e = sim::rosbag::map_from_bag(
-        &cut,
-        &default(),
-        &levels,
-        sim::offline_map::map_config(&config),
-        None,
-        &dir.path().join("cut"),
-        &mut |_, _| {},
-    )
-    .unwrap_err()
-    .to_string();
+    let e = map_bag(&cut, &sim::rosbag::BagMapOptions::default()).unwrap_err();
     assert!(e.contains("cut.mcap") && e.contains("truncated"), "{e}");
 }

@@ -151,11 +151,8 @@ fn from_bag(
     .with_context(|| format!("taxi-sim map --from-bag {}", bag.display()))?;
     progress.finish_and_clear();
     let m = &report.manifest;
-    let skipped = match &report.first_without_pose {
-        Some(why) => format!(
-            "; {} clouds skipped without a pose (the first: {why})",
-            report.without_pose
-        ),
+    let skipped = match &report.first_skipped {
+        Some(why) => format!("; {} clouds skipped (the first: {why})", report.skipped),
         None => String::new(),
     };
     let layout = report.layout.map_or(String::new(), |l| {
