@@ -114,6 +114,9 @@ pub struct Driver {
     /// The movers at the vehicle's body ([`at_body`]): released once seen away from the body,
     /// kept for good once lost.
     at_body: Vec<AtBody>,
+    /// Movers predicted out of view at the last plan (see `movers_at_body`): one whose track
+    /// drops while predicted to reach the standing vehicle's body is waited for.
+    coasting: Vec<TrackState>,
     /// The tracks seen and predicted as movers lately.
     streaks: Vec<MoverStreak>,
 }
@@ -128,6 +131,17 @@ struct AtBody {
     /// When it was last seen, seconds.
     seen_s: f64,
 }
+
+/// A mover predicted out of view whose track drops while predicted to reach the standing
+/// vehicle's body within this many seconds is waited for as one lost there. Short: a static
+/// object's parts sliding out of view (a stale map, heavy dropout) seem to move too, and over
+/// the whole horizon their predictions would reach the body and call the pilot.
+const DROPPED_AT_BODY_S: f64 = 2.0;
+
+/// ... and only once it had been out of view this long, seconds: it coasted out of view. Under
+/// heavy faults spurious returns make one-cell tracks that jump at 5-14 m/s and are dropped
+/// within a second.
+const COASTED_S: f64 = 2.0;
 
 /// A track seen and predicted as a mover on consecutive plans.
 #[derive(Clone, Copy, Debug)]
@@ -186,6 +200,7 @@ impl Driver {
             last_caution_s: None,
             hold: None,
             at_body: Vec::new(),
+            coasting: Vec::new(),
             streaks: Vec::new(),
         }
     }
@@ -237,6 +252,7 @@ impl Driver {
         self.last_conflict_s = None;
         self.last_caution_s = None;
         self.at_body.clear();
+        self.coasting.clear();
         self.streaks.clear();
         self.hold = None;
         self.route_s_m = None;
@@ -304,9 +320,20 @@ impl Driver {
         {
             chosen.collision_at_m = Some(chosen.collision_at_m.map_or(stop_at, |c| c.min(stop_at)));
         }
+        if let Some(at) = chosen.collision_at_m {
+            // Stopping - for a mover or the map - never where another mover is predicted to
+            // pass, when the vehicle can stop short of its path.
+            chosen.collision_at_m =
+                Some(self.stand_clear(&p, at, v0, decel, estimate.t_s, &config));
+        }
         let (mut v, _) = avoid(&chosen, wanted, decel, &config);
-        let body =
-            self.movers_at_body(&movers, &estimate.world_from_vehicle, estimate.t_s, &config);
+        let body = self.movers_at_body(
+            &movers,
+            &estimate.world_from_vehicle,
+            estimate.t_s,
+            v0 < 0.05,
+            &config,
+        );
         if body.is_some() {
             v = 0.0;
         }
@@ -427,6 +454,39 @@ impl Driver {
         self.hold.map(|(_, line, _)| (line - s).max(0.0))
     }
 
+    /// Where to stop instead of `at_m` ahead so as not to stand in a predicted mover's path
+    /// ([`traffic::stand_clear`]); `at_m` when it is clear or too late.
+    fn stand_clear(
+        &self,
+        p: &Plan,
+        at_m: f64,
+        v0: f64,
+        decel: f64,
+        now_s: f64,
+        config: &AutonomyConfig,
+    ) -> f64 {
+        if !config.traffic.enabled || self.predictions.is_empty() {
+            return at_m;
+        }
+        let path = TimedPath {
+            poses: &p.chosen().poses,
+            step_m: config.step_m,
+            profile: self.profile(0.0),
+            now_s,
+            yielding: false,
+        };
+        crate::traffic::stand_clear(
+            &path,
+            &self.vehicle.collision,
+            &self.predictions,
+            at_m,
+            config.stop_buffer_m,
+            stopping_distance_m(v0, decel, config),
+            &config.traffic,
+        )
+        .unwrap_or(at_m)
+    }
+
     /// The `movers` (the online map's tracker's) predicted, and the first conflict on `p`'s
     /// chosen path for a vehicle going from its speed now to `wanted` m/s (`None` with traffic
     /// off); `committed`: with the time margin of a vehicle that can no longer stop short.
@@ -476,10 +536,12 @@ impl Driver {
         movers: &[TrackState],
         pose: &Isometry2<f64>,
         now_s: f64,
+        stopped: bool,
         config: &AutonomyConfig,
     ) -> Option<DriverStatus> {
         if !config.traffic.enabled {
             self.at_body.clear();
+            self.coasting.clear();
             return None;
         }
         let cfg = &config.traffic;
@@ -495,10 +557,7 @@ impl Driver {
                     let seen_now = now_s - t.t_s <= 0.25;
                     return !seen_now || at();
                 }
-                let arriving = self.streaks.iter().any(|r| {
-                    r.id == t.id && r.mover_s.is_some_and(|m| now_s - m <= MOVER_LATELY_S)
-                }) && moved_beyond_its_extent(t, cfg);
-                arriving && at()
+                self.arriving(t, now_s, cfg) && at()
             })
             .map(|t| AtBody {
                 id: t.id,
@@ -515,6 +574,41 @@ impl Driver {
             .iter()
             .filter(|r| !movers.iter().any(|t| t.id == r.id));
         body.extend(lost);
+        // A mover that coasted out of view toward a standing vehicle and whose track was then
+        // dropped: predicted to reach the body within `DROPPED_AT_BODY_S`, it is waited for as
+        // one lost there (a van that drove into the blind zone behind the wing has not gone).
+        if stopped {
+            let dropped = self
+                .coasting
+                .iter()
+                .filter(|t| !movers.iter().any(|m| m.id == t.id))
+                .filter(|t| !body.iter().any(|r| r.id == t.id) && now_s - t.t_s >= COASTED_S)
+                .filter(|t| {
+                    let steps = (DROPPED_AT_BODY_S / 0.5).ceil() as usize;
+                    (0..=steps).any(|k| {
+                        let at_s = now_s + k as f64 * 0.5;
+                        at_body(&self.vehicle.collision, pose, t, at_s, cfg)
+                    })
+                })
+                .map(|t| AtBody {
+                    id: t.id,
+                    at: t.position,
+                    seen_s: t.t_s,
+                })
+                .collect::<Vec<_>>();
+            body.extend(dropped);
+        }
+        // Movers predicted out of view now, beyond what revealing a static object explains:
+        // checked again if their track drops (seen too briefly for a streak, maybe).
+        self.coasting = movers
+            .iter()
+            .filter(|t| {
+                now_s - t.t_s > 0.25
+                    && moved_beyond_its_extent(t, cfg)
+                    && self.predictions.iter().any(|p| p.track.id == t.id)
+            })
+            .cloned()
+            .collect();
         self.at_body = body;
         let seen = self
             .at_body
@@ -535,6 +629,15 @@ impl Driver {
                 _ => now_s,
             },
         })
+    }
+
+    /// Whether track `t` is a mover that may arrive at the body: one predicted on a streak
+    /// lately that has moved beyond its own extent.
+    fn arriving(&self, t: &TrackState, now_s: f64, cfg: &crate::traffic::TrafficConfig) -> bool {
+        self.streaks
+            .iter()
+            .any(|r| r.id == t.id && r.mover_s.is_some_and(|m| now_s - m <= MOVER_LATELY_S))
+            && moved_beyond_its_extent(t, cfg)
     }
 
     /// Each track seen (this revolution or the last, 0.25 s) and predicted now continues its

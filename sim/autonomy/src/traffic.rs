@@ -16,9 +16,12 @@
 //!   the mover is predicted to reach within `horizon_s` touches - so a vehicle never stands in
 //!   a mover's predicted path when it can stop short of it; when it cannot (too close, too
 //!   fast), it drives on if it clears the mover by `committed_margin_s`, and stops before the
-//!   conflict itself only if it does not. A mover predicted to pass before the vehicle arrives (or
-//!   after it has gone) is no conflict, so it does not stop the vehicle. While yielding, the
-//!   margin after grows by `resume_margin_s`, so the vehicle does not creep off and stop again.
+//!   conflict itself only if it does not. Wherever it stops - for a mover or for the map - it
+//!   stops short of any other mover's predicted path when it can ([`stand_clear`]): a stop for
+//!   one must not leave the tail across another's. A mover predicted to pass before the
+//!   vehicle arrives (or after it has gone) is no conflict, so it does not stop the vehicle.
+//!   While yielding, the margin after grows by `resume_margin_s`, so the vehicle does not creep
+//!   off and stop again.
 //! - Movers slower than `min_speed_m_s`, or than `sigmas` standard deviations of their speed,
 //!   are left to the map (their cells are obstacles there).
 //! - **Caution**: a candidate mover - seen to travel a metre, not yet beyond what revealing a
@@ -26,10 +29,12 @@
 //!   instead of stopping the vehicle: slow for what may move, stop for what does.
 //! - **A mover at the body** ([`at_body`]): one seen, or predicted while out of view, whose box
 //!   of hits, grown by what of it may be hidden, comes within `at_body_m` of a circle of a level
-//!   it occupies is where the map cannot hold it (returns
-//!   within the map's self-hit margin of the vehicle are dropped as its own): the vehicle does
+//!   it occupies is where the map cannot hold it (returns within the map's self-hit margin of
+//!   the vehicle are dropped as its own): the vehicle does
 //!   not move until it is seen away from the body, and one lost there is waited for as a hidden
-//!   obstacle (the pilot is called). A person who walked up to the fuselage, a truck that
+//!   obstacle (the pilot is called); so is one predicted out of view whose track drops while
+//!   it is predicted to reach the standing vehicle's body within the horizon (a van lost into
+//!   the blind zone behind a wing). A person who walked up to the fuselage, a truck that
 //!   struck the nose: the vehicle moving on would meet them. Only a mover arrives there: a
 //!   track predicted lately that has moved beyond its own extent
 //!   ([`moved_beyond_its_extent`]) - not a parked car whose visible part slides.
@@ -444,6 +449,52 @@ fn conflict_with(
     best
 }
 
+/// Where the vehicle about to stop `stop_at_m` along `path` (it stands `stand_back_m` before
+/// that) should stop instead, so that it does not stand where a mover is predicted to pass
+/// within the horizon: before the first pose such a mover's predicted positions touch, when
+/// that lies beyond `stopping_m` (the vehicle can still stop short of it). A stop for one mover,
+/// or for an obstacle in the map, must not leave the tail across another's path. `None`:
+/// standing there is clear of every mover, or it is too late to stop short.
+pub fn stand_clear(
+    path: &TimedPath<'_>,
+    model: &CollisionModel,
+    predictions: &[Prediction],
+    stop_at_m: f64,
+    stand_back_m: f64,
+    stopping_m: f64,
+    cfg: &TrafficConfig,
+) -> Option<f64> {
+    let last = path.poses.len().checked_sub(1)?;
+    let mut at_m = stop_at_m;
+    let mut moved = false;
+    // Each earlier line may stand in a third mover's path: at most one step per mover.
+    for _ in 0..predictions.len() {
+        let stand = (((at_m - stand_back_m) / path.step_m).floor().max(0.0) as usize).min(last);
+        let earliest = predictions
+            .iter()
+            .filter_map(|p| {
+                let (a, b, radius) = swept(&p.track, path.now_s, path.now_s + cfg.horizon_s, cfg);
+                let reach = radius + cfg.margin_m;
+                touches(model, &path.poses[stand], p.track.levels, &a, &b, reach).then(|| {
+                    path.poses[..=stand]
+                        .iter()
+                        .position(|pose| touches(model, pose, p.track.levels, &a, &b, reach))
+                        .unwrap_or(stand) as f64
+                        * path.step_m
+                })
+            })
+            .reduce(f64::min);
+        match earliest {
+            Some(zone_m) if zone_m > stopping_m && zone_m < at_m => {
+                at_m = zone_m;
+                moved = true;
+            }
+            _ => break,
+        }
+    }
+    moved.then_some(at_m)
+}
+
 /// The first pose (up to `up_to`) that any position the mover is predicted to reach within the
 /// horizon touches, as a distance along the path.
 fn conflict_zone(
@@ -534,6 +585,44 @@ mod tests {
             yielding,
         };
         first_conflict(&path, &model(), &p, &cfg)
+    }
+
+    /// The vehicle about to stop 20 m ahead (standing 3 m before that: its circles over 17-27
+    /// m) for something further on, with a slow mover crossing there from the right: it stops
+    /// short of the mover's predicted path when it can, its circles then clear of every
+    /// position the mover is predicted to reach; too late to stop short, or the mover far off,
+    /// the line stays.
+    #[test]
+    fn a_stop_is_moved_short_of_another_movers_path() {
+        let cfg = TrafficConfig::default();
+        let poses = straight(121);
+        let path = TimedPath {
+            poses: &poses,
+            step_m: 0.5,
+            profile: at_speed(2.0),
+            now_s: 0.0,
+            yielding: false,
+        };
+        let clear = |m: &TrackState, stopping_m: f64| {
+            let p = predict(std::slice::from_ref(m), 0.0, &cfg);
+            stand_clear(&path, &model(), &p, 20.0, 3.0, stopping_m, &cfg)
+        };
+        let truck = mover(22.0, -9.0, 0.0, 1.1, 0b11);
+        let at = clear(&truck, 2.0).expect("moved short of the truck's path");
+        assert!(at > 2.0 && at < 17.0, "{at}");
+        // Standing there (3 m before the line), no circle meets the truck's 8-s sweep; half a
+        // metre further on, one does (the line is the zone's start, not earlier).
+        let (a, b, r) = swept(&truck, 0.0, cfg.horizon_s, &cfg);
+        let touches_at = |x: f64| {
+            let pose = Isometry2::new(Vector2::new(x, 0.0), 0.0);
+            touches(&model(), &pose, truck.levels, &a, &b, r + cfg.margin_m)
+        };
+        assert!(!touches_at(at - 3.0));
+        assert!(touches_at(at));
+        // Too late to stop short of it: the line stays (driving on is the avoider's call).
+        assert_eq!(clear(&truck, at + 0.5), None);
+        // A mover predicted to stay 30 m off: standing at the line is clear.
+        assert_eq!(clear(&mover(22.0, -40.0, 0.0, 1.1, 0b11), 2.0), None);
     }
 
     #[test]

@@ -162,64 +162,69 @@ fn a_slow_truck_not_yet_confirmed_slows_the_jet_in_time() {
     assert_eq!(was.contacts_judged[0].contact.part, "wing_left");
 }
 
-/// FIXME (README, Known problems): the jet stops for one fuel truck ahead (2.8 m/s, which passes
-/// 0.28 m from its wing) with its tail across the path of another, slower one (1.08 m/s) whose
-/// path its nose crossed 20 s before the truck came; still creeping to a halt at 0.13 m/s, its
-/// left nacelle meets that truck - at fault by the judge's rule (above 0.05 m/s). Asserted as it
-/// is. Found by the traffic campaign (variant 560 of 1000 on 8c04d85, its only run at fault).
+/// Changed, not mended at its root: the jet stops for one fuel truck ahead (2.8 m/s) with its
+/// tail across the path of a slower one (1.08 m/s). The stack never predicts the slow truck: it
+/// reads its speed as 0.55 m/s (under the 0.8 m/s floor of prediction; its visible part grows as
+/// it comes head-on) and then loses it behind the left wing, the map holding its old cells. What
+/// holds the jet is a ghost of the first truck - its visible part sliding back as the wing hid
+/// it, a track driving back toward the jet, then lost. Before, the ghost's track expired and
+/// the jet moved off as the slow truck reached its nacelle (at fault, 0.13 m/s). Now a mover
+/// whose track drops while it is predicted to reach the standing vehicle's body is waited for
+/// as one lost there: the slow truck strikes the standing nacelle and the pilot is called
+/// (README, Known problems). Found by the traffic campaign (variant 560 of 1000 on 8c04d85).
 #[test]
-fn fixme_a_fuel_truck_meets_the_stopping_jets_nacelle() {
+fn a_truck_lost_toward_the_standing_jet_is_waited_for() {
     let r = run_found_with(&found("fuel_truck_meets_the_stopping_jets_nacelle"), |_| {});
-    assert_eq!(r.contacts_at_fault, 1, "{:?}", r.contacts_judged);
-    let c = &r.contacts_judged[0];
-    assert_eq!(
-        (c.contact.object.as_str(), c.contact.part.as_str()),
-        ("fuel_truck_1", "nacelle_left")
-    );
-    assert!(
-        c.vehicle_speed_m_s > 0.05 && c.vehicle_speed_m_s < 0.5,
-        "{c:?}"
-    );
-    let second = r.obstacles.iter().find(|o| o.id == "fuel_truck_2").unwrap();
-    assert_eq!(second.pet_mover_first, Some(true), "{second:?}");
-}
-
-/// FIXME (README, Known problems): a follow-me car appears 3.2 m left of the centreline ahead of
-/// the jet at 8 m/s and drives toward it; 2.1 s later the left wing meets it at 5.1 m/s, then
-/// the left main gear. Asserted as it is. Found by the traffic campaign (variant 880 of 1000
-/// on 8c04d85).
-#[test]
-fn fixme_a_follow_me_car_appears_at_the_wing() {
-    let r = run_found_with(&found("follow_me_car_appears_at_the_wing"), |_| {});
-    assert_eq!(r.contacts_at_fault, 2, "{:?}", r.contacts_judged);
-    let parts: Vec<&str> = r
+    assert_eq!(r.contacts_at_fault, 0, "{:?}", r.contacts_judged);
+    assert_eq!(r.end, sim::engine::EndReason::WaitingForHiddenObstacle);
+    let c: Vec<(&str, &str)> = r
         .contacts_judged
         .iter()
-        .filter(|c| c.at_fault)
-        .map(|c| c.contact.part.as_str())
+        .map(|c| (c.contact.object.as_str(), c.contact.part.as_str()))
         .collect();
-    assert_eq!(parts, ["wing_left", "main_gear_left"]);
+    assert_eq!(c, [("fuel_truck_1", "nacelle_left")]);
 }
 
-/// FIXME (README, Known problems): a van crossing at 6.3 m/s strikes the standing jet's tail
-/// cone, and the jet then moves while it still touches (at fault). Asserted as it is. Found by
-/// the traffic campaign (variant 963 of 1000 on 8c04d85).
+/// Not a case any stack can pass, kept as the evidence for the campaign's change: a follow-me car
+/// appeared (`appears_s` 29.6 s) 3.2 m left of the centreline ahead of the jet at 8 m/s - inside
+/// its stopping distance - and drove toward it. The stack braked at once (from the speed at the
+/// first contact, braking at the jet's 1.5 m/s^2 began within 0.3 s of the appearance), and the
+/// left wing still met the car. The traffic campaign now has follow-me cars turn onto the
+/// taxiway in the first 8 s, at least 85 m ahead. Found by the traffic campaign (variant 880 of
+/// 1000 on 8c04d85).
 #[test]
-fn fixme_a_van_strikes_the_tail_of_the_standing_jet() {
+fn a_follow_me_car_appearing_at_the_wing_cannot_be_avoided() {
+    let s = found("follow_me_car_appears_at_the_wing");
+    let appears_s = s.obstacles[0].appears_s;
+    let r = run_found_with(&s, |_| {});
+    let first = r.contacts_judged.first().expect("a contact");
+    assert_eq!(first.contact.part, "wing_left", "{:?}", r.contacts_judged);
+    // 8 m/s down to the contact's speed at 1.5 m/s^2 at most: braking began by this time.
+    let braking_by_s = first.contact.time_s - (8.0 - first.vehicle_speed_m_s) / 1.5;
+    assert!(
+        braking_by_s - appears_s < 0.3,
+        "braking by {braking_by_s:.2} s, the car appeared at {appears_s:.2} s"
+    );
+}
+
+/// Fixed: a van crossing at 6.3 m/s, predicted, then lost into the blind zone behind the
+/// standing jet's wing, strikes its tail cone (struck while standing). Before, its track
+/// expired 6 s after it was last seen - a second before it arrived - and the jet moved off while
+/// the van still touched the tail (at fault). Now a mover whose track drops while it is
+/// predicted to reach the standing vehicle's body is waited for as one lost there: the pilot is
+/// called. Found by the traffic campaign (variant 963 of 1000 on 8c04d85).
+#[test]
+fn a_van_lost_behind_the_wing_holds_the_standing_jet() {
     let r = run_found_with(&found("van_strikes_the_tail_of_the_standing_jet"), |_| {});
     assert_eq!(
         (r.contacts_struck, r.contacts_at_fault),
-        (1, 1),
+        (1, 0),
         "{:?}",
         r.contacts_judged
     );
-    assert!(
-        r.contacts_judged
-            .iter()
-            .all(|c| c.contact.object == "van_1" && c.contact.part == "tail_cone"),
-        "{:?}",
-        r.contacts_judged
-    );
+    let c = &r.contacts_judged[0].contact;
+    assert_eq!((c.object.as_str(), c.part.as_str()), ("van_1", "tail_cone"));
+    assert_eq!(r.end, sim::engine::EndReason::WaitingForHiddenObstacle);
 }
 
 /// FIXME (README, Known problems): on KSYR's taxiway W the file's network runs 9-14 m off the
