@@ -1,0 +1,218 @@
+//! The UDP datagrams of a capture: a pcap or pcapng file read with `pcap-parser`, each packet's
+//! link layer (Ethernet with or without an 802.1Q tag, Linux cooked capture v1 or v2, raw IPv4),
+//! IPv4 header (its own length, not assumed 20 bytes) and UDP header parsed. Packets that are
+//! not IPv4 UDP (ARP, IPv6, TCP) are skipped; a fragment, a packet cut short by the capture's
+//! snap length or a length field past the packet's end is an error naming the packet.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use pcap_parser::{Linktype, PcapBlockOwned, PcapError, create_reader, pcapng::Block};
+
+use crate::VelodyneError;
+
+/// One UDP datagram of a capture.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Datagram {
+    /// The packet's record index in the capture, from 0 (every record counts, UDP or not).
+    pub index: usize,
+    /// The capture's timestamp (the host's clock), seconds since the Unix epoch.
+    pub time_s: f64,
+    /// UDP source port.
+    pub src_port: u16,
+    /// UDP destination port.
+    pub dst_port: u16,
+    /// The UDP payload.
+    pub payload: Vec<u8>,
+}
+
+/// Every IPv4 UDP datagram of the capture at `path`, in capture order.
+pub fn read_datagrams(path: &Path) -> Result<Vec<Datagram>, VelodyneError> {
+    let file = File::open(path).map_err(|source| VelodyneError::Io {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    let whole = |what: String| VelodyneError::File {
+        file: path.to_path_buf(),
+        what,
+    };
+    let mut reader = create_reader(1 << 20, file)
+        .map_err(|e| whole(format!("not a pcap or pcapng capture ({e:?})")))?;
+    let mut out = Vec::new();
+    // The legacy header's link type and time unit; pcapng's per interface.
+    let mut legacy: Option<(Linktype, f64)> = None;
+    let mut interfaces: Vec<(Linktype, f64)> = Vec::new();
+    let mut index = 0usize;
+    loop {
+        match reader.next() {
+            Ok((offset, block)) => {
+                let packet = match block {
+                    PcapBlockOwned::LegacyHeader(h) => {
+                        let unit = if h.is_nanosecond_precision() {
+                            1e-9
+                        } else {
+                            1e-6
+                        };
+                        legacy = Some((h.network, unit));
+                        None
+                    }
+                    PcapBlockOwned::Legacy(b) => {
+                        let (link, unit) = legacy.ok_or_else(|| whole("no header".into()))?;
+                        let time_s = b.ts_sec as f64 + b.ts_usec as f64 * unit;
+                        Some((link, time_s, b.caplen, b.origlen, b.data.to_vec()))
+                    }
+                    PcapBlockOwned::NG(Block::SectionHeader(_)) => {
+                        interfaces.clear();
+                        None
+                    }
+                    PcapBlockOwned::NG(Block::InterfaceDescription(i)) => {
+                        let per_s = i.ts_resolution().unwrap_or(1_000_000).max(1) as f64;
+                        interfaces.push((i.linktype, 1.0 / per_s));
+                        None
+                    }
+                    PcapBlockOwned::NG(Block::EnhancedPacket(p)) => {
+                        let &(link, unit) = interfaces.get(p.if_id as usize).ok_or_else(|| {
+                            packet_error(path, index, format!("interface {} undeclared", p.if_id))
+                        })?;
+                        let ticks = (u64::from(p.ts_high) << 32) | u64::from(p.ts_low);
+                        let data = p.data.get(..p.caplen as usize).unwrap_or(p.data);
+                        Some((
+                            link,
+                            ticks as f64 * unit,
+                            p.caplen,
+                            p.origlen,
+                            data.to_vec(),
+                        ))
+                    }
+                    PcapBlockOwned::NG(Block::SimplePacket(p)) => {
+                        let &(link, _) = interfaces
+                            .first()
+                            .ok_or_else(|| packet_error(path, index, "no interface".into()))?;
+                        let len = p.data.len() as u32;
+                        Some((link, 0.0, len, p.origlen.max(len), p.data.to_vec()))
+                    }
+                    PcapBlockOwned::NG(_) => None,
+                };
+                if let Some((link, time_s, caplen, origlen, data)) = packet {
+                    if caplen < origlen {
+                        return Err(packet_error(
+                            path,
+                            index,
+                            format!("cut short by the capture: {caplen} of {origlen} bytes kept"),
+                        ));
+                    }
+                    if let Some(d) = udp(link, &data).map_err(|w| packet_error(path, index, w))? {
+                        out.push(Datagram {
+                            index,
+                            time_s,
+                            src_port: d.0,
+                            dst_port: d.1,
+                            payload: d.2.to_vec(),
+                        });
+                    }
+                    index += 1;
+                }
+                reader.consume(offset);
+            }
+            Err(PcapError::Eof) => break,
+            Err(PcapError::Incomplete(_)) => {
+                reader
+                    .refill()
+                    .map_err(|e| whole(format!("read failed ({e:?})")))?;
+                if reader.reader_exhausted() && reader.data().is_empty() {
+                    break;
+                }
+            }
+            Err(PcapError::UnexpectedEof) => {
+                return Err(whole(format!(
+                    "cut short: the file ends inside packet {index} (after {} whole UDP \
+                     datagrams)",
+                    out.len()
+                )));
+            }
+            Err(e) => return Err(packet_error(path, index, format!("unreadable ({e:?})"))),
+        }
+    }
+    if index == 0 {
+        return Err(whole("no packets".into()));
+    }
+    Ok(out)
+}
+
+fn packet_error(path: &Path, index: usize, what: String) -> VelodyneError {
+    VelodyneError::Packet {
+        file: PathBuf::from(path),
+        index,
+        what,
+    }
+}
+
+/// A UDP datagram's ports and payload; `None` for what is not IPv4 UDP.
+type Udp<'a> = (u16, u16, &'a [u8]);
+
+/// The UDP datagram in a packet of link type `link`.
+pub fn udp(link: Linktype, data: &[u8]) -> Result<Option<Udp<'_>>, String> {
+    let be16 = |b: &[u8], at: usize| b.get(at..at + 2).map(|s| u16::from_be_bytes([s[0], s[1]]));
+    let short = |what: &str| format!("{what} cut short ({} bytes)", data.len());
+    let (ethertype, ip) = match link {
+        Linktype::ETHERNET => {
+            let mut at = 12;
+            let mut t = be16(data, at).ok_or_else(|| short("Ethernet header"))?;
+            if t == 0x8100 {
+                at += 4;
+                t = be16(data, at).ok_or_else(|| short("802.1Q tag"))?;
+            }
+            (t, &data[(at + 2).min(data.len())..])
+        }
+        Linktype::LINUX_SLL => (
+            be16(data, 14).ok_or_else(|| short("Linux cooked header"))?,
+            data.get(16..).ok_or_else(|| short("Linux cooked header"))?,
+        ),
+        Linktype::LINUX_SLL2 => (
+            be16(data, 0).ok_or_else(|| short("Linux cooked v2 header"))?,
+            data.get(20..)
+                .ok_or_else(|| short("Linux cooked v2 header"))?,
+        ),
+        Linktype::RAW | Linktype::IPV4 => (0x0800, data),
+        Linktype(other) => {
+            return Err(format!(
+                "link type {other} not supported (Ethernet 1, Linux cooked 113 and 276, raw IPv4 \
+                 101 and 228 are)"
+            ));
+        }
+    };
+    if ethertype != 0x0800 || ip.first().is_none_or(|b| b >> 4 != 4) {
+        return Ok(None);
+    }
+    let ihl = usize::from(ip[0] & 0x0f) * 4;
+    if ihl < 20 || ip.len() < ihl {
+        return Err(short("IPv4 header"));
+    }
+    if ip[9] != 17 {
+        return Ok(None);
+    }
+    let total = usize::from(be16(ip, 2).unwrap_or(0));
+    let flags_offset = be16(ip, 6).unwrap_or(0);
+    if flags_offset & 0x2000 != 0 || flags_offset & 0x1fff != 0 {
+        return Err("an IPv4 fragment (Velodyne packets are never fragmented)".into());
+    }
+    if total < ihl + 8 || total > ip.len() {
+        return Err(format!(
+            "IPv4 total length {total} outside the packet's {} bytes",
+            ip.len()
+        ));
+    }
+    let u = &ip[ihl..total];
+    let (src, dst, len) = (
+        be16(u, 0).unwrap_or(0),
+        be16(u, 2).unwrap_or(0),
+        usize::from(be16(u, 4).unwrap_or(0)),
+    );
+    if len < 8 || len > u.len() {
+        return Err(format!(
+            "UDP length {len} outside the datagram's {} bytes",
+            u.len()
+        ));
+    }
+    Ok(Some((src, dst, &u[8..len])))
+}

@@ -1,0 +1,156 @@
+//! Points and revolutions. A return's point in the sensor frame is VeloView's: `x = d cos(w)
+//! sin(a)`, `y = d cos(w) cos(a)`, `z = d sin(w)`, with `d` the distance, `w` the laser's
+//! vertical angle and `a` the block's azimuth (clockwise from +y; no per-laser azimuth
+//! interpolation on the HDL-32E, as VeloView). A revolution ends where a block's azimuth is
+//! smaller than the one before it (so the first and last of a capture are partial). Returns of
+//! distance 0 (no echo) are skipped; in dual-return mode the second block of a pair is skipped
+//! where it repeats the first. The VLP-16's second firing sequence of a block is placed at
+//! the block's azimuth too (VeloView shifts it by half a step; not done here yet).
+
+use std::path::Path;
+
+use crate::capture::read_datagrams;
+use crate::packet::{BLOCKS, DATA_LEN, DATA_PORT, DISTANCE_UNIT_M, POSITION_LEN, POSITION_PORT};
+use crate::{Calibration, DataPacket, PositionPacket, Product, ReturnMode, VelodyneError};
+
+/// One return.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point {
+    /// Position in the sensor frame, metres (+y ahead at azimuth 0, +z up).
+    pub xyz_m: [f32; 3],
+    /// Distance, metres.
+    pub distance_m: f32,
+    /// Intensity as the sensor reports it, 0-255.
+    pub intensity: u8,
+    /// The laser (its channel number within a firing sequence).
+    pub laser: u8,
+    /// Azimuth of its block, 0.01 degree.
+    pub azimuth_cdeg: u16,
+    /// When it fired, microseconds past the hour (the sensor's clock).
+    pub time_us: f64,
+}
+
+/// One revolution's returns, in firing order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Frame {
+    /// Its returns.
+    pub points: Vec<Point>,
+}
+
+/// A capture's data packets decoded (with their record indices) and its position packets.
+#[derive(Clone, Debug, Default)]
+pub struct Capture {
+    /// Data packets, with the record index of each.
+    pub data: Vec<(usize, DataPacket)>,
+    /// Position packets, with the record index of each.
+    pub positions: Vec<(usize, PositionPacket)>,
+}
+
+impl Capture {
+    /// Reads the Velodyne packets of the capture at `path`: UDP datagrams to port 2368 of 1206
+    /// bytes and to port 8308 of 512 bytes; others are skipped. Data packets from more than one
+    /// kind of sensor are an error.
+    pub fn read(path: &Path) -> Result<Capture, VelodyneError> {
+        let mut capture = Capture::default();
+        let located = |index: usize, what: String| VelodyneError::Packet {
+            file: path.to_path_buf(),
+            index,
+            what,
+        };
+        for d in read_datagrams(path)? {
+            if d.dst_port == DATA_PORT && d.payload.len() == DATA_LEN {
+                let p = DataPacket::decode(&d.payload).map_err(|w| located(d.index, w))?;
+                if let Some((first, q)) = capture.data.first()
+                    && (q.product, q.return_mode) != (p.product, p.return_mode)
+                {
+                    return Err(located(
+                        d.index,
+                        format!(
+                            "from another sensor: {:?} in {:?} mode, packet {first} was {:?} in \
+                             {:?} mode",
+                            p.product, p.return_mode, q.product, q.return_mode
+                        ),
+                    ));
+                }
+                capture.data.push((d.index, p));
+            } else if d.dst_port == POSITION_PORT && d.payload.len() == POSITION_LEN {
+                let p = PositionPacket::decode(&d.payload).map_err(|w| located(d.index, w))?;
+                capture.positions.push((d.index, p));
+            }
+        }
+        if capture.data.is_empty() {
+            return Err(VelodyneError::File {
+                file: path.to_path_buf(),
+                what: format!("no Velodyne data packets (UDP port {DATA_PORT}, {DATA_LEN} bytes)"),
+            });
+        }
+        Ok(capture)
+    }
+
+    /// The sensor the packets say, if they say.
+    pub fn product(&self) -> Product {
+        self.data
+            .first()
+            .map_or(Product::Unspecified, |(_, p)| p.product)
+    }
+}
+
+/// The returns of `packets` (of one sensor) cut into revolutions.
+pub fn frames(packets: &[DataPacket], calibration: &Calibration) -> Vec<Frame> {
+    let mut out = vec![Frame::default()];
+    let mut last_azimuth: Option<u16> = None;
+    for p in packets {
+        let dual = p.return_mode == ReturnMode::Dual;
+        for (k, block) in p.blocks.iter().enumerate() {
+            let a = block.azimuth_cdeg;
+            if last_azimuth.is_some_and(|l| a < l) {
+                out.push(Frame::default());
+            }
+            last_azimuth = Some(a);
+            let repeat = (dual && k % 2 == 1).then(|| &p.blocks[k - 1]);
+            let firing = if dual { k / 2 } else { k };
+            let frame = out.last_mut().expect("one frame at least");
+            for (j, &(d, intensity)) in block.channels.iter().enumerate() {
+                if d == 0 || repeat.is_some_and(|r| r.channels[j].0 == d) {
+                    continue;
+                }
+                let laser = j % calibration.lasers().max(1);
+                let Some(&w) = calibration.vertical_deg.get(laser) else {
+                    continue;
+                };
+                let time_us = firing_time_us(p, firing, j);
+                let (w, az) = (w.to_radians(), f64::from(a) * 0.01_f64.to_radians());
+                let dist = f64::from(d) * DISTANCE_UNIT_M;
+                frame.points.push(Point {
+                    xyz_m: [
+                        (dist * w.cos() * az.sin()) as f32,
+                        (dist * w.cos() * az.cos()) as f32,
+                        (dist * w.sin()) as f32,
+                    ],
+                    distance_m: dist as f32,
+                    intensity,
+                    laser: laser as u8,
+                    azimuth_cdeg: a,
+                    time_us,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// When channel `j` of firing `k` of packet `p` fired (manuals, appendix
+/// E): the HDL-32E stamps the last firing of the packet (46.08 us a sequence, 1.152 us a
+/// laser); the VLP-16 the first (two 16-laser sequences a block, 55.296 us each, 2.304 us a
+/// laser).
+fn firing_time_us(p: &DataPacket, k: usize, j: usize) -> f64 {
+    let t = f64::from(p.timestamp_us);
+    let dual = p.return_mode == ReturnMode::Dual;
+    if p.product == Product::Vlp16 {
+        t + k as f64 * 110.592 + (j / 16) as f64 * 55.296 + (j % 16) as f64 * 2.304
+    } else {
+        let firings = if dual { BLOCKS / 2 } else { BLOCKS };
+        let last = (firings - 1) as f64 * 46.08 + 31.0 * 1.152;
+        t - last + k as f64 * 46.08 + j as f64 * 1.152
+    }
+}
