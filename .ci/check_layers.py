@@ -10,7 +10,7 @@ import re
 import sys
 
 LAYERS = ["toml_file", "chart", "error", "world", "airports", "scenario", "offline_map", "engine", "replay",
-          "rosbag", "studies", "campaign", "tune", "bench"]
+          "rosbag", "pcap", "studies", "campaign", "tune", "bench"]
 
 def strip_comments(text):
     return "\n".join(line.split("//", 1)[0] for line in text.splitlines())

@@ -16,6 +16,7 @@
 //!   observer hook and the report;
 //! - [`replay`]: the Rerun recording and live view of a run (the only module that names Rerun);
 //! - [`rosbag`]: a run as a ROS 2 bag (MCAP with `metadata.yaml`);
+//! - [`pcap`]: real Velodyne captures as scans and offline maps;
 //! - [`studies`]: the mapping demo and the small-obstacle sweep;
 //! - [`campaign`]: scenario families sampled, run in parallel, searched for failures;
 //! - [`tune`]: collision-model tuning on the campaign engine;
@@ -37,6 +38,7 @@ pub mod engine;
 
 pub mod replay;
 
+pub mod pcap;
 pub mod rosbag;
 
 pub mod studies;

@@ -8,6 +8,7 @@
 mod campaign;
 mod fuzz;
 mod map_files;
+mod pcap;
 mod replay;
 mod rosbag;
 mod scenario;

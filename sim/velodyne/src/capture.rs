@@ -216,3 +216,43 @@ pub fn udp(link: Linktype, data: &[u8]) -> Result<Option<Udp<'_>>, String> {
     }
     Ok(Some((src, dst, &u[8..len])))
 }
+
+/// A classic pcap (little-endian, microsecond stamps, Ethernet) of `datagrams`: `(time_s,
+/// port, payload)`, each sent from 192.168.1.201 to the broadcast address on that UDP port, as
+/// a Velodyne sensor sends them. What the tests build captures with; VeloView, Wireshark and
+/// the ROS driver read it.
+pub fn pcap_bytes(datagrams: &[(f64, u16, Vec<u8>)]) -> Vec<u8> {
+    let mut out = Vec::new();
+    out.extend_from_slice(&0xa1b2_c3d4u32.to_le_bytes());
+    out.extend_from_slice(&2u16.to_le_bytes());
+    out.extend_from_slice(&4u16.to_le_bytes());
+    for w in [0u32, 0, 65535, 1] {
+        out.extend_from_slice(&w.to_le_bytes());
+    }
+    for (time_s, port, payload) in datagrams {
+        let mut f = vec![0xff; 6];
+        f.extend_from_slice(&[0x60, 0x76, 0x88, 0x20, 0x12, 0x6e, 0x08, 0x00]);
+        let total = (20 + 8 + payload.len()) as u16;
+        f.extend_from_slice(&[0x45, 0]);
+        f.extend_from_slice(&total.to_be_bytes());
+        f.extend_from_slice(&[
+            0, 0, 0x40, 0, 64, 17, 0, 0, 192, 168, 1, 201, 255, 255, 255, 255,
+        ]);
+        f.extend_from_slice(&port.to_be_bytes());
+        f.extend_from_slice(&port.to_be_bytes());
+        f.extend_from_slice(&((8 + payload.len()) as u16).to_be_bytes());
+        f.extend_from_slice(&[0, 0]);
+        f.extend_from_slice(payload);
+        let (secs, micros) = (time_s.floor(), ((time_s - time_s.floor()) * 1e6).round());
+        for w in [
+            secs as u32,
+            (micros as u32).min(999_999),
+            f.len() as u32,
+            f.len() as u32,
+        ] {
+            out.extend_from_slice(&w.to_le_bytes());
+        }
+        out.extend_from_slice(&f);
+    }
+    out
+}

@@ -26,6 +26,8 @@ pub struct Point {
     pub laser: u8,
     /// Azimuth of its block, 0.01 degree.
     pub azimuth_cdeg: u16,
+    /// Its firing sequence, counted from the capture's first (a column of a scan).
+    pub firing: u32,
     /// When it fired, microseconds past the hour (the sensor's clock).
     pub time_us: f64,
 }
@@ -99,6 +101,7 @@ impl Capture {
 pub fn frames(packets: &[DataPacket], calibration: &Calibration) -> Vec<Frame> {
     let mut out = vec![Frame::default()];
     let mut last_azimuth: Option<u16> = None;
+    let mut firings = 0u32;
     for p in packets {
         let dual = p.return_mode == ReturnMode::Dual;
         for (k, block) in p.blocks.iter().enumerate() {
@@ -109,6 +112,9 @@ pub fn frames(packets: &[DataPacket], calibration: &Calibration) -> Vec<Frame> {
             last_azimuth = Some(a);
             let repeat = (dual && k % 2 == 1).then(|| &p.blocks[k - 1]);
             let firing = if dual { k / 2 } else { k };
+            if repeat.is_none() {
+                firings += 1;
+            }
             let frame = out.last_mut().expect("one frame at least");
             for (j, &(d, intensity)) in block.channels.iter().enumerate() {
                 if d == 0 || repeat.is_some_and(|r| r.channels[j].0 == d) {
@@ -131,6 +137,7 @@ pub fn frames(packets: &[DataPacket], calibration: &Calibration) -> Vec<Frame> {
                     intensity,
                     laser: laser as u8,
                     azimuth_cdeg: a,
+                    firing: firings - 1,
                     time_us,
                 });
             }

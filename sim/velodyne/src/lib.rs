@@ -10,15 +10,19 @@
 //! - [`frames`]: points in the sensor frame with their laser, azimuth, intensity and firing
 //!   time, cut into revolutions where the azimuth wraps - VeloView's rule, so its expected
 //!   values (`monterey.test`) can be reproduced exactly.
+//! - [`scan`]: a revolution as a [`mapper::Scan`] (columns = firing sequences, beams = lasers
+//!   by vertical angle), what the mapper inserts.
 
 pub mod calibration;
 pub mod capture;
 mod error;
 pub mod frames;
 pub mod packet;
+pub mod scan;
 
 pub use calibration::Calibration;
-pub use capture::{Datagram, read_datagrams};
+pub use capture::{Datagram, pcap_bytes, read_datagrams};
 pub use error::VelodyneError;
 pub use frames::{Capture, Frame, Point, frames};
 pub use packet::{DataPacket, PositionPacket, Product, ReturnMode};
+pub use scan::{SensorScan, to_scan};

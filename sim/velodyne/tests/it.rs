@@ -30,22 +30,9 @@ fn pcap(link: u32, records: &[Vec<u8>]) -> Vec<u8> {
     out
 }
 
-/// An Ethernet frame carrying `payload` in UDP to `port` (IPv4 without options).
+/// An Ethernet frame carrying `payload` in UDP to `port`, as the crate writes it.
 fn ethernet_udp(port: u16, payload: &[u8]) -> Vec<u8> {
-    let mut f = vec![0xff; 6];
-    f.extend_from_slice(&[0x60, 0x76, 0x88, 0x20, 0x12, 0x6e, 0x08, 0x00]);
-    let total = (20 + 8 + payload.len()) as u16;
-    f.extend_from_slice(&[0x45, 0]);
-    f.extend_from_slice(&total.to_be_bytes());
-    f.extend_from_slice(&[
-        0, 0, 0x40, 0, 64, 17, 0, 0, 192, 168, 1, 201, 255, 255, 255, 255,
-    ]);
-    f.extend_from_slice(&port.to_be_bytes());
-    f.extend_from_slice(&port.to_be_bytes());
-    f.extend_from_slice(&((8 + payload.len()) as u16).to_be_bytes());
-    f.extend_from_slice(&[0, 0]);
-    f.extend_from_slice(payload);
-    f
+    velodyne::capture::pcap_bytes(&[(0.0, port, payload.to_vec())])[24 + 16..].to_vec()
 }
 
 /// An HDL-32E packet whose block `k` is at `azimuths[k]`, every channel `j` at (10 + j) m with
@@ -126,6 +113,36 @@ fn built_packets_decode_to_their_points_and_revolutions() {
         "{}",
         p.time_us
     );
+}
+
+/// A revolution as the mapper's scan: a column per firing sequence, a beam per laser by
+/// vertical angle (the HDL-32E's interleaved banks sorted: laser 2 at -29.33 degrees is beam 1),
+/// each point in the simulator's sensor frame (azimuth 0 forward along +x) moved to the world.
+#[test]
+fn a_revolution_becomes_the_mappers_scan() {
+    let p = packet(std::array::from_fn(|k| 9_000 + 20 * k as u16), 2_000_000);
+    let calibration = Calibration::built_in(Product::Hdl32e).unwrap();
+    let f = frames(&[p], &calibration);
+    let sensor = nalgebra::Isometry3::translation(5.0, -2.0, 1.5);
+    let vehicle = nalgebra::Isometry2::translation(5.0, -2.0);
+    let s = velodyne::to_scan(&f[0], &calibration, &sensor, &vehicle).unwrap();
+    assert_eq!((s.scan.beams(), s.scan.columns().len()), (32, 12));
+    assert_eq!(s.scan.returns().iter().flatten().count(), 12 * 31);
+    // Column 3 (azimuth 90.6 degrees: clockwise from forward, so to the right, -y), laser 2.
+    let r = s.scan.returns()[3 * 32 + 1].expect("a return");
+    let (w, a) = ((-29.33f64).to_radians(), 90.6f64.to_radians());
+    let in_sensor = [
+        12.0 * w.cos() * a.cos(),
+        -12.0 * w.cos() * a.sin(),
+        12.0 * w.sin(),
+    ];
+    let want = [5.0 + in_sensor[0], -2.0 + in_sensor[1], 1.5 + in_sensor[2]];
+    for (got, want) in r.point_in_world.iter().zip(want) {
+        assert!((got - want).abs() < 1e-4, "{r:?} {want:?}");
+    }
+    assert!((r.intensity - 2.0 / 255.0).abs() < 1e-6);
+    // Channel 5 (laser at -6.67 degrees, beam 18) has no echo.
+    assert_eq!(s.scan.returns()[3 * 32 + 18], None);
 }
 
 /// In dual-return mode a block pair repeats an azimuth; where the second repeats the first's
@@ -247,4 +264,14 @@ fn shared_data_monterey_reproduces_veloviews_values() {
         }
     }
     assert_eq!(checked, 4);
+    // A whole revolution as the mapper's scan: a column per firing, every return kept.
+    let s = velodyne::to_scan(
+        &f[8],
+        &calibration,
+        &nalgebra::Isometry3::identity(),
+        &nalgebra::Isometry2::identity(),
+    )
+    .unwrap();
+    assert!((1842..=1844).contains(&s.scan.columns().len()));
+    assert_eq!(s.scan.returns().iter().flatten().count(), f[8].points.len());
 }

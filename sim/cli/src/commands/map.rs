@@ -1,6 +1,6 @@
 //! `taxi-sim map`: the mapping drive that builds a scenario's offline multi-height map (optionally
-//! recorded as a ROS 2 bag), or the same map built from a bag's point clouds and poses, with a
-//! progress bar.
+//! recorded as a ROS 2 bag), or the same map built from a bag's point clouds and poses or from a
+//! real Velodyne capture, with a progress bar.
 
 use std::path::PathBuf;
 
@@ -57,6 +57,96 @@ pub struct MapArgs {
     /// Firings a revolution (default: found in each cloud from its azimuths).
     #[arg(long, requires = "from_bag")]
     pub columns: Option<usize>,
+    /// Build the map from this Velodyne capture (pcap or pcapng; HDL-32E, VLP-16): its full
+    /// revolutions, the sensor standing at `--pose`.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["from_bag", "record"])]
+    pub pcap: Option<PathBuf>,
+    /// Where the sensor stands, `x,y,yaw` (metres, metres, degrees; azimuth 0 along the yaw).
+    #[arg(
+        long,
+        value_name = "X,Y,YAW",
+        default_value = "0,0,0",
+        requires = "pcap"
+    )]
+    pub pose: String,
+    /// The sensor's height above the ground, metres (default: found from the ground returns).
+    #[arg(long, value_name = "M", requires = "pcap")]
+    pub sensor_height: Option<f64>,
+}
+
+/// `--pose x,y,yaw_deg` read.
+pub(crate) fn parse_pose(text: &str) -> anyhow::Result<nalgebra::Isometry2<f64>> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|w| w.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| {
+            anyhow::anyhow!("--pose {text}: {e} (want x,y,yaw: metres, metres, degrees)")
+        })?;
+    anyhow::ensure!(
+        v.len() == 3 && v.iter().all(|x| x.is_finite()),
+        "--pose {text}: want three finite numbers x,y,yaw (metres, metres, degrees)"
+    );
+    Ok(nalgebra::Isometry2::new(
+        nalgebra::Vector2::new(v[0], v[1]),
+        v[2].to_radians(),
+    ))
+}
+
+/// `--pcap`.
+fn from_pcap(
+    args: &MapArgs,
+    pcap: &std::path::Path,
+    scenario: &Scenario,
+    config: &RunConfig,
+) -> anyhow::Result<()> {
+    let pose = parse_pose(&args.pose)?;
+    if let Some(h) = args.sensor_height {
+        anyhow::ensure!(
+            h.is_finite() && h > 0.0,
+            "--sensor-height {h}: a height above the ground, metres"
+        );
+    }
+    let dir = args.out.clone().unwrap_or_else(|| {
+        let stem = pcap
+            .file_stem()
+            .map_or_else(|| "pcap".into(), |s| s.to_string_lossy().into_owned());
+        PathBuf::from("out")
+            .join("maps")
+            .join(format!("{stem}-pcap"))
+    });
+    let levels = levels_of(scenario, config)?;
+    let progress = crate::bar(0, "mapping the capture");
+    let report = sim::pcap::map_from_pcap(
+        pcap,
+        &pose,
+        args.sensor_height,
+        &levels,
+        map_config(config),
+        &dir,
+        &mut |done, total| {
+            progress.set_length(total);
+            progress.set_position(done);
+        },
+    )
+    .with_context(|| format!("taxi-sim map --pcap {}", pcap.display()))?;
+    progress.finish_and_clear();
+    let m = &report.manifest;
+    let (h, found) = report.height_m;
+    crate::emit(&format!(
+        "{}: mapped {} revolutions, the sensor {h:.2} m above the ground ({}), into {} blocks; occupied cells per level {:?} (levels at {:?} m)\nwrote {}\n",
+        pcap.display(),
+        report.revolutions,
+        if found {
+            "found from the ground returns"
+        } else {
+            "as given"
+        },
+        m.blocks,
+        m.occupied_cells,
+        m.level_heights_m,
+        dir.display()
+    ))
 }
 
 pub(crate) fn build_map(
@@ -177,6 +267,9 @@ pub fn run(args: &MapArgs) -> anyhow::Result<()> {
     let config = RunConfig::for_scenario(&scenario, args.config.as_deref())?;
     if let Some(bag) = &args.from_bag {
         return from_bag(args, bag, &scenario, &config);
+    }
+    if let Some(pcap) = &args.pcap {
+        return from_pcap(args, pcap, &scenario, &config);
     }
     let dir = args
         .out

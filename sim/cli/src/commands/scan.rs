@@ -1,4 +1,5 @@
-//! `taxi-sim scan`: one LiDAR revolution of a scenario's world from a point of its route, as PLY.
+//! `taxi-sim scan`: one LiDAR revolution of a scenario's world from a point of its route, or one
+//! revolution of a real Velodyne capture, as PLY.
 
 use std::path::PathBuf;
 
@@ -12,8 +13,28 @@ use sim::world::{Lidar, SweepPoses};
 /// Arguments of `taxi-sim scan`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct ScanArgs {
-    /// The scenario file.
-    pub scenario: PathBuf,
+    /// The scenario file (not with `--pcap`).
+    #[arg(required_unless_present = "pcap", conflicts_with = "pcap")]
+    pub scenario: Option<PathBuf>,
+    /// A Velodyne capture (pcap or pcapng; HDL-32E, VLP-16) to take the revolution from.
+    #[arg(long, value_name = "FILE")]
+    pub pcap: Option<PathBuf>,
+    /// The capture's revolution (VeloView's frame numbering: 0 is the partial first).
+    #[arg(long, default_value_t = 1, requires = "pcap")]
+    pub revolution: usize,
+    /// Where the capture's sensor stands, `x,y,yaw` (metres, metres, degrees), for `--frame
+    /// world`.
+    #[arg(
+        long,
+        value_name = "X,Y,YAW",
+        default_value = "0,0,0",
+        requires = "pcap"
+    )]
+    pub pose: String,
+    /// The capture's sensor height above the ground, metres, for `--frame world` (default:
+    /// found from the ground returns).
+    #[arg(long, value_name = "M", requires = "pcap")]
+    pub sensor_height: Option<f64>,
     /// Where on the route, metres along it from its first point (0 = the start pose).
     #[arg(long, default_value_t = 0.0)]
     pub at: f64,
@@ -51,7 +72,13 @@ impl From<Frame> for sim::world::ply::Frame {
 
 /// Runs `taxi-sim scan`.
 pub fn run(args: &ScanArgs) -> anyhow::Result<()> {
-    let scenario = Scenario::from_file(&args.scenario)?;
+    if let Some(pcap) = &args.pcap {
+        return from_pcap(args, pcap);
+    }
+    let Some(path) = &args.scenario else {
+        anyhow::bail!("a scenario file or --pcap FILE");
+    };
+    let scenario = Scenario::from_file(path)?;
     anyhow::ensure!(
         args.at.is_finite() && args.at >= 0.0,
         "--at {}: must be a distance >= 0 along the route",
@@ -109,4 +136,43 @@ fn pose_along(scenario: &Scenario, s: f64) -> anyhow::Result<Isometry2<f64>> {
         left -= len;
     }
     anyhow::bail!("--at {s}: the route is only {:.1} m long", route.length_m())
+}
+
+/// `--pcap`: one revolution of a capture.
+fn from_pcap(args: &ScanArgs, pcap: &std::path::Path) -> anyhow::Result<()> {
+    let recording = sim::pcap::read(pcap)?;
+    let n = recording.frames.len();
+    let frame = recording.frames.get(args.revolution).ok_or_else(|| {
+        anyhow::anyhow!(
+            "--revolution {}: {} has {n} (0 to {})",
+            args.revolution,
+            pcap.display(),
+            n.saturating_sub(1)
+        )
+    })?;
+    let pose = crate::commands::map::parse_pose(&args.pose)?;
+    let (height, how) = match args.sensor_height {
+        Some(h) => (h, "as given"),
+        None => (
+            recording.ground_height_below_sensor_m(frame).unwrap_or(0.0),
+            "found from the ground returns",
+        ),
+    };
+    let scan = recording.scan(frame, &pose, height)?;
+    sim::world::ply::write(&scan, args.frame.into(), &args.out)
+        .with_context(|| format!("writing {}", args.out.display()))?;
+    let partial = if args.revolution == 0 || args.revolution + 1 == n {
+        " (partial: the capture starts or ends inside it)"
+    } else {
+        ""
+    };
+    crate::emit(&format!(
+        "{}: revolution {} of {n}{partial}: {} returns in {} firings of {} lasers, the sensor {height:.2} m above the ground ({how}); wrote {}\n",
+        pcap.display(),
+        args.revolution,
+        frame.points.len(),
+        scan.scan.columns().len(),
+        scan.scan.beams(),
+        args.out.display()
+    ))
 }
