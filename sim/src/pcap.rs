@@ -4,13 +4,16 @@
 //! as the mapping drive writes its map.
 //!
 //! The sensor stands at a pose the user gives (a standing recording; a moving one needs poses,
-//! not read yet), at a height the user gives or that the ground says: the most common height of
-//! the returns of the lasers aimed 10 degrees or more below the horizon.
+//! not read yet), at a height the user gives or that the ground says ([`Ground`]: a plane fitted
+//! to the returns of the lasers aimed 8 degrees or more down), level or - asked to - with the
+//! tilt that plane shows removed (a mount's pitch and roll).
 
 use std::path::Path;
 
 use mapper::{Levels, MapConfig, MultiHeightMap};
-use nalgebra::{Isometry2, Isometry3, Point2, Translation3, UnitQuaternion};
+use nalgebra::{
+    Isometry2, Isometry3, Matrix3, Point2, Point3, Translation3, UnitQuaternion, Vector3,
+};
 use velodyne::{Calibration, Capture, Frame};
 
 use crate::error::{Error, Result};
@@ -52,36 +55,38 @@ impl Recording {
         if n > 2 { &self.frames[1..n - 1] } else { &[] }
     }
 
-    /// The sensor's height above the ground, from revolution `frame`: the most common height
-    /// (5-cm bins) of the returns of lasers aimed 10 degrees or more below the horizon, within
-    /// 30 m. `None` when there are fewer than 100 such returns.
-    pub fn ground_height_below_sensor_m(&self, frame: &Frame) -> Option<f64> {
-        let mut bins = std::collections::HashMap::<i64, usize>::new();
-        let mut n = 0;
-        for p in &frame.points {
-            let low = self
-                .calibration
+    /// The ground under the sensor ([`Ground::fit`]) from the returns of `frames` of the lasers
+    /// aimed 8 degrees or more down.
+    pub fn ground(&self, frames: &[Frame]) -> Option<Ground> {
+        let low = |laser: u8| {
+            self.calibration
                 .vertical_deg
-                .get(usize::from(p.laser))
-                .is_some_and(|&w| w <= -10.0);
-            if low && p.distance_m < 30.0 {
-                *bins
-                    .entry((f64::from(p.xyz_m[2]) / 0.05).floor() as i64)
-                    .or_default() += 1;
-                n += 1;
-            }
-        }
-        if n < 100 {
-            return None;
-        }
-        let (bin, _) = bins.into_iter().max_by_key(|&(b, c)| (c, -b))?;
-        Some(-(bin as f64 + 0.5) * 0.05)
+                .get(usize::from(laser))
+                .is_some_and(|&w| w <= -8.0)
+        };
+        let points: Vec<Point3<f64>> = frames
+            .iter()
+            .flat_map(|f| &f.points)
+            .filter(|p| low(p.laser))
+            .map(|p| {
+                // VeloView's frame to the simulator's sensor frame (x forward, y left).
+                let [x, y, z] = p.xyz_m.map(f64::from);
+                Point3::new(y, -x, z)
+            })
+            .collect();
+        Ground::fit(&points)
     }
 
-    /// Revolution `frame` as the simulator's LiDAR scan, the sensor `height_m` above the ground
-    /// at `pose` (azimuth 0 along its heading).
-    pub fn scan(&self, frame: &Frame, pose: &Isometry2<f64>, height_m: f64) -> Result<LidarScan> {
-        let s = velodyne::to_scan(frame, &self.calibration, &sensor_pose(pose, height_m), pose)
+    /// Revolution `frame` as the simulator's LiDAR scan, the sensor at `vehicle_from_sensor`
+    /// (its height and attitude) on a vehicle at `pose` (azimuth 0 along its heading).
+    pub fn scan(
+        &self,
+        frame: &Frame,
+        pose: &Isometry2<f64>,
+        vehicle_from_sensor: &Isometry3<f64>,
+    ) -> Result<LidarScan> {
+        let world_from_sensor = crate::world::planar_to_3d(pose) * vehicle_from_sensor;
+        let s = velodyne::to_scan(frame, &self.calibration, &world_from_sensor, pose)
             .map_err(Error::Invalid)?;
         let n = s.scan.returns().len();
         Ok(LidarScan {
@@ -92,12 +97,15 @@ impl Recording {
     }
 }
 
-/// The sensor's pose in the world: at `pose`, `height_m` up, facing its heading.
-pub fn sensor_pose(pose: &Isometry2<f64>, height_m: f64) -> Isometry3<f64> {
-    Isometry3::from_parts(
-        Translation3::new(pose.translation.x, pose.translation.y, height_m),
-        UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), pose.rotation.angle()),
-    )
+/// How `map --pcap` places the sensor.
+#[derive(Clone, Copy, Debug)]
+pub struct Placement {
+    /// Where the sensor stands (azimuth 0 along the heading).
+    pub pose: Isometry2<f64>,
+    /// Its height above the ground, metres (`None`: the fitted ground's).
+    pub height_m: Option<f64>,
+    /// Remove the tilt fitted to the ground (the mount's pitch and roll); else level.
+    pub level: bool,
 }
 
 /// What `map --pcap` built.
@@ -106,16 +114,17 @@ pub struct PcapMapReport {
     pub manifest: MapManifest,
     /// Revolutions inserted (the full ones).
     pub revolutions: usize,
-    /// The sensor's height used, metres, and whether it came from the ground.
-    pub height_m: (f64, bool),
+    /// The ground fitted to the full revolutions.
+    pub ground: Ground,
+    /// The sensor on the vehicle as mapped: its height and attitude.
+    pub vehicle_from_sensor: Isometry3<f64>,
 }
 
 /// Builds the offline map of `levels` from the capture at `pcap` (its full revolutions, the
-/// sensor standing at `pose`, `height_m` up or as the ground says) into `out`.
+/// sensor placed by `placement`) into `out`.
 pub fn map_from_pcap(
     pcap: &Path,
-    pose: &Isometry2<f64>,
-    height_m: Option<f64>,
+    placement: &Placement,
     levels: &Levels,
     config: MapConfig,
     out: &Path,
@@ -123,35 +132,34 @@ pub fn map_from_pcap(
 ) -> Result<PcapMapReport> {
     let recording = read(pcap)?;
     let full = recording.full();
-    let Some(first) = full.first() else {
+    if full.is_empty() {
         return Err(Error::Invalid(format!(
             "{}: no full revolution ({} partial)",
             pcap.display(),
             recording.frames.len()
         )));
+    }
+    let ground = recording.ground(full).ok_or_else(|| {
+        Error::Invalid(format!(
+            "{}: too few ground returns to fit the ground under the sensor",
+            pcap.display()
+        ))
+    })?;
+    let mut vehicle_from_sensor = if placement.level {
+        ground.sensor_above_level_ground()
+    } else {
+        Isometry3::translation(0.0, 0.0, ground.height_m())
     };
-    let height = match height_m {
-        Some(h) => (h, false),
-        None => (
-            recording
-                .ground_height_below_sensor_m(first)
-                .ok_or_else(|| {
-                    Error::Invalid(format!(
-                        "{}: too few ground returns to find the sensor's height; give \
-                     --sensor-height",
-                        pcap.display()
-                    ))
-                })?,
-            true,
-        ),
-    };
+    if let Some(h) = placement.height_m {
+        vehicle_from_sensor.translation.vector.z = h;
+    }
     let blocks_dir = out.join("blocks");
     crate::offline_map::clear_blocks(&blocks_dir)?;
-    let center = Point2::from(pose.translation.vector);
+    let center = Point2::from(placement.pose.translation.vector);
     let mut map =
         MultiHeightMap::with_stores(config, levels.clone(), center, None, Some(&blocks_dir))?;
     for (i, frame) in full.iter().enumerate() {
-        let scan = recording.scan(frame, pose, height.0)?;
+        let scan = recording.scan(frame, &placement.pose, &vehicle_from_sensor)?;
         map.insert_scan(&scan.scan, None)?;
         progress(i as u64 + 1, full.len() as u64);
     }
@@ -170,6 +178,104 @@ pub fn map_from_pcap(
     Ok(PcapMapReport {
         manifest,
         revolutions: full.len(),
-        height_m: height,
+        ground,
+        vehicle_from_sensor,
+    })
+}
+
+/// The ground under a sensor: the plane `z = a x + b y + c` in the sensor's frame fitted to
+/// returns of the ground, and their spread about it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ground {
+    /// The plane's slope along x.
+    pub a: f64,
+    /// The plane's slope along y.
+    pub b: f64,
+    /// The plane's height at the sensor, metres (minus the sensor's height).
+    pub c: f64,
+    /// Standard deviation of the fitted returns about the plane, metres.
+    pub spread_m: f64,
+}
+
+impl Ground {
+    /// The ground fitted to `points` (in the sensor frame; those 4-30 m away horizontally
+    /// count): a least-squares plane through those within 0.25 m of their most common height
+    /// (5-cm bins), refitted to those within 0.15 m of the first. `None` below 50 points.
+    pub fn fit(points: &[Point3<f64>]) -> Option<Ground> {
+        let near: Vec<Point3<f64>> = points
+            .iter()
+            .copied()
+            .filter(|p| (4.0..30.0).contains(&p.coords.xy().norm()))
+            .collect();
+        let mut bins = std::collections::HashMap::<i64, usize>::new();
+        for p in &near {
+            *bins.entry((p.z / 0.05).floor() as i64).or_default() += 1;
+        }
+        let (mode, _) = bins.into_iter().max_by_key(|&(b, c)| (c, -b))?;
+        let mode_z = (mode as f64 + 0.5) * 0.05;
+        let band: Vec<Point3<f64>> = near
+            .into_iter()
+            .filter(|p| (p.z - mode_z).abs() < 0.25)
+            .collect();
+        let first = fit_plane(&band)?;
+        let inliers: Vec<Point3<f64>> = band
+            .into_iter()
+            .filter(|p| (p.z - first.z_at(p)).abs() < 0.15)
+            .collect();
+        let plane = fit_plane(&inliers)?;
+        let spread = (inliers
+            .iter()
+            .map(|p| (p.z - plane.z_at(p)).powi(2))
+            .sum::<f64>()
+            / inliers.len() as f64)
+            .sqrt();
+        Some(Ground {
+            spread_m: spread,
+            ..plane
+        })
+    }
+
+    /// The plane's height at `p`'s x, y.
+    pub fn z_at(&self, p: &Point3<f64>) -> f64 {
+        self.a * p.x + self.b * p.y + self.c
+    }
+
+    /// The sensor's height above the ground under it, metres.
+    pub fn height_m(&self) -> f64 {
+        -self.c
+    }
+
+    /// The sensor's pitch (nose up positive) and roll (right side down positive), degrees.
+    pub fn pitch_roll_deg(&self) -> [f64; 2] {
+        [-self.a.atan().to_degrees(), -self.b.atan().to_degrees()]
+    }
+
+    /// The sensor's pose over this ground made level at z = 0: its height, and the tilt that
+    /// turns the ground's normal up.
+    pub fn sensor_above_level_ground(&self) -> Isometry3<f64> {
+        let normal = Vector3::new(-self.a, -self.b, 1.0).normalize();
+        let rotation = UnitQuaternion::rotation_between(&normal, &Vector3::z()).unwrap_or_default();
+        Isometry3::from_parts(Translation3::new(0.0, 0.0, self.height_m()), rotation)
+    }
+}
+
+/// The least-squares plane through `points` (at least 50).
+fn fit_plane(points: &[Point3<f64>]) -> Option<Ground> {
+    if points.len() < 50 {
+        return None;
+    }
+    let mut m = Matrix3::zeros();
+    let mut v = Vector3::zeros();
+    for p in points {
+        let row = Vector3::new(p.x, p.y, 1.0);
+        m += row * row.transpose();
+        v += row * p.z;
+    }
+    let s = m.lu().solve(&v)?;
+    Some(Ground {
+        a: s.x,
+        b: s.y,
+        c: s.z,
+        spread_m: 0.0,
     })
 }

@@ -35,8 +35,10 @@ enum Command {
     Map(commands::map::MapArgs),
     /// Validate a scenario file and print a summary.
     Check(commands::check::CheckArgs),
-    /// Write one LiDAR revolution of a scenario's world as PLY.
+    /// Write one LiDAR revolution of a scenario's world, or of a Velodyne capture, as PLY.
     Scan(commands::scan::ScanArgs),
+    /// A real Velodyne capture's figures against the simulator's HDL-32E at the same height.
+    CompareLidar(commands::compare_lidar::CompareLidarArgs),
     /// Vehicle collision models.
     #[command(subcommand)]
     Model(ModelCommand),
@@ -126,6 +128,7 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
         Command::Model(ModelCommand::Fit(args)) => commands::model::run(&args),
         Command::Model(ModelCommand::Levels(args)) => commands::model::levels(&args),
         Command::SmallObstacles(args) => commands::small::run(&args),
+        Command::CompareLidar(args) => commands::compare_lidar::run(&args),
         Command::Check(args) => commands::check::run(&args),
         Command::Map(args) => commands::map::run(&args),
         Command::Run(_) | Command::Campaign(_) | Command::Tune(_) => {

@@ -14,13 +14,18 @@ use velodyne::{Calibration, DataPacket, Product, ReturnMode};
 const HEIGHT_M: f64 = 2.0;
 const WALL_M: f64 = 15.0;
 
-/// The distance laser `j` at azimuth `a_cdeg` measures: the wall (ahead, within 20 degrees) or
-/// the ground, whichever is nearer; no echo beyond 100 m.
-fn distance_m(w_deg: f64, a_cdeg: u16) -> Option<f64> {
+/// The distance laser at elevation `w_deg` measures at azimuth `a_cdeg` from a sensor pitched
+/// `pitch_deg` nose up: the wall (when there is one: ahead, within 20 degrees) or the ground,
+/// whichever is nearer; no echo beyond 100 m.
+fn distance_m(w_deg: f64, a_cdeg: u16, pitch_deg: f64, wall: bool) -> Option<f64> {
     let (w, a) = (w_deg.to_radians(), (f64::from(a_cdeg) * 0.01).to_radians());
-    let ground = (w < 0.0).then(|| HEIGHT_M / (-w).sin());
+    // The direction in the simulator's sensor frame (x forward, y left), then pitched.
+    let (x, z) = (w.cos() * a.cos(), w.sin());
+    let t = pitch_deg.to_radians();
+    let down = -(x * t.sin() + z * t.cos());
+    let ground = (down > 0.0).then(|| HEIGHT_M / down);
     let ahead = a.cos();
-    let wall = (ahead > 20f64.to_radians().cos()).then(|| WALL_M / (w.cos() * ahead));
+    let wall = (wall && ahead > 20f64.to_radians().cos()).then(|| WALL_M / (w.cos() * ahead));
     let d = match (ground, wall) {
         (Some(g), Some(v)) => g.min(v),
         (g, v) => g.or(v)?,
@@ -28,8 +33,14 @@ fn distance_m(w_deg: f64, a_cdeg: u16) -> Option<f64> {
     (d < 100.0).then_some(d)
 }
 
-/// Three revolutions and a bit of the scene, 1800 firings each, as a pcap's bytes.
+/// Three revolutions and a bit of the scene (a level sensor, a wall ahead), 1800 firings each,
+/// as a pcap's bytes.
 fn capture() -> Vec<u8> {
+    capture_of(0.0, true)
+}
+
+/// The same, the sensor pitched `pitch_deg` nose up, with or without the wall.
+fn capture_of(pitch_deg: f64, wall: bool) -> Vec<u8> {
     let table = Calibration::built_in(Product::Hdl32e).unwrap();
     let firings = 1800 * 3 + 600;
     let mut datagrams = Vec::new();
@@ -38,7 +49,7 @@ fn capture() -> Vec<u8> {
             let a = (((p * 12 + k) % 1800) * 20) as u16;
             let mut channels = [(0u16, 0u8); CHANNELS];
             for (j, c) in channels.iter_mut().enumerate() {
-                if let Some(d) = distance_m(table.vertical_deg[j], a) {
+                if let Some(d) = distance_m(table.vertical_deg[j], a, pitch_deg, wall) {
                     *c = ((d / 0.002).round() as u16, 40);
                 }
             }
@@ -59,7 +70,7 @@ fn capture() -> Vec<u8> {
 }
 
 /// The capture's revolutions are cut where the azimuth wraps; the sensor's height is found from
-/// the ground returns to the 5-cm bin; a revolution as a scan holds every return, the wall's
+/// the ground fitted to its returns, to 2 mm; a revolution as a scan holds every return, the wall's
 /// 15 m ahead of the pose along its heading.
 #[test]
 fn a_built_capture_reads_as_revolutions_at_the_sensors_height() {
@@ -68,11 +79,12 @@ fn a_built_capture_reads_as_revolutions_at_the_sensors_height() {
     std::fs::write(&file, capture()).unwrap();
     let r = sim::pcap::read(&file).unwrap();
     assert_eq!((r.frames.len(), r.full().len()), (4, 2));
-    let h = r.ground_height_below_sensor_m(&r.full()[0]).unwrap();
-    assert!((h - HEIGHT_M).abs() <= 0.05, "{h}");
+    let g = r.ground(&r.full()[..1]).unwrap();
+    assert!((g.height_m() - HEIGHT_M).abs() <= 0.002, "{g:?}");
     // Standing at (100, 50) facing north: the wall 15 m north.
     let pose = Isometry2::new(Vector2::new(100.0, 50.0), 90f64.to_radians());
-    let scan = r.scan(&r.full()[0], &pose, HEIGHT_M).unwrap();
+    let mount = nalgebra::Isometry3::translation(0.0, 0.0, HEIGHT_M);
+    let scan = r.scan(&r.full()[0], &pose, &mount).unwrap();
     assert_eq!(scan.scan.columns().len(), 1800);
     assert_eq!(
         scan.scan.returns().iter().flatten().count(),
@@ -109,10 +121,14 @@ fn a_built_capture_maps_its_wall_on_every_level() {
     let levels = sim::offline_map::levels_of(&s, &config).unwrap();
     let out = dir.path().join("map");
     let pose = Isometry2::new(Vector2::new(10.0, -5.0), 0.0);
+    let placement = sim::pcap::Placement {
+        pose,
+        height_m: None,
+        level: false,
+    };
     let report = sim::pcap::map_from_pcap(
         &file,
-        &pose,
-        None,
+        &placement,
         &levels,
         sim::offline_map::map_config(&config),
         &out,
@@ -120,7 +136,8 @@ fn a_built_capture_maps_its_wall_on_every_level() {
     )
     .unwrap();
     assert_eq!(report.revolutions, 2);
-    assert!((report.height_m.0 - HEIGHT_M).abs() <= 0.05 && report.height_m.1);
+    let h = report.vehicle_from_sensor.translation.vector.z;
+    assert!((h - HEIGHT_M).abs() <= 0.002, "{h}");
     for k in 0..levels.count() {
         let grid = read_ros_map(&out.join(format!("level{k}.yaml"))).unwrap();
         let at = |x: f64, y: f64| {
@@ -137,4 +154,136 @@ fn a_built_capture_maps_its_wall_on_every_level() {
         }
         assert_eq!(at(18.0, -5.0), Trinary::Free, "level {k}");
     }
+}
+
+/// `compare-lidar`'s figures on built captures: a level sensor 2 m up is found level at 2 m, its
+/// flat ground never an obstacle; pitched 2 degrees nose up, the fit finds the pitch, the
+/// ground behind it (higher than a level sensor expects) is taken for obstacles, and with the
+/// fitted tilt removed none is.
+#[test]
+fn the_ground_fit_finds_a_sensors_height_and_tilt() {
+    let dir = tempfile::tempdir().unwrap();
+    let test = RunConfig::default().mapping.map.obstacle_test;
+    let figures = |pitch: f64| {
+        let file = dir.path().join(format!("pitch{pitch}.pcap"));
+        std::fs::write(&file, capture_of(pitch, false)).unwrap();
+        let r = sim::pcap::read(&file).unwrap();
+        sim::studies::lidar_compare::real(&r, "built", test).unwrap()
+    };
+    let level = figures(0.0);
+    assert!((level.height_m - HEIGHT_M).abs() < 0.005, "{level:?}");
+    assert!(
+        level.pitch_roll_deg.iter().all(|a| a.abs() < 0.02),
+        "{level:?}"
+    );
+    assert_eq!(level.false_obstacles_per_revolution, [0.0, 0.0, 0.0]);
+    // 2-mm range steps: the ground's spread about the plane is under a millimetre.
+    assert!(
+        level.ground_spread_m < 0.001 && level.range_noise_m < 0.002,
+        "{level:?}"
+    );
+    let pitched = figures(2.0);
+    assert!(
+        (pitched.pitch_roll_deg[0] - 2.0).abs() < 0.02,
+        "{pitched:?}"
+    );
+    assert!(pitched.pitch_roll_deg[1].abs() < 0.02, "{pitched:?}");
+    assert!((pitched.height_m - HEIGHT_M).abs() < 0.01, "{pitched:?}");
+    let [as_level, untilted, beam_pairs] = pitched.false_obstacles_per_revolution;
+    assert!(
+        as_level > 1000.0 && untilted == 0.0 && beam_pairs == 0.0,
+        "{pitched:?}"
+    );
+}
+
+/// The synthetic sensor over flat ground: level at the height asked, every low beam returning,
+/// the ground's spread about the plane its 2-cm range noise seen vertically (times the sine of
+/// each ground beam's elevation, root mean square), intensities its remission's.
+#[test]
+fn the_synthetic_sensors_figures_are_its_models() {
+    let config = RunConfig::default();
+    let f = sim::studies::lidar_compare::synthetic(
+        &config.lidar,
+        HEIGHT_M,
+        0.2,
+        3,
+        7,
+        config.mapping.map.obstacle_test,
+    )
+    .unwrap();
+    assert!((f.height_m - HEIGHT_M).abs() < 0.005, "{f:?}");
+    assert!(f.pitch_roll_deg.iter().all(|a| a.abs() < 0.05), "{f:?}");
+    let low: Vec<(f64, f64)> = f
+        .elevations_deg
+        .iter()
+        .zip(&f.no_return)
+        .filter(|(w, _)| **w <= -8.0)
+        .map(|(w, n)| (*w, *n))
+        .collect();
+    assert!(low.iter().all(|(_, n)| *n == 0.0), "{low:?}");
+    // The beams whose ground ring lies 4-30 m away, all with the same returns a revolution.
+    let sines: Vec<f64> = low
+        .iter()
+        .map(|(w, _)| w.to_radians())
+        .filter(|w| (4.0..30.0).contains(&(HEIGHT_M / (-w).tan())))
+        .map(|w| w.sin().powi(2))
+        .collect();
+    let expected =
+        config.lidar.noise_stddev_m * (sines.iter().sum::<f64>() / sines.len() as f64).sqrt();
+    assert!(
+        (f.ground_spread_m / expected - 1.0).abs() < 0.1,
+        "{} against {expected}",
+        f.ground_spread_m
+    );
+    // Along the beam, from one laser's consecutive firings: the configured range noise.
+    let noise = config.lidar.noise_stddev_m;
+    assert!(
+        (f.range_noise_m / noise - 1.0).abs() < 0.1,
+        "{} against {noise}",
+        f.range_noise_m
+    );
+    // Remission 0.2 attenuated over 4-30 m: 0.2 x exp(-0.004 d) x 255, about 45-50.
+    let d = &f.ground_intensity_deciles;
+    assert!(d[0] >= 44.0 && d[8] <= 51.0, "{d:?}");
+    assert_eq!(f.false_obstacles_per_revolution, [0.0, 0.0, 0.0]);
+}
+
+/// `map --pcap --level`: a sensor pitched 2 degrees nose up over flat, empty ground. Taken as
+/// level, the ground behind it seems to rise and is mapped as obstacles; with the fitted tilt
+/// removed, no cell is occupied.
+#[test]
+fn a_tilted_sensors_ground_is_clear_once_levelled() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("pitched.pcap");
+    std::fs::write(&file, capture_of(2.0, false)).unwrap();
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenarios/straight_cone_under_wing.toml");
+    let s = Scenario::from_file(&path).unwrap();
+    let config = RunConfig::default();
+    let levels = sim::offline_map::levels_of(&s, &config).unwrap();
+    let occupied = |level: bool| {
+        let placement = sim::pcap::Placement {
+            pose: Isometry2::identity(),
+            height_m: None,
+            level,
+        };
+        let out = dir.path().join(format!("map-{level}"));
+        let r = sim::pcap::map_from_pcap(
+            &file,
+            &placement,
+            &levels,
+            sim::offline_map::map_config(&config),
+            &out,
+            &mut |_, _| {},
+        )
+        .unwrap();
+        assert!(
+            (r.ground.pitch_roll_deg()[0] - 2.0).abs() < 0.02,
+            "{:?}",
+            r.ground
+        );
+        r.manifest.occupied_cells[0]
+    };
+    assert!(occupied(false) > 100);
+    assert_eq!(occupied(true), 0);
 }

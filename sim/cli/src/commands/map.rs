@@ -69,9 +69,13 @@ pub struct MapArgs {
         requires = "pcap"
     )]
     pub pose: String,
-    /// The sensor's height above the ground, metres (default: found from the ground returns).
+    /// The sensor's height above the ground, metres (default: the ground fitted to its returns).
     #[arg(long, value_name = "M", requires = "pcap")]
     pub sensor_height: Option<f64>,
+    /// Remove the sensor's tilt fitted to the ground (its mount's pitch and roll; `taxi-sim
+    /// compare-lidar` shows it); without it the sensor is taken as level.
+    #[arg(long, requires = "pcap")]
+    pub level: bool,
 }
 
 /// `--pose x,y,yaw_deg` read.
@@ -117,10 +121,14 @@ fn from_pcap(
     });
     let levels = levels_of(scenario, config)?;
     let progress = crate::bar(0, "mapping the capture");
+    let placement = sim::pcap::Placement {
+        pose,
+        height_m: args.sensor_height,
+        level: args.level,
+    };
     let report = sim::pcap::map_from_pcap(
         pcap,
-        &pose,
-        args.sensor_height,
+        &placement,
         &levels,
         map_config(config),
         &dir,
@@ -132,15 +140,21 @@ fn from_pcap(
     .with_context(|| format!("taxi-sim map --pcap {}", pcap.display()))?;
     progress.finish_and_clear();
     let m = &report.manifest;
-    let (h, found) = report.height_m;
+    let [pitch, roll] = report.ground.pitch_roll_deg();
+    let h = report.vehicle_from_sensor.translation.vector.z;
     crate::emit(&format!(
-        "{}: mapped {} revolutions, the sensor {h:.2} m above the ground ({}), into {} blocks; occupied cells per level {:?} (levels at {:?} m)\nwrote {}\n",
+        "{}: mapped {} revolutions, the sensor {h:.2} m above the ground ({}), the ground's tilt {pitch:.2} deg pitch, {roll:.2} deg roll ({}), into {} blocks; occupied cells per level {:?} (levels at {:?} m)\nwrote {}\n",
         pcap.display(),
         report.revolutions,
-        if found {
-            "found from the ground returns"
-        } else {
+        if args.sensor_height.is_some() {
             "as given"
+        } else {
+            "fitted to the ground"
+        },
+        if args.level {
+            "removed"
+        } else {
+            "kept: the sensor taken as level"
         },
         m.blocks,
         m.occupied_cells,

@@ -5,6 +5,7 @@ pub mod airport;
 pub mod bench;
 pub mod campaign;
 pub mod check;
+pub mod compare_lidar;
 pub mod demo;
 pub mod figures;
 pub mod map;

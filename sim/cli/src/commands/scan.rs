@@ -32,7 +32,7 @@ pub struct ScanArgs {
     )]
     pub pose: String,
     /// The capture's sensor height above the ground, metres, for `--frame world` (default:
-    /// found from the ground returns).
+    /// the ground fitted to its returns).
     #[arg(long, value_name = "M", requires = "pcap")]
     pub sensor_height: Option<f64>,
     /// Where on the route, metres along it from its first point (0 = the start pose).
@@ -154,11 +154,14 @@ fn from_pcap(args: &ScanArgs, pcap: &std::path::Path) -> anyhow::Result<()> {
     let (height, how) = match args.sensor_height {
         Some(h) => (h, "as given"),
         None => (
-            recording.ground_height_below_sensor_m(frame).unwrap_or(0.0),
-            "found from the ground returns",
+            recording
+                .ground(std::slice::from_ref(frame))
+                .map_or(0.0, |g| g.height_m()),
+            "fitted to the ground",
         ),
     };
-    let scan = recording.scan(frame, &pose, height)?;
+    let mount = nalgebra::Isometry3::translation(0.0, 0.0, height);
+    let scan = recording.scan(frame, &pose, &mount)?;
     sim::world::ply::write(&scan, args.frame.into(), &args.out)
         .with_context(|| format!("writing {}", args.out.display()))?;
     let partial = if args.revolution == 0 || args.revolution + 1 == n {

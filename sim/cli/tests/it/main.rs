@@ -24,6 +24,7 @@ mod campaign;
 mod cli;
 mod figures;
 mod hostile;
+mod pcap;
 mod replay;
 #[path = "../../../tests/it/smoke_campaign.rs"]
 mod smoke_campaign;

@@ -1,0 +1,110 @@
+//! `taxi-sim scan --pcap`, `map --pcap` and `compare-lidar` end to end on a capture built here:
+//! an HDL-32E standing 1.8 m above flat ground, two revolutions and a bit. Bad arguments exit 2
+//! with a message naming them.
+
+use velodyne::packet::{Block, CHANNELS};
+use velodyne::{Calibration, DataPacket, Product, ReturnMode};
+
+fn taxi_sim(args: &[&str]) -> (i32, String, String) {
+    crate::taxi_sim_in(std::path::Path::new(env!("CARGO_MANIFEST_DIR")), args)
+}
+
+/// The capture: each laser aimed down returns from the ground 1.8 m below, the rest nothing.
+fn capture(path: &std::path::Path) {
+    let table = Calibration::built_in(Product::Hdl32e).unwrap();
+    let datagrams: Vec<(f64, u16, Vec<u8>)> = (0..(1800 * 2 + 600) / 12)
+        .map(|p| {
+            let blocks = std::array::from_fn(|k| {
+                let mut channels = [(0u16, 0u8); CHANNELS];
+                for (j, c) in channels.iter_mut().enumerate() {
+                    let w = table.vertical_deg[j].to_radians();
+                    if w < -0.02 && 1.8 / (-w).sin() < 100.0 {
+                        *c = ((1.8 / (-w).sin() / 0.002).round() as u16, 30);
+                    }
+                }
+                Block {
+                    azimuth_cdeg: (((p * 12 + k) % 1800) * 20) as u16,
+                    channels,
+                }
+            });
+            let packet = DataPacket {
+                blocks,
+                timestamp_us: 553 * p as u32,
+                return_mode: ReturnMode::Strongest,
+                product: Product::Hdl32e,
+            };
+            (553e-6 * p as f64, 2368, packet.encode())
+        })
+        .collect();
+    std::fs::write(path, velodyne::pcap_bytes(&datagrams)).unwrap();
+}
+
+#[test]
+fn a_capture_scans_maps_and_compares() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("ground.pcap");
+    capture(&file);
+    let f = file.to_str().unwrap();
+    let ply = dir.path().join("rev1.ply");
+    let (code, out, err) = taxi_sim(&["scan", "--pcap", f, "--out", ply.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("revolution 1 of 3") && out.contains("1.80 m above the ground"),
+        "{out}"
+    );
+    assert!(std::fs::metadata(&ply).unwrap().len() > 1800 * 20);
+    let map = dir.path().join("map");
+    let scenario = "../../scenarios/straight_cone_under_wing.toml";
+    let (code, out, err) = taxi_sim(&[
+        "map",
+        scenario,
+        "--pcap",
+        f,
+        "--pose",
+        "5,5,90",
+        "--out",
+        map.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("mapped 1 revolutions"), "{out}");
+    assert!(map.join("level0.yaml").exists() && map.join("manifest.json").exists());
+    let (code, out, err) = taxi_sim(&["compare-lidar", "--pcap", f]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("| height above the fitted ground | 1.800 m |"),
+        "{out}"
+    );
+}
+
+#[test]
+fn bad_pcap_arguments_exit_2_naming_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("ground.pcap");
+    capture(&file);
+    let f = file.to_str().unwrap();
+    let out = dir.path().join("x.ply");
+    let (code, _, err) = taxi_sim(&[
+        "scan",
+        "--pcap",
+        f,
+        "--revolution",
+        "7",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("--revolution 7") && err.contains("has 3 (0 to 2)"),
+        "{err}"
+    );
+    let scenario = "../../scenarios/straight_cone_under_wing.toml";
+    let (code, _, err) = taxi_sim(&["map", scenario, "--pcap", f, "--pose", "1,2"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--pose 1,2"), "{err}");
+    let (code, _, err) = taxi_sim(&["compare-lidar", "--pcap", scenario]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("straight_cone_under_wing.toml") && err.contains("not a pcap"),
+        "{err}"
+    );
+}

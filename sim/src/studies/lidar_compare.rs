@@ -1,0 +1,306 @@
+//! The synthetic HDL-32E against a real one (`taxi-sim compare-lidar`): the same figures from a
+//! real capture's full revolutions and from the simulator's sensor at the same height over
+//! flat, empty ground.
+//!
+//! Ground returns: those of the lasers aimed 8 degrees or more down, 4-30 m away horizontally,
+//! within 0.25 m of the ground's most common height; a plane fitted to them by least squares,
+//! refitted to those within 0.15 m of the first fit. From it: the sensor's height, pitch and
+//! roll, and the spread of the returns about it (the range noise seen vertically). Per beam: the
+//! fraction of firings without a return, the ground ring's radius (the median horizontal range
+//! of its ground returns; a level sensor at height h puts it at h / tan|elevation|). The
+//! intensity of ground returns (0-255, the sensor's raw scale; the simulator's 0-1 times 255).
+//! And what the mapper's beam-pair obstacle test, with the run configuration's settings, makes
+//! of the ground: obstacle returns among ground returns per revolution - with the sensor taken
+//! as level (as `map --pcap` takes it), and with the fitted tilt removed.
+
+use mapper::occupancy::ObstacleTest;
+use mapper::{ObstacleTestParams, Scan};
+use nalgebra::{Isometry2, Isometry3, Point3};
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::pcap::{Ground, Recording};
+use crate::world::{Lidar, LidarConfig, Scene, SweepPoses, World};
+
+/// The figures of one sensor.
+#[derive(Clone, Debug, Serialize)]
+pub struct Figures {
+    /// Which sensor.
+    pub label: String,
+    /// Revolutions measured.
+    pub revolutions: usize,
+    /// Firings (columns) a revolution, mean.
+    pub firings_per_revolution: f64,
+    /// Returns a revolution, mean.
+    pub returns_per_revolution: f64,
+    /// Each beam's elevation, degrees, lowest first.
+    pub elevations_deg: Vec<f64>,
+    /// Each beam's fraction of firings without a return.
+    pub no_return: Vec<f64>,
+    /// Ground returns used, a revolution.
+    pub ground_returns_per_revolution: f64,
+    /// The fitted ground: the sensor's height above it, metres.
+    pub height_m: f64,
+    /// The sensor's pitch (nose up positive) and roll (right side down positive), degrees.
+    pub pitch_roll_deg: [f64; 2],
+    /// Standard deviation of the ground returns about the plane, metres (range noise seen
+    /// vertically, and the ground's own shape).
+    pub ground_spread_m: f64,
+    /// Range noise along the beam, metres: the spread of the range difference between one
+    /// laser's ground returns in consecutive firings (1.4826 x its median absolute deviation,
+    /// over the square root of 2) - blind to the ground's shape, which changes little in 0.2
+    /// degree.
+    pub range_noise_m: f64,
+    /// Each beam's ground ring radius, metres (`None`: too few ground returns).
+    pub ring_radius_m: Vec<Option<f64>>,
+    /// Deciles (10-90 %) of the ground returns' intensity, 0-255.
+    pub ground_intensity_deciles: Vec<f64>,
+    /// Ground returns the obstacle test calls obstacles, a revolution: the sensor taken as
+    /// level; with the fitted tilt removed; and with the tilt removed and no unsafe height (the
+    /// beam-pair test alone, as CARMEN's default of 1 m nearly is).
+    pub false_obstacles_per_revolution: [f64; 3],
+}
+
+/// A revolution's returns in the frame of a level sensor at the origin: `[beam]` per column,
+/// the point and its intensity 0-255.
+type Columns = Vec<Vec<Option<(Point3<f64>, f64)>>>;
+
+fn columns_of(scan: &Scan, world_from_sensor: &Isometry3<f64>, scale: f64) -> Columns {
+    let to_sensor = world_from_sensor.inverse();
+    scan.returns()
+        .chunks(scan.beams())
+        .map(|c| {
+            c.iter()
+                .map(|r| r.map(|r| (to_sensor * r.point_in_world, f64::from(r.intensity) * scale)))
+                .collect()
+        })
+        .collect()
+}
+
+/// The ground under the sensor ([`Ground::fit`]) from the low lasers' returns of `revs`.
+fn fit_ground(label: &str, low: &[bool], revs: &[Columns]) -> Result<Ground> {
+    let points: Vec<Point3<f64>> = revs
+        .iter()
+        .flatten()
+        .flat_map(|col| col.iter().enumerate())
+        .filter_map(|(b, r)| r.filter(|_| low[b]).map(|(p, _)| p))
+        .collect();
+    Ground::fit(&points).ok_or_else(|| Error::Invalid(format!("{label}: too few ground returns")))
+}
+
+/// The figures of revolutions `revs` (in the sensor frame, beams lowest first).
+fn figures(
+    label: &str,
+    elevations_deg: &[f64],
+    revs: &[Columns],
+    test: ObstacleTestParams,
+) -> Result<Figures> {
+    let beams = elevations_deg.len();
+    let low: Vec<bool> = elevations_deg.iter().map(|&w| w <= -8.0).collect();
+    let ground_fit = fit_ground(label, &low, revs)?;
+    let (plane, spread) = (ground_fit, ground_fit.spread_m);
+    let is_ground = |p: &Point3<f64>| {
+        (4.0..30.0).contains(&p.coords.xy().norm()) && (p.z - plane.z_at(p)).abs() < 0.15
+    };
+    let height_m = plane.height_m();
+    // Per beam: no returns, ring radii; ground intensities; false obstacles.
+    let mut firings = 0usize;
+    let mut missing = vec![0usize; beams];
+    let mut ring: Vec<Vec<f64>> = vec![Vec::new(); beams];
+    let mut intensities = Vec::new();
+    let mut returns = 0usize;
+    let mut ground = 0usize;
+    let mut false_obstacles = [0usize; 3];
+    let mut steps: Vec<f64> = Vec::new();
+    let level = Isometry3::translation(0.0, 0.0, height_m);
+    let untilted = plane.sensor_above_level_ground();
+    let tests = [
+        ObstacleTest::new(ObstacleTestParams {
+            ground_height_m: 0.0,
+            ..test
+        }),
+        ObstacleTest::new(ObstacleTestParams {
+            ground_height_m: 0.0,
+            unsafe_height_above_ground_m: None,
+            ..test
+        }),
+    ];
+    for rev in revs {
+        for pair in rev.windows(2) {
+            for (a, b) in pair[0]
+                .iter()
+                .zip(&pair[1])
+                .zip(&low)
+                .filter(|(_, l)| **l)
+                .map(|(x, _)| x)
+            {
+                if let (Some((a, _)), Some((b, _))) = (a, b)
+                    && is_ground(a)
+                    && is_ground(b)
+                {
+                    steps.push(b.coords.norm() - a.coords.norm());
+                }
+            }
+        }
+        for col in rev {
+            firings += 1;
+            for (b, r) in col.iter().enumerate() {
+                match r {
+                    None => missing[b] += 1,
+                    Some((p, i)) => {
+                        returns += 1;
+                        if low[b] && is_ground(p) {
+                            ground += 1;
+                            ring[b].push(p.coords.xy().norm());
+                            intensities.push(*i);
+                        }
+                    }
+                }
+            }
+            for (k, (frame, test)) in [(level, 0), (untilted, 0), (untilted, 1)]
+                .iter()
+                .enumerate()
+            {
+                false_obstacles[k] += ground_obstacles(col, frame, &tests[*test], &is_ground);
+            }
+        }
+    }
+    let n = revs.len().max(1) as f64;
+    intensities.sort_by(f64::total_cmp);
+    let decile = |q: f64| {
+        intensities
+            .get(((intensities.len() as f64 - 1.0) * q).round() as usize)
+            .copied()
+            .unwrap_or(f64::NAN)
+    };
+    Ok(Figures {
+        label: label.to_string(),
+        revolutions: revs.len(),
+        firings_per_revolution: firings as f64 / n,
+        returns_per_revolution: returns as f64 / n,
+        elevations_deg: elevations_deg.to_vec(),
+        no_return: missing
+            .iter()
+            .map(|&m| m as f64 / firings.max(1) as f64)
+            .collect(),
+        ground_returns_per_revolution: ground as f64 / n,
+        height_m,
+        pitch_roll_deg: plane.pitch_roll_deg(),
+        ground_spread_m: spread,
+        range_noise_m: robust_std(&mut steps) / 2f64.sqrt(),
+        ring_radius_m: ring
+            .into_iter()
+            .map(|mut v| {
+                (v.len() >= 20).then(|| {
+                    v.sort_by(f64::total_cmp);
+                    v[v.len() / 2]
+                })
+            })
+            .collect(),
+        ground_intensity_deciles: (1..10).map(|k| decile(k as f64 / 10.0)).collect(),
+        false_obstacles_per_revolution: false_obstacles.map(|f| f as f64 / n),
+    })
+}
+
+/// How many of a column's ground returns the obstacle test calls obstacles, its points moved by
+/// `world_from_sensor` (the beam below each one as the mapper pairs them: the previous beam with
+/// a return, none after a beam without).
+fn ground_obstacles(
+    col: &[Option<(Point3<f64>, f64)>],
+    world_from_sensor: &Isometry3<f64>,
+    test: &ObstacleTest,
+    is_ground: &dyn Fn(&Point3<f64>) -> bool,
+) -> usize {
+    let sensor = Point3::from(world_from_sensor.translation.vector);
+    let mut below: Option<(Point3<f64>, f64)> = None;
+    let mut n = 0;
+    for r in col {
+        let Some((p, _)) = r else {
+            below = None;
+            continue;
+        };
+        let w = world_from_sensor * p;
+        let range = (w.coords.xy() - sensor.coords.xy()).norm();
+        let obstacle = match below {
+            Some((lower, lower_range)) => test.is_obstacle(&sensor, &lower, lower_range, &w, range),
+            None => false,
+        };
+        if obstacle && is_ground(p) {
+            n += 1;
+        }
+        below = Some((w, range));
+    }
+    n
+}
+
+/// 1.4826 times the median absolute deviation of `v` (the standard deviation of a normal
+/// spread, unmoved by a few outliers); 0 for an empty `v`.
+fn robust_std(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    let median = v[v.len() / 2];
+    let mut dev: Vec<f64> = v.iter().map(|x| (x - median).abs()).collect();
+    dev.sort_by(f64::total_cmp);
+    1.4826 * dev[dev.len() / 2]
+}
+
+/// The real sensor's figures from `recording`'s full revolutions.
+pub fn real(recording: &Recording, label: &str, test: ObstacleTestParams) -> Result<Figures> {
+    let order = velodyne::scan::beams(&recording.calibration);
+    let mut elevations = vec![0.0; order.len()];
+    for (laser, &beam) in order.iter().enumerate() {
+        elevations[beam] = recording.calibration.vertical_deg[laser];
+    }
+    let revs = recording
+        .full()
+        .iter()
+        .map(|f| {
+            let s = recording.scan(f, &Isometry2::identity(), &Isometry3::identity())?;
+            Ok(columns_of(&s.scan, &Isometry3::identity(), 255.0))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    figures(label, &elevations, &revs, test)
+}
+
+/// The simulator's sensor (`config`) `height_m` above flat, empty ground of `remission`: the
+/// figures of `revolutions` revolutions.
+pub fn synthetic(
+    config: &LidarConfig,
+    height_m: f64,
+    remission: f32,
+    revolutions: usize,
+    seed: u64,
+    test: ObstacleTestParams,
+) -> Result<Figures> {
+    let vehicle =
+        aircraft::Vehicle::shipped("iara_car").map_err(|e| Error::Invalid(e.to_string()))?;
+    let scene = Scene {
+        min_m: [-150.0, -150.0],
+        max_m: [150.0, 150.0],
+        ground_remission: remission,
+        pavement_texture: 0.0,
+        solids: Vec::new(),
+        patches: Vec::new(),
+        areas: Vec::new(),
+    };
+    let pose = Isometry2::identity();
+    let world = World::static_only(&scene, &vehicle, &pose);
+    let mount = Isometry3::translation(0.0, 0.0, height_m);
+    let lidar = Lidar::new(config.clone(), mount).map_err(Error::Invalid)?;
+    let revs: Vec<Columns> = (0..revolutions as u64)
+        .map(|i| {
+            let s = lidar.scan(&world, &SweepPoses::still(pose), i, seed);
+            columns_of(&s.scan, &mount, 255.0)
+        })
+        .collect();
+    let n = config.channels;
+    let elevations: Vec<f64> = (0..n)
+        .map(|b| {
+            config.lower_fov_deg
+                + b as f64 / (n - 1).max(1) as f64 * (config.upper_fov_deg - config.lower_fov_deg)
+        })
+        .collect();
+    figures("synthetic HDL-32E", &elevations, &revs, test)
+}
