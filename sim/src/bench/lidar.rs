@@ -141,5 +141,59 @@ pub fn lidar_figures(samples: usize, progress: &mut dyn FnMut(&str)) -> crate::R
         "ms",
         Some("<= 10 ms, >= 3x generic"),
     );
-    Ok(vec![against(fast, &generic), generic])
+    progress("decoding packets");
+    let decode = decoder_figure(samples)?;
+    Ok(vec![against(fast, &generic), generic, decode])
+}
+
+/// The Velodyne decoder: one HDL-32E revolution's packets (1843 firings in 154 packets, every
+/// channel returning) decoded from their bytes, cut and made the mapper's scan - against the
+/// sensor's own 10 revolutions a second.
+fn decoder_figure(samples: usize) -> crate::Result<Figure> {
+    use velodyne::packet::Block;
+    let payloads: Vec<Vec<u8>> = (0..154u32)
+        .map(|p| {
+            let blocks = std::array::from_fn(|k| Block {
+                azimuth_cdeg: ((p * 12 + k as u32) * 36000 / 1848) as u16,
+                channels: std::array::from_fn(|j| ((2000 + 150 * j) as u16, j as u8)),
+            });
+            velodyne::DataPacket {
+                blocks,
+                timestamp_us: 553 * p,
+                return_mode: velodyne::ReturnMode::Strongest,
+                product: velodyne::Product::Hdl32e,
+            }
+            .encode()
+        })
+        .collect();
+    let calibration = velodyne::Calibration::built_in(velodyne::Product::Hdl32e)
+        .ok_or_else(|| crate::Error::Invalid("no HDL-32E table".into()))?;
+    let mount = nalgebra::Isometry3::translation(0.0, 0.0, 2.0);
+    let pose = nalgebra::Isometry2::identity();
+    let mut failure = None;
+    let seconds = median_seconds(samples, 1, || {
+        let packets: Result<Vec<_>, String> = payloads
+            .iter()
+            .map(|b| velodyne::DataPacket::decode(b))
+            .collect();
+        let outcome = packets.and_then(|p| {
+            let frames = velodyne::frames(&p, &calibration);
+            velodyne::to_scan(&frames[0], &calibration, &mount, &pose)
+        });
+        match outcome {
+            Ok(scan) => {
+                black_box(scan);
+            }
+            Err(e) => failure = Some(e),
+        }
+    });
+    if let Some(e) = failure {
+        return Err(crate::Error::Invalid(format!("decoder benchmark: {e}")));
+    }
+    Ok(figure(
+        "lidar/velodyne_decode/hdl32e_revolution_to_scan",
+        seconds,
+        "ms",
+        Some("<= 100 ms (the sensor's 10 Hz)"),
+    ))
 }

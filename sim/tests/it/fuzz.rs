@@ -400,3 +400,57 @@ fn ros2_bags_and_their_poses() {
         ros2::msgs::read_odometry(b).ok().map(|t| format!("{t:?}"))
     });
 }
+
+/// Velodyne captures: a pcap of HDL-32E packets (several revolutions of ground returns) and a
+/// position packet, fuzzed; read, cut into revolutions, each made a scan, the ground fitted.
+#[test]
+fn velodyne_captures() {
+    use velodyne::packet::{Block, CHANNELS};
+    let mut datagrams: Vec<(f64, u16, Vec<u8>)> = (0..70u16)
+        .map(|p| {
+            let blocks = std::array::from_fn(|k| {
+                let mut channels = [(0u16, 0u8); CHANNELS];
+                for (j, c) in channels.iter_mut().enumerate() {
+                    *c = ((1000 + 97 * j) as u16, j as u8);
+                }
+                Block {
+                    azimuth_cdeg: ((p * 12 + k as u16) % 120) * 300,
+                    channels,
+                }
+            });
+            let packet = velodyne::DataPacket {
+                blocks,
+                timestamp_us: 553 * u32::from(p),
+                return_mode: velodyne::ReturnMode::Strongest,
+                product: velodyne::Product::Hdl32e,
+            };
+            (f64::from(p) * 553e-6, 2368, packet.encode())
+        })
+        .collect();
+    let mut position = vec![0u8; 512];
+    position[206..213].copy_from_slice(b"$GPRMC,");
+    datagrams.insert(3, (0.001, 8308, position));
+    let seed = velodyne::pcap_bytes(&datagrams);
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("fuzzed.pcap");
+    std::fs::write(&file, &seed).unwrap();
+    let sound = sim::pcap::read(&file).unwrap();
+    assert_eq!((sound.frames.len(), sound.positions), (7, 1));
+    fuzz("velodyne capture", seed, true, |b| {
+        std::fs::write(&file, b).unwrap();
+        let r = sim::pcap::read(&file).ok()?;
+        let mount = nalgebra::Isometry3::translation(0.0, 0.0, 2.0);
+        let pose = nalgebra::Isometry2::identity();
+        let returns: usize = r
+            .frames
+            .iter()
+            .filter_map(|f| r.scan(f, &pose, &mount).ok())
+            .map(|s| s.scan.returns().iter().flatten().count())
+            .sum();
+        Some(format!(
+            "{} {returns} {:?}",
+            r.frames.len(),
+            r.ground(r.full())
+        ))
+    });
+}

@@ -58,7 +58,8 @@ pub struct BenchArgs {
 pub enum BenchTarget {
     /// Scan insertion, exact EDT vs chamfer, pose checks.
     Mapper,
-    /// One HDL-32E revolution: the fast cast vs Rapier's generic per-ray query.
+    /// One HDL-32E revolution: the fast cast vs Rapier's generic per-ray query; a real
+    /// sensor's revolution of packets decoded into a scan.
     Lidar,
     /// The closed loop on `--scenario`: real-time factor and wall time per stage.
     Loop,
