@@ -30,16 +30,22 @@ pub struct Recording {
     pub positions: usize,
 }
 
-/// Reads the capture at `path` (its sensor from its packets).
-pub fn read(path: &Path) -> Result<Recording> {
+/// Reads the capture at `path` (its sensor from its packets), with the VeloView calibration
+/// file `calibration` or the sensor's built-in table.
+pub fn read(path: &Path, calibration: Option<&Path>) -> Result<Recording> {
     let capture = Capture::read(path).map_err(|e| Error::Invalid(e.to_string()))?;
-    let calibration = Calibration::built_in(capture.product()).ok_or_else(|| {
+    let built_in = Calibration::built_in(capture.product()).ok_or_else(|| {
         Error::Invalid(format!(
             "{}: the packets do not say which sensor took them (older firmware); only the \
              built-in tables of the HDL-32E and VLP-16 are known",
             path.display()
         ))
     })?;
+    let calibration = match calibration {
+        Some(file) => Calibration::from_veloview_xml(file, built_in.lasers())
+            .map_err(|e| Error::Invalid(e.to_string()))?,
+        None => built_in,
+    };
     let packets: Vec<_> = capture.data.into_iter().map(|(_, p)| p).collect();
     Ok(Recording {
         frames: velodyne::frames(&packets, &calibration),
@@ -121,16 +127,17 @@ pub struct PcapMapReport {
 }
 
 /// Builds the offline map of `levels` from the capture at `pcap` (its full revolutions, the
-/// sensor placed by `placement`) into `out`.
+/// sensor placed by `placement`, calibrated by `calibration` or its built-in table) into `out`.
 pub fn map_from_pcap(
     pcap: &Path,
+    calibration: Option<&Path>,
     placement: &Placement,
     levels: &Levels,
     config: MapConfig,
     out: &Path,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<PcapMapReport> {
-    let recording = read(pcap)?;
+    let recording = read(pcap, calibration)?;
     let full = recording.full();
     if full.is_empty() {
         return Err(Error::Invalid(format!(

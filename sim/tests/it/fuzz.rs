@@ -434,11 +434,11 @@ fn velodyne_captures() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("fuzzed.pcap");
     std::fs::write(&file, &seed).unwrap();
-    let sound = sim::pcap::read(&file).unwrap();
+    let sound = sim::pcap::read(&file, None).unwrap();
     assert_eq!((sound.frames.len(), sound.positions), (7, 1));
     fuzz("velodyne capture", seed, true, |b| {
         std::fs::write(&file, b).unwrap();
-        let r = sim::pcap::read(&file).ok()?;
+        let r = sim::pcap::read(&file, None).ok()?;
         let mount = nalgebra::Isometry3::translation(0.0, 0.0, 2.0);
         let pose = nalgebra::Isometry2::identity();
         let returns: usize = r

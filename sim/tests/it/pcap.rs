@@ -77,7 +77,7 @@ fn a_built_capture_reads_as_revolutions_at_the_sensors_height() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("built.pcap");
     std::fs::write(&file, capture()).unwrap();
-    let r = sim::pcap::read(&file).unwrap();
+    let r = sim::pcap::read(&file, None).unwrap();
     assert_eq!((r.frames.len(), r.full().len()), (4, 2));
     let g = r.ground(&r.full()[..1]).unwrap();
     assert!((g.height_m() - HEIGHT_M).abs() <= 0.002, "{g:?}");
@@ -128,6 +128,7 @@ fn a_built_capture_maps_its_wall_on_every_level() {
     };
     let report = sim::pcap::map_from_pcap(
         &file,
+        None,
         &placement,
         &levels,
         sim::offline_map::map_config(&config),
@@ -167,7 +168,7 @@ fn the_ground_fit_finds_a_sensors_height_and_tilt() {
     let figures = |pitch: f64| {
         let file = dir.path().join(format!("pitch{pitch}.pcap"));
         std::fs::write(&file, capture_of(pitch, false)).unwrap();
-        let r = sim::pcap::read(&file).unwrap();
+        let r = sim::pcap::read(&file, None).unwrap();
         sim::studies::lidar_compare::real(&r, "built", test).unwrap()
     };
     let level = figures(0.0);
@@ -270,6 +271,7 @@ fn a_tilted_sensors_ground_is_clear_once_levelled() {
         let out = dir.path().join(format!("map-{level}"));
         let r = sim::pcap::map_from_pcap(
             &file,
+            None,
             &placement,
             &levels,
             sim::offline_map::map_config(&config),

@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use crate::capture::read_datagrams;
-use crate::packet::{BLOCKS, DATA_LEN, DATA_PORT, DISTANCE_UNIT_M, POSITION_LEN, POSITION_PORT};
+use crate::packet::{BLOCKS, DATA_LEN, DATA_PORT, POSITION_LEN, POSITION_PORT};
 use crate::{Calibration, DataPacket, PositionPacket, Product, ReturnMode, VelodyneError};
 
 /// One return.
@@ -125,14 +125,20 @@ pub fn frames(packets: &[DataPacket], calibration: &Calibration) -> Vec<Frame> {
                     continue;
                 };
                 let time_us = firing_time_us(p, firing, j);
-                let (w, az) = (w.to_radians(), f64::from(a) * 0.01_f64.to_radians());
-                let dist = f64::from(d) * DISTANCE_UNIT_M;
+                let c = calibration;
+                let az = (f64::from(a) * 0.01 - c.rotation_deg[laser]).to_radians();
+                let w = w.to_radians();
+                let dist = f64::from(d) * c.distance_unit_m + c.distance_offset_m[laser];
+                // VeloView's corrections (all zero in the built-in tables).
+                let (v_off, h_off) = (c.vertical_offset_m[laser], c.horizontal_offset_m[laser]);
+                let xy = dist * w.cos() - v_off * w.sin();
+                let xyz = [
+                    xy * az.sin() - h_off * az.cos(),
+                    xy * az.cos() + h_off * az.sin(),
+                    dist * w.sin() + v_off * w.cos(),
+                ];
                 frame.points.push(Point {
-                    xyz_m: [
-                        (dist * w.cos() * az.sin()) as f32,
-                        (dist * w.cos() * az.cos()) as f32,
-                        (dist * w.sin()) as f32,
-                    ],
+                    xyz_m: xyz.map(|v| v as f32),
                     distance_m: dist as f32,
                     intensity,
                     laser: laser as u8,

@@ -14,6 +14,9 @@ pub struct CompareLidarArgs {
     /// The real sensor's capture (pcap or pcapng).
     #[arg(long, value_name = "FILE")]
     pub pcap: PathBuf,
+    /// The sensor's VeloView calibration file (XML; default: its built-in table).
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<PathBuf>,
     /// Run configuration (TOML) whose `[lidar]` and obstacle-test settings to use (default: the
     /// defaults).
     #[arg(long, value_name = "FILE")]
@@ -44,7 +47,7 @@ pub fn run(args: &CompareLidarArgs) -> anyhow::Result<()> {
         None => RunConfig::default(),
     };
     let test = config.mapping.map.obstacle_test;
-    let recording = sim::pcap::read(&args.pcap)?;
+    let recording = sim::pcap::read(&args.pcap, args.calibration.as_deref())?;
     let label = format!("real ({})", args.pcap.display());
     let real = real(&recording, &label, test).with_context(|| args.pcap.display().to_string())?;
     let revolutions = args.revolutions.unwrap_or(real.revolutions).max(1);

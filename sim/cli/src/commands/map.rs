@@ -61,6 +61,9 @@ pub struct MapArgs {
     /// revolutions, the sensor standing at `--pose`.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["from_bag", "record"])]
     pub pcap: Option<PathBuf>,
+    /// The sensor's VeloView calibration file (XML; default: its built-in table).
+    #[arg(long, value_name = "FILE", requires = "pcap")]
+    pub calibration: Option<PathBuf>,
     /// Where the sensor stands, `x,y,yaw` (metres, metres, degrees; azimuth 0 along the yaw).
     #[arg(
         long,
@@ -128,6 +131,7 @@ fn from_pcap(
     };
     let report = sim::pcap::map_from_pcap(
         pcap,
+        args.calibration.as_deref(),
         &placement,
         &levels,
         map_config(config),

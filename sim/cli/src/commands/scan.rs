@@ -19,6 +19,9 @@ pub struct ScanArgs {
     /// A Velodyne capture (pcap or pcapng; HDL-32E, VLP-16) to take the revolution from.
     #[arg(long, value_name = "FILE")]
     pub pcap: Option<PathBuf>,
+    /// The sensor's VeloView calibration file (XML; default: its built-in table).
+    #[arg(long, value_name = "FILE", requires = "pcap")]
+    pub calibration: Option<PathBuf>,
     /// The capture's revolution (VeloView's frame numbering: 0 is the partial first).
     #[arg(long, default_value_t = 1, requires = "pcap")]
     pub revolution: usize,
@@ -140,7 +143,7 @@ fn pose_along(scenario: &Scenario, s: f64) -> anyhow::Result<Isometry2<f64>> {
 
 /// `--pcap`: one revolution of a capture.
 fn from_pcap(args: &ScanArgs, pcap: &std::path::Path) -> anyhow::Result<()> {
-    let recording = sim::pcap::read(pcap)?;
+    let recording = sim::pcap::read(pcap, args.calibration.as_deref())?;
     let n = recording.frames.len();
     let frame = recording.frames.get(args.revolution).ok_or_else(|| {
         anyhow::anyhow!(
