@@ -598,12 +598,15 @@ impl Driver {
                 .collect::<Vec<_>>();
             body.extend(dropped);
         }
-        // Movers predicted out of view now, beyond what revealing a static object explains:
-        // checked again if their track drops (seen too briefly for a streak, maybe).
+        // Movers predicted out of view now, confirmed and beyond what revealing a static object
+        // explains: checked again if their track drops (seen too briefly for a streak, maybe).
+        // Unconfirmed ones are not: a one-cell track jumping at 7 m/s at the edge of view, lost
+        // for 6 s, would be predicted onto the body from 50 m away.
         self.coasting = movers
             .iter()
             .filter(|t| {
                 now_s - t.t_s > 0.25
+                    && t.confirmed
                     && moved_beyond_its_extent(t, cfg)
                     && self.predictions.iter().any(|p| p.track.id == t.id)
             })

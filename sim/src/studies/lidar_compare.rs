@@ -115,15 +115,21 @@ fn figures(
     let level = Isometry3::translation(0.0, 0.0, height_m);
     let untilted = plane.sensor_above_level_ground();
     let tests = [
-        ObstacleTest::new(ObstacleTestParams {
-            ground_height_m: 0.0,
-            ..test
-        }),
-        ObstacleTest::new(ObstacleTestParams {
-            ground_height_m: 0.0,
-            unsafe_height_above_ground_m: None,
-            ..test
-        }),
+        (
+            &ObstacleTest::new(ObstacleTestParams {
+                ground_height_m: 0.0,
+                ..test
+            }),
+            test.unsafe_height_above_ground_m,
+        ),
+        (
+            &ObstacleTest::new(ObstacleTestParams {
+                ground_height_m: 0.0,
+                unsafe_height_above_ground_m: None,
+                ..test
+            }),
+            None,
+        ),
     ];
     for rev in revs {
         for pair in rev.windows(2) {
@@ -161,7 +167,8 @@ fn figures(
                 .iter()
                 .enumerate()
             {
-                false_obstacles[k] += ground_obstacles(col, frame, &tests[*test], &is_ground);
+                let low_ground = |b: usize, p: &Point3<f64>| low[b] && is_ground(p);
+                false_obstacles[k] += ground_obstacles(col, frame, tests[*test], &low_ground);
             }
         }
     }
@@ -202,30 +209,33 @@ fn figures(
     })
 }
 
-/// How many of a column's ground returns the obstacle test calls obstacles, its points moved by
-/// `world_from_sensor` (the beam below each one as the mapper pairs them: the previous beam with
-/// a return, none after a beam without).
+/// How many of a column's ground returns (`is_ground(beam, point)`) the obstacle test with its
+/// unsafe height calls obstacles, its points moved by `world_from_sensor` - the beam below each
+/// one as the mapper pairs them: the previous beam with a return, none after a beam without (the
+/// vehicle's ceiling, which also breaks pairs, is left out: no ground return lies above one).
 fn ground_obstacles(
     col: &[Option<(Point3<f64>, f64)>],
     world_from_sensor: &Isometry3<f64>,
-    test: &ObstacleTest,
-    is_ground: &dyn Fn(&Point3<f64>) -> bool,
+    (test, unsafe_height): (&ObstacleTest, Option<f64>),
+    is_ground: &dyn Fn(usize, &Point3<f64>) -> bool,
 ) -> usize {
     let sensor = Point3::from(world_from_sensor.translation.vector);
     let mut below: Option<(Point3<f64>, f64)> = None;
     let mut n = 0;
-    for r in col {
+    for (b, r) in col.iter().enumerate() {
         let Some((p, _)) = r else {
             below = None;
             continue;
         };
         let w = world_from_sensor * p;
         let range = (w.coords.xy() - sensor.coords.xy()).norm();
+        // As the mapper pairs them (`mapper::map::insert`): with no beam below, only the unsafe
+        // height decides.
         let obstacle = match below {
             Some((lower, lower_range)) => test.is_obstacle(&sensor, &lower, lower_range, &w, range),
-            None => false,
+            None => unsafe_height.is_some_and(|h| w.z >= h),
         };
-        if obstacle && is_ground(p) {
+        if obstacle && is_ground(b, p) {
             n += 1;
         }
         below = Some((w, range));

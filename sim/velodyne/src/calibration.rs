@@ -75,9 +75,9 @@ impl Calibration {
             file: path.to_path_buf(),
             source,
         })?;
-        let bad = |line: usize, what: String| VelodyneError::File {
+        let bad = |at: usize, what: String| VelodyneError::File {
             file: path.to_path_buf(),
-            what: format!("line {line}: {what}"),
+            what: format!("line {}: {what}", line_at(&text, at)),
         };
         let entries = read_xml(&text).map_err(|(line, what)| bad(line, what))?;
         if entries.lasers.is_empty() {
@@ -89,24 +89,44 @@ impl Calibration {
         let mut out = Self::with_vertical(vec![f64::NAN; lasers]);
         let mut seen = vec![false; lasers];
         if let Some(lsb) = entries.dist_lsb_cm {
-            if !(lsb.is_finite() && lsb > 0.0) {
+            if !(lsb > 0.0 && lsb <= 10.0) {
                 return Err(bad(
-                    entries.dist_lsb_line,
-                    format!("distLSB_ {lsb}: not a positive length"),
+                    entries.dist_lsb_at,
+                    format!("distLSB_ {lsb}: not a length of 0 to 10 cm"),
                 ));
             }
             out.distance_unit_m = lsb / 100.0;
         }
         for px in &entries.lasers {
             let Some(id) = px.id else {
-                return Err(bad(px.line, "a laser (px) without id_".into()));
+                return Err(bad(px.at, "a laser (px) without id_".into()));
             };
             if id >= lasers {
                 continue;
             }
             let Some(vertical) = px.vertical_deg else {
-                return Err(bad(px.line, format!("laser {id}: no vertCorrection_")));
+                return Err(bad(px.at, format!("laser {id}: no vertCorrection_")));
             };
+            if !(-90.0 < vertical && vertical < 90.0) {
+                return Err(bad(
+                    px.at,
+                    format!(
+                        "laser {id}: vertCorrection_ {vertical}: not an angle between -90 and 90 degrees"
+                    ),
+                ));
+            }
+            for (name, v) in [
+                ("distCorrection_", px.distance_cm),
+                ("vertOffsetCorrection_", px.vertical_offset_cm),
+                ("horizOffsetCorrection_", px.horizontal_offset_cm),
+            ] {
+                if v.is_some_and(|v| v.abs() > 100.0) {
+                    return Err(bad(
+                        px.at,
+                        format!("laser {id}: {name} {} cm: beyond a metre", v.unwrap_or(0.0)),
+                    ));
+                }
+            }
             let cm = |v: Option<f64>| v.unwrap_or(0.0) / 100.0;
             out.vertical_deg[id] = vertical;
             out.rotation_deg[id] = px.rotation_deg.unwrap_or(0.0);
@@ -132,7 +152,8 @@ impl Calibration {
 /// One `px` entry of a VeloView file.
 #[derive(Default)]
 struct Px {
-    line: usize,
+    /// Byte offset of its start in the file.
+    at: usize,
     id: Option<usize>,
     vertical_deg: Option<f64>,
     rotation_deg: Option<f64>,
@@ -145,21 +166,23 @@ struct Px {
 #[derive(Default)]
 struct Entries {
     dist_lsb_cm: Option<f64>,
-    dist_lsb_line: usize,
+    dist_lsb_at: usize,
     lasers: Vec<Px>,
 }
 
-/// The entries of a VeloView file; an error is (line, what).
+/// The line of byte offset `at` in `text`, from 1 (counted only for an error's message).
+fn line_at(text: &str, at: usize) -> usize {
+    text.as_bytes()[..at.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+/// The entries of a VeloView file; an error is (byte offset, what).
 fn read_xml(text: &str) -> Result<Entries, (usize, String)> {
     use quick_xml::events::Event;
     let mut reader = quick_xml::Reader::from_str(text);
-    let line_at = |pos: u64| {
-        text.as_bytes()[..(pos as usize).min(text.len())]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count()
-            + 1
-    };
     let mut out = Entries::default();
     let mut stack: Vec<String> = Vec::new();
     let mut px: Option<Px> = None;
@@ -167,13 +190,13 @@ fn read_xml(text: &str) -> Result<Entries, (usize, String)> {
         let pos = reader.buffer_position();
         let event = reader
             .read_event()
-            .map_err(|e| (line_at(reader.error_position()), format!("not XML: {e}")))?;
+            .map_err(|e| (reader.error_position() as usize, format!("not XML: {e}")))?;
         match event {
             Event::Start(e) => {
                 let name = String::from_utf8_lossy(e.name().as_ref()).into_owned();
                 if name == "px" {
                     px = Some(Px {
-                        line: line_at(pos),
+                        at: pos as usize,
                         ..Px::default()
                     });
                 }
@@ -190,7 +213,9 @@ fn read_xml(text: &str) -> Result<Entries, (usize, String)> {
                 let Some(field) = stack.last() else { continue };
                 let value = t
                     .decode()
-                    .map_err(|e| (line_at(pos), format!("{field}: {e}")))?;
+                    .map_err(|e| (pos as usize, format!("{field}: {e}")))?;
+                let value = quick_xml::escape::unescape(&value)
+                    .map_err(|e| (pos as usize, format!("{field}: {e}")))?;
                 let value = value.trim();
                 if value.is_empty() {
                     continue;
@@ -202,7 +227,7 @@ fn read_xml(text: &str) -> Result<Entries, (usize, String)> {
                         .filter(|v| v.is_finite())
                         .ok_or_else(|| {
                             (
-                                line_at(pos),
+                                pos as usize,
                                 format!("{field}: {value:?} is not a finite number"),
                             )
                         })
@@ -210,12 +235,12 @@ fn read_xml(text: &str) -> Result<Entries, (usize, String)> {
                 match (field.as_str(), px.as_mut()) {
                     ("distLSB_", _) => {
                         out.dist_lsb_cm = Some(number()?);
-                        out.dist_lsb_line = line_at(pos);
+                        out.dist_lsb_at = pos as usize;
                     }
                     ("id_", Some(p)) => {
                         let id = number()?;
                         if id < 0.0 || id.fract() != 0.0 || id > 1024.0 {
-                            return Err((line_at(pos), format!("id_ {value}: not a laser number")));
+                            return Err((pos as usize, format!("id_ {value}: not a laser number")));
                         }
                         p.id = Some(id as usize);
                     }

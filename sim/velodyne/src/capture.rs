@@ -1,8 +1,10 @@
 //! The UDP datagrams of a capture: a pcap or pcapng file read with `pcap-parser`, each packet's
 //! link layer (Ethernet with or without an 802.1Q tag, Linux cooked capture v1 or v2, raw IPv4),
 //! IPv4 header (its own length, not assumed 20 bytes) and UDP header parsed. Packets that are
-//! not IPv4 UDP (ARP, IPv6, TCP) are skipped; a fragment, a packet cut short by the capture's
-//! snap length or a length field past the packet's end is an error naming the packet.
+//! not IPv4 UDP (ARP, IPv6, TCP) are skipped; one for the sensor's ports (2368, 8308) that is a
+//! fragment, cut short by the capture's snap length or with a length field past its end is an
+//! error naming the packet - anyone else's such packet is skipped. An unsupported link type is
+//! an error.
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -94,21 +96,15 @@ pub fn read_datagrams(path: &Path) -> Result<Vec<Datagram>, VelodyneError> {
                     PcapBlockOwned::NG(_) => None,
                 };
                 if let Some((link, time_s, caplen, origlen, data)) = packet {
-                    if caplen < origlen {
-                        return Err(packet_error(
-                            path,
-                            index,
-                            format!("cut short by the capture: {caplen} of {origlen} bytes kept"),
-                        ));
-                    }
-                    if let Some(d) = udp(link, &data).map_err(|w| packet_error(path, index, w))? {
-                        out.push(Datagram {
-                            index,
-                            time_s,
-                            src_port: d.0,
-                            dst_port: d.1,
-                            payload: d.2.to_vec(),
-                        });
+                    let record = Record {
+                        index,
+                        link,
+                        time_s,
+                        caplen,
+                        origlen,
+                    };
+                    if let Some(d) = datagram_of(path, &record, &data)? {
+                        out.push(d);
                     }
                     index += 1;
                 }
@@ -139,6 +135,66 @@ pub fn read_datagrams(path: &Path) -> Result<Vec<Datagram>, VelodyneError> {
     Ok(out)
 }
 
+/// A packet record's fields beside its data.
+struct Record {
+    index: usize,
+    link: Linktype,
+    time_s: f64,
+    caplen: u32,
+    origlen: u32,
+}
+
+/// The UDP datagram of one packet record; `None` for what is skipped (not IPv4 UDP, or someone
+/// else's packet that cannot be read whole).
+fn datagram_of(path: &Path, r: &Record, data: &[u8]) -> Result<Option<Datagram>, VelodyneError> {
+    if !supported(r.link) {
+        return Err(packet_error(
+            path,
+            r.index,
+            format!(
+                "link type {} not supported (Ethernet 1, Linux cooked 113 and 276, raw IPv4 101 \
+                 and 228 are)",
+                r.link.0
+            ),
+        ));
+    }
+    // A packet that cannot be read whole is an error if it was for the sensor's ports, and
+    // skipped if it was not (a fragment of someone else's traffic).
+    let velodyne = |port: Option<u16>| {
+        port.is_some_and(|p| p == crate::packet::DATA_PORT || p == crate::packet::POSITION_PORT)
+    };
+    let parsed = udp(r.link, data);
+    if r.caplen < r.origlen {
+        let port = match &parsed {
+            Ok(Some(d)) => Some(d.1),
+            Ok(None) => None,
+            Err((port, _)) => *port,
+        };
+        if velodyne(port) {
+            return Err(packet_error(
+                path,
+                r.index,
+                format!(
+                    "cut short by the capture: {} of {} bytes kept",
+                    r.caplen, r.origlen
+                ),
+            ));
+        }
+        return Ok(None);
+    }
+    match parsed {
+        Ok(Some(d)) => Ok(Some(Datagram {
+            index: r.index,
+            time_s: r.time_s,
+            src_port: d.0,
+            dst_port: d.1,
+            payload: d.2.to_vec(),
+        })),
+        Err((port, what)) if velodyne(port) => Err(packet_error(path, r.index, what)),
+        Ok(None) | Err(_) => Ok(None),
+    }
+}
+
 fn packet_error(path: &Path, index: usize, what: String) -> VelodyneError {
     VelodyneError::Packet {
         file: PathBuf::from(path),
@@ -147,13 +203,26 @@ fn packet_error(path: &Path, index: usize, what: String) -> VelodyneError {
     }
 }
 
-/// A UDP datagram's ports and payload; `None` for what is not IPv4 UDP.
+/// A UDP datagram's ports and payload.
 type Udp<'a> = (u16, u16, &'a [u8]);
 
-/// The UDP datagram in a packet of link type `link`.
-pub fn udp(link: Linktype, data: &[u8]) -> Result<Option<Udp<'_>>, String> {
+/// Whether packets of link type `link` can be read.
+fn supported(link: Linktype) -> bool {
+    matches!(
+        link,
+        Linktype::ETHERNET
+            | Linktype::LINUX_SLL
+            | Linktype::LINUX_SLL2
+            | Linktype::RAW
+            | Linktype::IPV4
+    )
+}
+
+/// The UDP datagram in a packet of link type `link` (one [`supported`]): `None` for what is not
+/// IPv4 UDP; an error says what is wrong, with the destination port when it could be read.
+pub fn udp(link: Linktype, data: &[u8]) -> Result<Option<Udp<'_>>, (Option<u16>, String)> {
     let be16 = |b: &[u8], at: usize| b.get(at..at + 2).map(|s| u16::from_be_bytes([s[0], s[1]]));
-    let short = |what: &str| format!("{what} cut short ({} bytes)", data.len());
+    let short = |what: &str| (None, format!("{what} cut short ({} bytes)", data.len()));
     let (ethertype, ip) = match link {
         Linktype::ETHERNET => {
             let mut at = 12;
@@ -173,13 +242,7 @@ pub fn udp(link: Linktype, data: &[u8]) -> Result<Option<Udp<'_>>, String> {
             data.get(20..)
                 .ok_or_else(|| short("Linux cooked v2 header"))?,
         ),
-        Linktype::RAW | Linktype::IPV4 => (0x0800, data),
-        Linktype(other) => {
-            return Err(format!(
-                "link type {other} not supported (Ethernet 1, Linux cooked 113 and 276, raw IPv4 \
-                 101 and 228 are)"
-            ));
-        }
+        _ => (0x0800, data),
     };
     if ethertype != 0x0800 || ip.first().is_none_or(|b| b >> 4 != 4) {
         return Ok(None);
@@ -191,15 +254,25 @@ pub fn udp(link: Linktype, data: &[u8]) -> Result<Option<Udp<'_>>, String> {
     if ip[9] != 17 {
         return Ok(None);
     }
-    let total = usize::from(be16(ip, 2).unwrap_or(0));
     let flags_offset = be16(ip, 6).unwrap_or(0);
+    // Only a first fragment (offset 0) carries the UDP header.
+    let port = (flags_offset & 0x1fff == 0)
+        .then(|| be16(ip, ihl + 2))
+        .flatten();
+    let total = usize::from(be16(ip, 2).unwrap_or(0));
     if flags_offset & 0x2000 != 0 || flags_offset & 0x1fff != 0 {
-        return Err("an IPv4 fragment (Velodyne packets are never fragmented)".into());
+        return Err((
+            port,
+            "an IPv4 fragment (Velodyne packets are never fragmented)".into(),
+        ));
     }
     if total < ihl + 8 || total > ip.len() {
-        return Err(format!(
-            "IPv4 total length {total} outside the packet's {} bytes",
-            ip.len()
+        return Err((
+            port,
+            format!(
+                "IPv4 total length {total} outside the packet's {} bytes",
+                ip.len()
+            ),
         ));
     }
     let u = &ip[ihl..total];
@@ -209,9 +282,9 @@ pub fn udp(link: Linktype, data: &[u8]) -> Result<Option<Udp<'_>>, String> {
         usize::from(be16(u, 4).unwrap_or(0)),
     );
     if len < 8 || len > u.len() {
-        return Err(format!(
-            "UDP length {len} outside the datagram's {} bytes",
-            u.len()
+        return Err((
+            Some(dst),
+            format!("UDP length {len} outside the datagram's {} bytes", u.len()),
         ));
     }
     Ok(Some((src, dst, &u[8..len])))

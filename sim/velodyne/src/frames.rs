@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use crate::capture::read_datagrams;
-use crate::packet::{BLOCKS, DATA_LEN, DATA_PORT, POSITION_LEN, POSITION_PORT};
+use crate::packet::{BLOCKS, CHANNELS, DATA_LEN, DATA_PORT, POSITION_LEN, POSITION_PORT};
 use crate::{Calibration, DataPacket, PositionPacket, Product, ReturnMode, VelodyneError};
 
 /// One return.
@@ -26,7 +26,8 @@ pub struct Point {
     pub laser: u8,
     /// Azimuth of its block, 0.01 degree.
     pub azimuth_cdeg: u16,
-    /// Its firing sequence, counted from the capture's first (a column of a scan).
+    /// Its firing sequence, counted from the capture's first (a column of a scan; a VLP-16
+    /// block holds two).
     pub firing: u32,
     /// When it fired, microseconds past the hour (the sensor's clock).
     pub time_us: f64,
@@ -112,8 +113,10 @@ pub fn frames(packets: &[DataPacket], calibration: &Calibration) -> Vec<Frame> {
             last_azimuth = Some(a);
             let repeat = (dual && k % 2 == 1).then(|| &p.blocks[k - 1]);
             let firing = if dual { k / 2 } else { k };
+            // A VLP-16 block holds two firing sequences: two columns.
+            let sequences: u32 = if p.product == Product::Vlp16 { 2 } else { 1 };
             if repeat.is_none() {
-                firings += 1;
+                firings += sequences;
             }
             let frame = out.last_mut().expect("one frame at least");
             for (j, &(d, intensity)) in block.channels.iter().enumerate() {
@@ -143,7 +146,7 @@ pub fn frames(packets: &[DataPacket], calibration: &Calibration) -> Vec<Frame> {
                     intensity,
                     laser: laser as u8,
                     azimuth_cdeg: a,
-                    firing: firings - 1,
+                    firing: firings - sequences + j as u32 * sequences / CHANNELS as u32,
                     time_us,
                 });
             }

@@ -6,7 +6,8 @@
 //! - [`packet`]: a 1206-byte data packet (12 blocks of 32 channels: azimuth in 0.01 degree,
 //!   distance in 2 mm, intensity; the timestamp in microseconds past the hour; the factory
 //!   bytes: return mode and product) and a 512-byte position packet (its NMEA `$GPRMC`).
-//! - [`calibration`]: each laser's vertical angle, from the sensor's built-in table.
+//! - [`calibration`]: each laser's vertical angle and corrections, from the sensor's built-in
+//!   table or a VeloView calibration file (XML).
 //! - [`frames`]: points in the sensor frame with their laser, azimuth, intensity and firing
 //!   time, cut into revolutions where the azimuth wraps - VeloView's rule, so its expected
 //!   values (`monterey.test`) can be reproduced exactly.

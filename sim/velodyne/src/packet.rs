@@ -190,7 +190,7 @@ impl PositionPacket {
         if !nmea.is_empty() && !nmea.starts_with('$') {
             return Err(format!(
                 "its NMEA sentence starts {:?}, not '$'",
-                &nmea[..nmea.len().min(8)]
+                nmea.chars().take(8).collect::<String>()
             ));
         }
         Ok(PositionPacket { timestamp_us, nmea })

@@ -1,4 +1,5 @@
-//! A revolution as the mapper takes it: a [`mapper::Scan`] of columns (firing sequences) x
+//! A revolution as the mapper takes it: a [`mapper::Scan`] of columns (firing sequences: one a
+//! block on the HDL-32E, two on the VLP-16) x
 //! beams (lasers by vertical angle, beam 0 the lowest), each return in the world frame with its
 //! intensity scaled to 0..1 (raw / 255), no echo as `None`.
 //!

@@ -145,6 +145,29 @@ fn a_revolution_becomes_the_mappers_scan() {
     assert_eq!(s.scan.returns()[3 * 32 + 18], None);
 }
 
+/// A VLP-16 block holds two 16-laser firing sequences: two columns of the scan, every return
+/// kept (16 beams by angle, -15 degrees the lowest).
+#[test]
+fn a_vlp16_block_is_two_columns() {
+    let mut p = packet(std::array::from_fn(|k| 40 * k as u16), 9_000);
+    p.product = Product::Vlp16;
+    let calibration = Calibration::built_in(Product::Vlp16).unwrap();
+    let f = frames(&[p], &calibration);
+    let s = velodyne::to_scan(
+        &f[0],
+        &calibration,
+        &nalgebra::Isometry3::identity(),
+        &nalgebra::Isometry2::identity(),
+    )
+    .unwrap();
+    assert_eq!((s.scan.beams(), s.scan.columns().len()), (16, 24));
+    assert_eq!(s.scan.returns().iter().flatten().count(), f[0].points.len());
+    assert_eq!(f[0].points.len(), 12 * 31);
+    // Channel 16 (laser 0 of the second sequence, -15 degrees) is beam 0 of column 1.
+    let r = s.scan.returns()[16].expect("a return");
+    assert!((r.range_m - 26.0).abs() < 1e-3, "{r:?}");
+}
+
 /// In dual-return mode a block pair repeats an azimuth; where the second repeats the first's
 /// distance (one echo), the return is counted once.
 #[test]
@@ -227,6 +250,47 @@ fn hostile_captures_are_located_errors() {
     // No data packets at all.
     let e = error_of(&pcap(1, &[ethernet_udp(53, b"dns")]));
     assert!(e.contains("no Velodyne data packets"), "{e}");
+}
+
+/// Other traffic in a capture is skipped, even when it could not be read whole (a fragment, a
+/// packet snapped by the capture); 802.1Q-tagged and Linux cooked (v1, v2) captures read as
+/// Ethernet ones do.
+#[test]
+fn other_traffic_and_other_link_layers() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = packet([0; 12], 0).encode();
+    let sensor = ethernet_udp(2368, &good);
+    let mut fragment = ethernet_udp(53, b"a fragment of a DNS answer");
+    fragment[14 + 6] = 0x20; // more fragments
+    let snapped = ethernet_udp(53, &[7u8; 400])[..100].to_vec();
+    let mut bytes = pcap(1, &[fragment, sensor.clone(), snapped.clone()]);
+    // The snapped record says 100 of 442 bytes.
+    let third = bytes.len() - snapped.len() - 16;
+    bytes[third + 12..third + 16].copy_from_slice(&442u32.to_le_bytes());
+    let path = write(dir.path(), "mixed.pcap", &bytes);
+    let c = Capture::read(&path).unwrap();
+    assert_eq!(c.data.len(), 1);
+    assert_eq!(c.data[0].0, 1);
+    // The same packet behind an 802.1Q tag, and in Linux cooked captures.
+    let mut tagged = sensor[..12].to_vec();
+    tagged.extend_from_slice(&[0x81, 0x00, 0x00, 0x05]);
+    tagged.extend_from_slice(&sensor[12..]);
+    let ip = &sensor[14..];
+    let mut sll = vec![0u8; 14];
+    sll.extend_from_slice(&[0x08, 0x00]);
+    sll.extend_from_slice(ip);
+    let mut sll2 = vec![0x08, 0x00];
+    sll2.extend_from_slice(&[0u8; 18]);
+    sll2.extend_from_slice(ip);
+    for (link, record) in [(1, tagged), (113, sll), (276, sll2), (101, ip.to_vec())] {
+        let path = write(
+            dir.path(),
+            &format!("link{link}.pcap"),
+            &pcap(link, &[record]),
+        );
+        let c = Capture::read(&path).unwrap_or_else(|e| panic!("link {link}: {e}"));
+        assert_eq!(c.data[0].1, packet([0; 12], 0), "link {link}");
+    }
 }
 
 /// A VeloView calibration file of `lasers` lasers, each at the HDL-32E's angle, laser 0 with

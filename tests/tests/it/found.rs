@@ -227,6 +227,18 @@ fn a_van_lost_behind_the_wing_holds_the_standing_jet() {
     assert_eq!(r.end, sim::engine::EndReason::WaitingForHiddenObstacle);
 }
 
+/// Fixed: a one-cell ghost at a crossing fuel truck's far end, 53 m off the road, seemed to
+/// move toward it at 7.7 m/s (never confirmed); its track dropped after 6 s out of view while
+/// its prediction put it at the standing jet's body, and the jet waited for it as a mover lost
+/// there - the pilot was called where the lap used to complete. Now only confirmed movers are
+/// waited for. Found by the traffic campaign (variant 19 on ff63a25).
+#[test]
+fn a_ghost_track_lost_far_off_does_not_call_the_pilot() {
+    let r = run_found_with(&found("ghost_of_a_fuel_truck_lost_far_off"), |_| {});
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts_judged);
+    assert_eq!(r.end, sim::engine::EndReason::Completed, "{:?}", r.stops);
+}
+
 /// FIXME (README, Known problems): on KSYR's taxiway W the file's network runs 9-14 m off the
 /// painted centreline near the runway 10/28 crossing; following it, the jet's left main gear
 /// strikes an elevated edge light at 5 m/s (the light is too small for the LiDAR to resolve in

@@ -159,7 +159,15 @@ fn from_pcap(args: &ScanArgs, pcap: &std::path::Path) -> anyhow::Result<()> {
         None => (
             recording
                 .ground(std::slice::from_ref(frame))
-                .map_or(0.0, |g| g.height_m()),
+                .ok_or_else(|| {
+                    anyhow::anyhow!(
+                        "{}: revolution {}: too few ground returns to fit the ground; give \
+                         --sensor-height",
+                        pcap.display(),
+                        args.revolution
+                    )
+                })?
+                .height_m(),
             "fitted to the ground",
         ),
     };
