@@ -31,12 +31,19 @@ pub struct Figures {
     pub revolutions: usize,
     /// Firings (columns) a revolution, mean.
     pub firings_per_revolution: f64,
+    /// Firings a second (the real sensor's from its firing times; the synthetic's columns times
+    /// its rotation rate).
+    pub firings_per_second: f64,
     /// Returns a revolution, mean.
     pub returns_per_revolution: f64,
     /// Each beam's elevation, degrees, lowest first.
     pub elevations_deg: Vec<f64>,
     /// Each beam's fraction of firings without a return.
     pub no_return: Vec<f64>,
+    /// The lasers aimed 8 degrees or more down: their fraction of firings without a return in
+    /// each 30-degree sector of azimuth (sector k from 30k degrees, counter-clockwise from
+    /// ahead; a firing's azimuth is its first return's).
+    pub no_return_low_by_sector: Vec<f64>,
     /// Ground returns used, a revolution.
     pub ground_returns_per_revolution: f64,
     /// The fitted ground: the sensor's height above it, metres.
@@ -93,6 +100,7 @@ fn figures(
     label: &str,
     elevations_deg: &[f64],
     revs: &[Columns],
+    firings_per_second: f64,
     test: ObstacleTestParams,
 ) -> Result<Figures> {
     let beams = elevations_deg.len();
@@ -112,6 +120,7 @@ fn figures(
     let mut ground = 0usize;
     let mut false_obstacles = [0usize; 3];
     let mut steps: Vec<f64> = Vec::new();
+    let mut by_sector = [(0usize, 0usize); SECTORS];
     let level = Isometry3::translation(0.0, 0.0, height_m);
     let untilted = plane.sensor_above_level_ground();
     let tests = [
@@ -150,6 +159,7 @@ fn figures(
         }
         for col in rev {
             firings += 1;
+            count_low_by_sector(col, &low, &mut by_sector);
             for (b, r) in col.iter().enumerate() {
                 match r {
                     None => missing[b] += 1,
@@ -184,11 +194,16 @@ fn figures(
         label: label.to_string(),
         revolutions: revs.len(),
         firings_per_revolution: firings as f64 / n,
+        firings_per_second,
         returns_per_revolution: returns as f64 / n,
         elevations_deg: elevations_deg.to_vec(),
         no_return: missing
             .iter()
             .map(|&m| m as f64 / firings.max(1) as f64)
+            .collect(),
+        no_return_low_by_sector: by_sector
+            .iter()
+            .map(|&(missing, fired)| missing as f64 / fired.max(1) as f64)
             .collect(),
         ground_returns_per_revolution: ground as f64 / n,
         height_m,
@@ -207,6 +222,29 @@ fn figures(
         ground_intensity_deciles: (1..10).map(|k| decile(k as f64 / 10.0)).collect(),
         false_obstacles_per_revolution: false_obstacles.map(|f| f as f64 / n),
     })
+}
+
+/// Sectors of azimuth for the missing returns (30 degrees each).
+const SECTORS: usize = 12;
+
+/// Adds a column's low beams to its azimuth sector's `(missing, fired)` (the sector of its
+/// first return; a column with no return at all is left out: its azimuth is unknown).
+fn count_low_by_sector(
+    col: &[Option<(Point3<f64>, f64)>],
+    low: &[bool],
+    by_sector: &mut [(usize, usize); SECTORS],
+) {
+    let Some((p, _)) = col.iter().flatten().next() else {
+        return;
+    };
+    let azimuth = p.y.atan2(p.x).to_degrees().rem_euclid(360.0);
+    let sector = ((azimuth / (360.0 / SECTORS as f64)) as usize).min(SECTORS - 1);
+    for (r, _) in col.iter().zip(low).filter(|(_, l)| **l) {
+        by_sector[sector].1 += 1;
+        if r.is_none() {
+            by_sector[sector].0 += 1;
+        }
+    }
 }
 
 /// How many of a column's ground returns (`is_ground(beam, point)`) the obstacle test with its
@@ -271,7 +309,13 @@ pub fn real(recording: &Recording, label: &str, test: ObstacleTestParams) -> Res
             Ok(columns_of(&s.scan, &Isometry3::identity(), 255.0))
         })
         .collect::<Result<Vec<_>>>()?;
-    figures(label, &elevations, &revs, test)
+    figures(
+        label,
+        &elevations,
+        &revs,
+        firing_rate(recording.full()),
+        test,
+    )
 }
 
 /// The simulator's sensor (`config`) `height_m` above flat, empty ground of `remission`: the
@@ -312,5 +356,278 @@ pub fn synthetic(
                 + b as f64 / (n - 1).max(1) as f64 * (config.upper_fov_deg - config.lower_fov_deg)
         })
         .collect();
-    figures("synthetic HDL-32E", &elevations, &revs, test)
+    let rate = config.columns as f64 * config.rotation_frequency_hz;
+    figures("synthetic HDL-32E", &elevations, &revs, rate, test)
+}
+
+/// Firings a second over `frames`: firing sequences counted against the time from the first
+/// firing to the last (NaN with fewer than two).
+fn firing_rate(frames: &[velodyne::Frame]) -> f64 {
+    let mut firings = std::collections::BTreeSet::new();
+    let (mut first, mut last) = (f64::INFINITY, f64::NEG_INFINITY);
+    for p in frames.iter().flat_map(|f| &f.points) {
+        firings.insert(p.firing);
+        first = first.min(p.time_us);
+        last = last.max(p.time_us);
+    }
+    match (firings.first(), firings.last()) {
+        (Some(a), Some(b)) if b > a && last > first => {
+            // Firings between the first and the last, over the time between them.
+            f64::from(b - a) / ((last - first) * 1e-6)
+        }
+        _ => f64::NAN,
+    }
+}
+
+/// Low beams' sectors that miss more than this fraction are the mount's shadow (the vehicle the
+/// sensor stands on, its housing) or what stands close by: not the sensor's own misses.
+pub const SHADOW_MISS_FRACTION: f64 = 0.1;
+
+/// What the comparison says of one figure.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub enum Verdict {
+    /// A property of the sensor, calibrated: the synthetic's figure is within `tolerance` of
+    /// the real one (`holds`), by the setting `knob`.
+    Calibrated {
+        /// The tolerance, as said.
+        tolerance: String,
+        /// Whether the synthetic figure is within it.
+        holds: bool,
+        /// The setting that moves it.
+        knob: &'static str,
+    },
+    /// Not a property of the sensor alone (the scene's, the mount's) or not calibratable from
+    /// the capture: why.
+    Not(&'static str),
+}
+
+/// One row of the comparison.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    /// The figure.
+    pub figure: &'static str,
+    /// The real sensor's value.
+    pub real: String,
+    /// The synthetic sensor's value.
+    pub synthetic: String,
+    /// What the calibration claims of it.
+    pub verdict: Verdict,
+}
+
+/// Mean of the low beams' no-return fractions where `keep(elevation)`.
+fn no_return_mean(f: &Figures, keep: impl Fn(f64) -> bool) -> f64 {
+    let v: Vec<f64> = f
+        .elevations_deg
+        .iter()
+        .zip(&f.no_return)
+        .filter(|(w, _)| keep(**w))
+        .map(|(_, n)| *n)
+        .collect();
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+/// The sectors where the low beams miss more than [`SHADOW_MISS_FRACTION`].
+pub fn shadow_sectors(f: &Figures) -> Vec<bool> {
+    f.no_return_low_by_sector
+        .iter()
+        .map(|&m| m > SHADOW_MISS_FRACTION)
+        .collect()
+}
+
+/// The low beams' no-return fraction outside `shadow` (mean over the sectors).
+pub fn no_return_outside(f: &Figures, shadow: &[bool]) -> f64 {
+    let v: Vec<f64> = f
+        .no_return_low_by_sector
+        .iter()
+        .zip(shadow)
+        .filter(|(_, s)| !**s)
+        .map(|(m, _)| *m)
+        .collect();
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+/// Median relative error of the ground rings' radii against `h / tan(elevation)`, percent, and
+/// how many rings.
+fn ring_error(f: &Figures) -> Option<(f64, usize)> {
+    let mut e: Vec<f64> = f
+        .elevations_deg
+        .iter()
+        .zip(&f.ring_radius_m)
+        .filter_map(|(w, r)| {
+            let expected = f.height_m / (-w.to_radians()).tan();
+            r.map(|r| 100.0 * (r - expected) / expected)
+        })
+        .collect();
+    e.sort_by(f64::total_cmp);
+    e.get(e.len() / 2).map(|m| (*m, e.len()))
+}
+
+/// Whether `synthetic` is within `fraction` of `real`, relative.
+fn within(real: f64, synthetic: f64, fraction: f64) -> bool {
+    (synthetic - real).abs() <= fraction * real.abs()
+}
+
+/// The comparison, figure by figure, with what the calibration claims of each.
+pub fn rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
+    use Verdict::{Calibrated, Not};
+    let both = |f: &dyn Fn(&Figures) -> String| (f(real), f(synthetic));
+    let mut rows = Vec::new();
+    let mut push = |figure, (r, s): (String, String), verdict| {
+        rows.push(Row {
+            figure,
+            real: r,
+            synthetic: s,
+            verdict,
+        })
+    };
+    let (fr, fs) = (real.firings_per_second, synthetic.firings_per_second);
+    push(
+        "firings a second",
+        both(&|f| format!("{:.0}", f.firings_per_second)),
+        Calibrated {
+            tolerance: "1 %".into(),
+            holds: within(fr, fs, 0.01),
+            knob: "columns x rotation_frequency_hz",
+        },
+    );
+    push(
+        "firings a revolution",
+        both(&|f| format!("{:.0}", f.firings_per_revolution)),
+        Not("the rotation rate set on the unit: firings a second over revolutions a second"),
+    );
+    push(
+        "returns a revolution",
+        both(&|f| format!("{:.0}", f.returns_per_revolution)),
+        Not("the scene's: the real one has cars, trees and sky, the synthetic flat empty ground"),
+    );
+    let shadow = shadow_sectors(real);
+    let sectors = |f: &Figures| {
+        let s: Vec<String> = shadow_sectors(f)
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| **s)
+            .map(|(k, _)| format!("{}-{}", 30 * k, 30 * (k + 1)))
+            .collect();
+        if s.is_empty() {
+            "none".into()
+        } else {
+            s.join(", ") + " deg"
+        }
+    };
+    push(
+        "sectors where the beams 8 deg or more down miss > 10 %",
+        both(&sectors),
+        Not(
+            "the mount's shadow or what stands close by (a capture cannot tell which); the \
+             simulator casts its own vehicle",
+        ),
+    );
+    let (or, os) = (
+        no_return_outside(real, &shadow),
+        no_return_outside(synthetic, &shadow),
+    );
+    push(
+        "no return, beams 8 deg or more down, outside those sectors",
+        (
+            format!("{:.2} %", 100.0 * or),
+            format!("{:.2} %", 100.0 * os),
+        ),
+        Calibrated {
+            tolerance: "0.5 percentage point".into(),
+            holds: (os - or).abs() <= 0.005,
+            knob: "dropoff_general_rate",
+        },
+    );
+    push(
+        "no return, beams above 8 deg down (mean)",
+        both(&|f| format!("{:.1} %", 100.0 * no_return_mean(f, |w| w > -8.0))),
+        Not("the scene's: sky and far objects"),
+    );
+    push(
+        "ground returns a revolution",
+        both(&|f| format!("{:.0}", f.ground_returns_per_revolution)),
+        Not("the scene's: what stands on the ground hides it"),
+    );
+    push(
+        "height above the fitted ground; pitch, roll",
+        both(&|f| {
+            let [p, r] = f.pitch_roll_deg;
+            format!("{:.3} m; {p:.2}, {r:.2} deg", f.height_m)
+        }),
+        Not("the mount's: the synthetic sensor is put at the fitted height, level"),
+    );
+    push(
+        "ground spread about the plane (std)",
+        both(&|f| format!("{:.1} mm", 1000.0 * f.ground_spread_m)),
+        Not("the road's shape (crown, camber) against a flat plane"),
+    );
+    let (nr, ns) = (real.range_noise_m, synthetic.range_noise_m);
+    push(
+        "range noise along the beam (consecutive firings on the ground)",
+        both(&|f| format!("{:.1} mm", 1000.0 * f.range_noise_m)),
+        Calibrated {
+            tolerance: "15 %".into(),
+            holds: within(nr, ns, 0.15),
+            knob: "noise_stddev_m",
+        },
+    );
+    let (er, es) = (ring_error(real), ring_error(synthetic));
+    push(
+        "ground rings against h / tan(elevation) (median error)",
+        both(&|f| ring_error(f).map_or("-".into(), |(m, n)| format!("{m:+.1} % ({n} rings)"))),
+        Calibrated {
+            tolerance: "2 percentage points".into(),
+            holds: matches!((er, es), (Some((a, _)), Some((b, _))) if (a - b).abs() <= 2.0),
+            knob: "lower_fov_deg, upper_fov_deg (the beams' elevations)",
+        },
+    );
+    push(
+        "ground intensity 10 / 50 / 90 % (0-255)",
+        both(&|f| {
+            let d = &f.ground_intensity_deciles;
+            format!("{:.0} / {:.0} / {:.0}", d[0], d[4], d[8])
+        }),
+        Not(
+            "raw against calibrated: the mapper takes remission, which CARMEN makes from raw \
+             values with a per-laser table; the capture has no surface of known remission to \
+             make one",
+        ),
+    );
+    push(
+        "ground returns taken for obstacles a revolution: level; tilt removed; and no unsafe height",
+        both(&|f| {
+            let [a, b, c] = f.false_obstacles_per_revolution;
+            format!("{a:.0}; {b:.0}; {c:.0}")
+        }),
+        Not("the mount's tilt and the road's shape (docs/velodyne.md)"),
+    );
+    rows
+}
+
+/// The comparison as a Markdown table.
+pub fn table(real: &Figures, synthetic: &Figures) -> String {
+    use std::fmt::Write as _;
+    let mut t = format!(
+        "| figure | {} | {} | calibrated? |\n| --- | --- | --- | --- |\n",
+        real.label, synthetic.label
+    );
+    for row in rows(real, synthetic) {
+        let verdict = match &row.verdict {
+            Verdict::Calibrated {
+                tolerance,
+                holds,
+                knob,
+            } => format!(
+                "{} within {tolerance} (`{knob}`)",
+                if *holds { "yes:" } else { "NO: not" }
+            ),
+            Verdict::Not(why) => format!("not the sensor's: {why}"),
+        };
+        let _ = writeln!(
+            t,
+            "| {} | {} | {} | {verdict} |",
+            row.figure, row.real, row.synthetic
+        );
+    }
+    t
 }

@@ -2,7 +2,10 @@
 //!
 //! 32 beams from -30.67 to +10.67 deg, 2187 columns a revolution (69,984 rays), 10 Hz, 100 m,
 //! all configurable, with the parameters CARLA's ray-cast lidar users know: Gaussian range noise,
-//! intensity = remission x exp(-attenuation x distance), general and intensity-based drop-off.
+//! intensity = remission x exp(-attenuation x distance), general and intensity-based drop-off;
+//! and a constant range bias per laser, as a real unit has (its calibration's residual; off by
+//! default). The noise and drop-off defaults are calibrated on a real HDL-32E
+//! (`docs/velodyne.md`).
 //! Optionally each column is fired from the pose at its firing time (motion during the sweep).
 //!
 //! The fast path uses what all rays of a column share, their origin: the ground is the analytic
@@ -24,8 +27,9 @@ use serde::{Deserialize, Serialize};
 
 use super::physics::{Owner, World, planar_to_3d, to_pose};
 
-/// LiDAR parameters (defaults: Velodyne HDL-32E; drop-off off, CARLA's defaults being
-/// 0.45 / 0.8 / 0.4).
+/// LiDAR parameters (defaults: Velodyne HDL-32E, range noise and general drop-off calibrated
+/// on a real one; no per-laser bias; intensity-based drop-off off, CARLA's defaults being 0.45 / 0.8 /
+/// 0.4).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct LidarConfig {
@@ -41,11 +45,23 @@ pub struct LidarConfig {
     pub rotation_frequency_hz: f64,
     /// Maximum range, metres. Default 100.
     pub range_m: f64,
-    /// Standard deviation of the Gaussian range noise, metres. Default 0.02.
+    /// Standard deviation of the Gaussian range noise, fresh at every return, metres. Default
+    /// 0.004: a real HDL-32E's precision, measured on VeloView's recording (4.2 mm between one
+    /// laser's consecutive firings on the ground; `taxi-sim compare-lidar`).
     pub noise_stddev_m: f64,
+    /// Standard deviation of each laser's constant range bias, metres: drawn once per sensor
+    /// unit (`range_bias_unit`), the same every revolution. Default 0: a recording's consecutive
+    /// firings cannot see a bias, and the datasheet's +-2 cm accuracy does not say how much of it
+    /// is one (`docs/velodyne.md`: at 0.02 six closed-loop tests move).
+    pub range_bias_stddev_m: f64,
+    /// Which sensor unit: seeds the lasers' range biases (a unit's biases are the same in the
+    /// mapping drive and every run, whatever the run's seed). Default 1.
+    pub range_bias_unit: u64,
     /// Intensity attenuation with distance, 1/m (`intensity = remission exp(-a d)`). Default 0.004.
     pub atmosphere_attenuation_rate: f64,
-    /// Probability of dropping any return. Default 0.
+    /// Probability of dropping any return. Default 0.013: a real HDL-32E's low beams miss 1.3 %
+    /// of their ground returns outside its mount's shadow (VeloView's recording, `taxi-sim
+    /// compare-lidar`; 0-4 % by sector).
     pub dropoff_general_rate: f64,
     /// Returns at or above this intensity are never dropped by intensity. Default 0.8.
     pub dropoff_intensity_limit: f64,
@@ -64,9 +80,11 @@ impl Default for LidarConfig {
             columns: 2187,
             rotation_frequency_hz: 10.0,
             range_m: 100.0,
-            noise_stddev_m: 0.02,
+            noise_stddev_m: 0.004,
+            range_bias_stddev_m: 0.0,
+            range_bias_unit: 1,
             atmosphere_attenuation_rate: 0.004,
-            dropoff_general_rate: 0.0,
+            dropoff_general_rate: 0.013,
             dropoff_intensity_limit: 0.8,
             dropoff_zero_intensity: 0.0,
             motion_during_sweep: false,
@@ -97,6 +115,7 @@ impl LidarConfig {
         }
         for (f, v) in [
             ("noise_stddev_m", self.noise_stddev_m),
+            ("range_bias_stddev_m", self.range_bias_stddev_m),
             (
                 "atmosphere_attenuation_rate",
                 self.atmosphere_attenuation_rate,
@@ -273,6 +292,19 @@ impl Lidar {
     /// Rays per revolution.
     pub fn rays(&self) -> usize {
         self.config.columns * self.config.channels
+    }
+
+    /// Each beam's constant range bias, metres, lowest beam first: Gaussian with
+    /// `range_bias_stddev_m`, from the unit's own generator (`range_bias_unit`).
+    pub fn range_biases_m(&self) -> Vec<f64> {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(mix(
+            self.config.range_bias_unit,
+            u64::MAX,
+            0x6269_6173,
+        ));
+        (0..self.config.channels)
+            .map(|_| self.config.range_bias_stddev_m * rng.sample::<f64, _>(StandardNormal))
+            .collect()
     }
 
     fn column_poses(&self, sweep: &SweepPoses, c: usize) -> (Isometry2<f64>, Isometry3<f64>) {
@@ -522,6 +554,7 @@ impl Lidar {
         let self_hits = self.self_hits(world);
         let scene = world.scene();
         let ground = world.ground_texture();
+        let biases = self.range_biases_m();
         // Every column writes its own slices of the preallocated outputs: no per-column vectors
         // to join afterwards.
         let n = self.config.columns * beams;
@@ -561,13 +594,15 @@ impl Lidar {
                     cast(c, origin, dirs, hits);
                     let mut rng =
                         Xoshiro256PlusPlus::seed_from_u64(mix(seed, scan_index, c as u64));
-                    for (((ret, owner), hit), d) in returns
+                    for ((((ret, owner), hit), d), bias) in returns
                         .iter_mut()
                         .zip(owners.iter_mut())
                         .zip(hits.iter())
                         .zip(dirs.iter())
+                        .zip(&biases)
                     {
-                        self.measure(scene, ground, &mut rng, (origin, d), *hit, (ret, owner));
+                        let ray = (origin, d, *bias);
+                        self.measure(scene, ground, &mut rng, ray, *hit, (ret, owner));
                     }
                     *column = mapper::ScanColumn {
                         world_from_sensor: sensor,
@@ -584,13 +619,13 @@ impl Lidar {
         }
     }
 
-    /// One ray's return: range noise, intensity, drop-off.
+    /// One ray's return (`bias`: its laser's range bias): range noise, intensity, drop-off.
     fn measure(
         &self,
         scene: &super::scene::Scene,
         ground: &super::scene::GroundTexture,
         rng: &mut Xoshiro256PlusPlus,
-        (origin, d): (Point3<f64>, &[f32; 3]),
+        (origin, d, bias): (Point3<f64>, &[f32; 3], f64),
         hit: Option<(f32, Owner)>,
         (ret, owned): (&mut Option<mapper::Return>, &mut Option<Owner>),
     ) {
@@ -602,7 +637,7 @@ impl Lidar {
         let Some((t, owner)) = hit else {
             return; // the outputs start as None
         };
-        let noise = cfg.noise_stddev_m * z;
+        let noise = bias + cfg.noise_stddev_m * z;
         let range = (t as f64 + noise).max(0.0);
         let point = origin + Vector3::new(d[0] as f64, d[1] as f64, d[2] as f64) * range;
         let remission = match owner {

@@ -37,9 +37,11 @@ fn a_tall_box_is_mapped_far_out_and_avoided_a_flat_one_is_never_mapped() {
 }
 
 /// The jet's nose sensor maps a 0.07 m box (under the obstacle height, over the 0.05 m safe
-/// height from the ground below which nothing is an obstacle) only about 6 m ahead of
-/// itself (6.2 m seen), 16 m ahead of the main gear: at 8 m/s its gear hits the box; with the avoider capped
-/// to what stops within 15.9 m (`detection_range_m`, about 5.5 m/s) it stops short.
+/// height from the ground below which nothing is an obstacle) only about 5.7 m ahead of itself
+/// (5.65 m seen; 6.2 m with the 2 cm range noise of the sensor before its calibration, whose
+/// errors lifted the box over the test sooner), 15.4 m ahead of the main gear: at 8 m/s its gear
+/// hits the box; with the avoider capped to what stops within 15.3 m (`detection_range_m`,
+/// about 5.4 m/s) it stops short.
 #[test]
 fn a_detection_range_slows_the_jet_enough_to_stop_for_a_flat_box() {
     let run = |detection_range_m| {
@@ -58,7 +60,7 @@ fn a_detection_range_slows_the_jet_enough_to_stop_for_a_flat_box() {
     };
     let uncapped = run(None);
     assert!(uncapped.contacts > 0, "{uncapped:?}");
-    let capped = run(Some(15.9));
+    let capped = run(Some(15.3));
     assert!(capped.first_mapped_m.is_some_and(|m| m < 7.0), "{capped:?}");
     assert_eq!(
         (capped.contacts, capped.outcome.as_str()),

@@ -27,6 +27,12 @@ fn run_found_with(s: &Scenario, change: impl FnOnce(&mut RunConfig)) -> sim::eng
     run(s, &setup).unwrap()
 }
 
+/// The calibrated HDL-32E (issue 39: 4 mm of range noise, 1.3 % drop-off) in place of the
+/// sensor a case was found with (its scenario's `[config.lidar]`).
+fn calibrated_sensor(c: &mut RunConfig) {
+    c.lidar = sim::world::LidarConfig::default();
+}
+
 fn found(name: &str) -> Scenario {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("found")
@@ -183,6 +189,26 @@ fn a_truck_lost_toward_the_standing_jet_is_waited_for() {
         .map(|c| (c.contact.object.as_str(), c.contact.part.as_str()))
         .collect();
     assert_eq!(c, [("fuel_truck_1", "nacelle_left")]);
+    // FIXME (README, Known problems): with the calibrated sensor the same case is at fault again:
+    // struck standing (50.1 s), the jet then creeps at 0.055 m/s while the slow truck still
+    // touches its left nacelle. Asserted as it is.
+    let r = run_found_with(
+        &found("fuel_truck_meets_the_stopping_jets_nacelle"),
+        calibrated_sensor,
+    );
+    assert_eq!(
+        (r.contacts_struck, r.contacts_at_fault),
+        (1, 1),
+        "FIXME fixed? {:?}",
+        r.contacts_judged
+    );
+    assert!(
+        r.contacts_judged
+            .iter()
+            .all(|c| c.contact.part == "nacelle_left"),
+        "{:?}",
+        r.contacts_judged
+    );
 }
 
 /// Not a case any stack can pass, kept as the evidence for the campaign's change: a follow-me car
@@ -225,6 +251,12 @@ fn a_van_lost_behind_the_wing_holds_the_standing_jet() {
     let c = &r.contacts_judged[0].contact;
     assert_eq!((c.object.as_str(), c.part.as_str()), ("van_1", "tail_cone"));
     assert_eq!(r.end, sim::engine::EndReason::WaitingForHiddenObstacle);
+    // With the calibrated sensor the van never touches the jet.
+    let r = run_found_with(
+        &found("van_strikes_the_tail_of_the_standing_jet"),
+        calibrated_sensor,
+    );
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts_judged);
 }
 
 /// Fixed: a one-cell ghost at a crossing fuel truck's far end, 53 m off the road, seemed to
@@ -313,6 +345,14 @@ fn fixme_the_car_passes_a_container_inside_the_danger_distance() {
     let (p, closest) = container_pass(&r);
     assert!((0.15..0.2).contains(&closest), "{p:?}");
     assert!(!p.met);
+    // With the calibrated sensor (and still the true pose) it passes 0.62 m from it: the cause is
+    // not found, the 2-cm range noise brought it out.
+    let r = run_found_with(&found("parking_lot_variant_505"), |c| {
+        c.pose_source = sim::scenario::PoseSourceConfig::Truth;
+        calibrated_sensor(c);
+    });
+    let (p, closest) = container_pass(&r);
+    assert!(closest > 0.4 && p.met, "{p:?}");
 }
 
 /// With the particle filter (the default since issue #24) the same variant passes the container

@@ -1,12 +1,11 @@
 //! `taxi-sim compare-lidar`: a real Velodyne capture's figures against the simulator's HDL-32E
 //! at the same height over flat ground, as a Markdown table (and JSON with every beam).
 
-use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use anyhow::Context as _;
 use sim::scenario::RunConfig;
-use sim::studies::lidar_compare::{Figures, real, synthetic};
+use sim::studies::lidar_compare::{real, rows, synthetic, table};
 
 /// Arguments of `taxi-sim compare-lidar`.
 #[derive(Debug, Clone, clap::Args)]
@@ -60,99 +59,12 @@ pub fn run(args: &CompareLidarArgs) -> anyhow::Result<()> {
         test,
     )?;
     if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&[&real, &synthetic])?;
+        let text = serde_json::to_string_pretty(&serde_json::json!({
+            "sensors": [&real, &synthetic],
+            "rows": rows(&real, &synthetic),
+        }))?;
         mapper::write_atomically(path, text.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
     }
     crate::emit(&table(&real, &synthetic))
-}
-
-/// The two sensors side by side.
-fn table(real: &Figures, synthetic: &Figures) -> String {
-    let mut t = String::new();
-    let _ = writeln!(
-        t,
-        "| figure | {} | {} |\n| --- | --- | --- |",
-        real.label, synthetic.label
-    );
-    let mut row = |name: &str, f: &dyn Fn(&Figures) -> String| {
-        let _ = writeln!(t, "| {name} | {} | {} |", f(real), f(synthetic));
-    };
-    row("revolutions", &|f| f.revolutions.to_string());
-    row("firings a revolution", &|f| {
-        format!("{:.0}", f.firings_per_revolution)
-    });
-    row("returns a revolution", &|f| {
-        format!("{:.0}", f.returns_per_revolution)
-    });
-    row("no return, beams 8 deg or more down (mean, max)", &|f| {
-        let low: Vec<f64> = f
-            .elevations_deg
-            .iter()
-            .zip(&f.no_return)
-            .filter(|(w, _)| **w <= -8.0)
-            .map(|(_, n)| *n)
-            .collect();
-        let mean = low.iter().sum::<f64>() / low.len().max(1) as f64;
-        let max = low.iter().copied().fold(0.0, f64::max);
-        format!("{:.1} %, {:.1} %", 100.0 * mean, 100.0 * max)
-    });
-    row("no return, beams above 8 deg down (mean)", &|f| {
-        let high: Vec<f64> = f
-            .elevations_deg
-            .iter()
-            .zip(&f.no_return)
-            .filter(|(w, _)| **w > -8.0)
-            .map(|(_, n)| *n)
-            .collect();
-        format!(
-            "{:.1} %",
-            100.0 * high.iter().sum::<f64>() / high.len().max(1) as f64
-        )
-    });
-    row("ground returns a revolution", &|f| {
-        format!("{:.0}", f.ground_returns_per_revolution)
-    });
-    row("height above the fitted ground", &|f| {
-        format!("{:.3} m", f.height_m)
-    });
-    row("pitch, roll (fitted)", &|f| {
-        format!("{:.2}, {:.2} deg", f.pitch_roll_deg[0], f.pitch_roll_deg[1])
-    });
-    row("ground spread about the plane (std)", &|f| {
-        format!("{:.1} mm", 1000.0 * f.ground_spread_m)
-    });
-    row(
-        "range noise along the beam (consecutive firings on the ground)",
-        &|f| format!("{:.1} mm", 1000.0 * f.range_noise_m),
-    );
-    row(
-        "ground rings against h / tan(elevation) (median error)",
-        &|f| {
-            let mut e: Vec<f64> = f
-                .elevations_deg
-                .iter()
-                .zip(&f.ring_radius_m)
-                .filter_map(|(w, r)| {
-                    let expected = f.height_m / (-w.to_radians()).tan();
-                    r.map(|r| 100.0 * (r - expected) / expected)
-                })
-                .collect();
-            e.sort_by(f64::total_cmp);
-            e.get(e.len() / 2)
-                .map_or("-".into(), |m| format!("{m:+.1} % ({} rings)", e.len()))
-        },
-    );
-    row("ground intensity 10 / 50 / 90 % (0-255)", &|f| {
-        let d = &f.ground_intensity_deciles;
-        format!("{:.0} / {:.0} / {:.0}", d[0], d[4], d[8])
-    });
-    row(
-        "ground returns taken for obstacles a revolution: level; tilt removed; and no unsafe height",
-        &|f| {
-            let [a, b, c] = f.false_obstacles_per_revolution;
-            format!("{a:.0}; {b:.0}; {c:.0}")
-        },
-    );
-    t
 }

@@ -78,7 +78,7 @@ fn a_capture_scans_maps_and_compares() {
     let (code, out, err) = taxi_sim(&["compare-lidar", "--pcap", f]);
     assert_eq!(code, 0, "{err}");
     assert!(
-        out.contains("| height above the fitted ground | 1.800 m |"),
+        out.contains("| height above the fitted ground; pitch, roll | 1.800 m; "),
         "{out}"
     );
 }
