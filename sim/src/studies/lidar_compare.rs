@@ -469,6 +469,13 @@ fn within(real: f64, synthetic: f64, fraction: f64) -> bool {
 
 /// The comparison, figure by figure, with what the calibration claims of each.
 pub fn rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
+    let mut rows = returns_rows(real, synthetic);
+    rows.extend(ground_rows(real, synthetic));
+    rows
+}
+
+/// The rows of the firings and their returns.
+fn returns_rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
     use Verdict::{Calibrated, Not};
     let both = |f: &dyn Fn(&Figures) -> String| (f(real), f(synthetic));
     let mut rows = Vec::new();
@@ -561,6 +568,22 @@ pub fn rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
         both(&|f| format!("{:.1} mm", 1000.0 * f.ground_spread_m)),
         Not("the road's shape (crown, camber) against a flat plane"),
     );
+    rows
+}
+
+/// The rows of the ground: its noise, rings, intensity and false obstacles.
+fn ground_rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
+    use Verdict::{Calibrated, Not};
+    let both = |f: &dyn Fn(&Figures) -> String| (f(real), f(synthetic));
+    let mut rows = Vec::new();
+    let mut push = |figure, (r, s): (String, String), verdict| {
+        rows.push(Row {
+            figure,
+            real: r,
+            synthetic: s,
+            verdict,
+        })
+    };
     let (nr, ns) = (real.range_noise_m, synthetic.range_noise_m);
     push(
         "range noise along the beam (consecutive firings on the ground)",
