@@ -1,6 +1,7 @@
 //! taxi-sim's airports: an X-Plane `apt.dat` (versions 1000 through 1200) read into a local
 //! metric frame at the airport's datum, its taxi routing network, and taxi routes along named
-//! taxiways rounded into paths an aircraft can drive.
+//! taxiways, on the painted centreline where the network strays from it, rounded into paths an
+//! aircraft can drive.
 //!
 //! Pure geometry and graphs: no simulator, renderer or scenario files (`sim` builds a world from
 //! an [`Airport`]).
@@ -11,6 +12,7 @@ mod error;
 pub mod geodesy;
 pub mod model;
 pub mod network;
+pub mod paint;
 pub mod path;
 pub mod route;
 mod row;
@@ -21,5 +23,5 @@ pub use geodesy::{LatLon, LocalFrame};
 pub use model::{Airport, Pavement, Runway, Sign, Stand, Surface};
 pub use network::{Edge, EdgeClass, Network, Node};
 pub use path::{PathOptions, TaxiPath, smooth};
-pub use route::{NetworkRoute, Place, RouteRequest, find, hold_points};
+pub use route::{NetworkRoute, Place, RouteRequest, find, find_on_network, hold_points};
 pub use size::SizeClass;

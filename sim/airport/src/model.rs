@@ -105,10 +105,31 @@ pub struct LineRun {
     pub points: Vec<Vector2<f64>>,
 }
 
-/// Painted line types (a few): what the localizer and the picture use.
+/// Painted line types (a few): what the localizer, the picture and the routes use (apt.dat's line
+/// type table: 1-9 yellow markings, 51-59 the same with a black border for contrast).
 pub mod line_type {
     /// Solid yellow taxiway centreline.
     pub const TAXIWAY_CENTRELINE: u32 = 1;
+    /// Solid yellow centreline with a broken yellow line each side: a taxiway centreline in a
+    /// runway's safety zone.
+    pub const SAFETY_ZONE_CENTRELINE: u32 = 7;
+    /// [`TAXIWAY_CENTRELINE`] with a black border.
+    pub const TAXIWAY_CENTRELINE_BORDERED: u32 = 51;
+    /// [`SAFETY_ZONE_CENTRELINE`] with a black border.
+    pub const SAFETY_ZONE_CENTRELINE_BORDERED: u32 = 57;
+
+    /// Whether line type `code` is a painted taxiway centreline (1, 7, 51, 57): the line pilots
+    /// taxi along.
+    #[must_use]
+    pub fn is_taxiway_centreline(code: u32) -> bool {
+        matches!(
+            code,
+            TAXIWAY_CENTRELINE
+                | SAFETY_ZONE_CENTRELINE
+                | TAXIWAY_CENTRELINE_BORDERED
+                | SAFETY_ZONE_CENTRELINE_BORDERED
+        )
+    }
     /// Runway hold-short line (two solid, two dashed yellow).
     pub const RUNWAY_HOLD: u32 = 4;
     /// Taxiway edge (double solid yellow).

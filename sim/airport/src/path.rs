@@ -46,7 +46,7 @@ const ARC_CHORD_M: f64 = 1.0;
 /// straight's braking into the next turn needs points along it.
 const STRAIGHT_STEP_M: f64 = 5.0;
 /// Corners turning less than this are left as they are (rad).
-const STRAIGHT_RAD: f64 = 1e-4;
+pub(crate) const STRAIGHT_RAD: f64 = 1e-4;
 
 /// Rounds `route` and gives it its speeds.
 ///
@@ -57,32 +57,11 @@ pub fn smooth(route: &NetworkRoute, options: &PathOptions) -> Result<TaxiPath, A
     let p = &route.points;
     let n = p.len();
     let legs: Vec<f64> = p.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
-    let mut deflection = vec![0.0; n];
-    let mut wanted = vec![0.0; n];
-    for i in 1..n.saturating_sub(1) {
-        let (u, v) = ((p[i] - p[i - 1]).normalize(), (p[i + 1] - p[i]).normalize());
-        deflection[i] = u.dot(&v).clamp(-1.0, 1.0).acos();
-        // The arc's middle lies r (1 / cos(d/2) - 1) inside the corner.
-        let cut_per_m = 1.0 / (deflection[i] / 2.0).cos() - 1.0;
-        let radius = if cut_per_m > 0.0 {
-            options
-                .turn_radius_m
-                .min(options.max_corner_cut_m / cut_per_m)
-        } else {
-            options.turn_radius_m
-        };
-        wanted[i] = radius.max(options.min_turn_radius_m) * (deflection[i] / 2.0).tan();
-    }
-    // Each leg is shared between its two corners in proportion to what they want of it.
-    let mut tangent = wanted.clone();
-    for i in 1..n.saturating_sub(1) {
-        for leg in [i - 1, i] {
-            let demand = wanted[leg] + wanted[leg + 1];
-            if demand > legs[leg] {
-                tangent[i] = tangent[i].min(legs[leg] * wanted[i] / demand);
-            }
-        }
-    }
+    let Corners {
+        deflection,
+        tangent,
+        ..
+    } = corners(p, options);
     let mut points = vec![p[0]];
     let mut curvature = vec![0.0];
     let mut tightest = f64::INFINITY;
@@ -144,6 +123,55 @@ pub fn smooth(route: &NetworkRoute, options: &PathOptions) -> Result<TaxiPath, A
         tightest_radius_m: tightest,
         length_m,
     })
+}
+
+/// Each corner of a polyline as [`smooth`] rounds it (the ends' entries are 0).
+#[derive(Debug, Clone)]
+pub(crate) struct Corners {
+    /// Deflection from straight on (rad).
+    pub deflection: Vec<f64>,
+    /// How far along each leg the fillet would reach with the legs to itself (m).
+    pub wanted: Vec<f64>,
+    /// How far it reaches, each leg shared between its two corners in proportion to what they
+    /// want of it (m); the fillet's radius is `tangent / tan(deflection / 2)`.
+    pub tangent: Vec<f64>,
+}
+
+/// The fillets of `p`'s corners as [`smooth`] makes them.
+pub(crate) fn corners(p: &[Vector2<f64>], options: &PathOptions) -> Corners {
+    let n = p.len();
+    let legs: Vec<f64> = p.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
+    let mut deflection = vec![0.0; n];
+    let mut wanted = vec![0.0; n];
+    for i in 1..n.saturating_sub(1) {
+        let (u, v) = ((p[i] - p[i - 1]).normalize(), (p[i + 1] - p[i]).normalize());
+        deflection[i] = u.dot(&v).clamp(-1.0, 1.0).acos();
+        // The arc's middle lies r (1 / cos(d/2) - 1) inside the corner.
+        let cut_per_m = 1.0 / (deflection[i] / 2.0).cos() - 1.0;
+        let radius = if cut_per_m > 0.0 {
+            options
+                .turn_radius_m
+                .min(options.max_corner_cut_m / cut_per_m)
+        } else {
+            options.turn_radius_m
+        };
+        wanted[i] = radius.max(options.min_turn_radius_m) * (deflection[i] / 2.0).tan();
+    }
+    // Each leg is shared between its two corners in proportion to what they want of it.
+    let mut tangent = wanted.clone();
+    for i in 1..n.saturating_sub(1) {
+        for leg in [i - 1, i] {
+            let demand = wanted[leg] + wanted[leg + 1];
+            if demand > legs[leg] {
+                tangent[i] = tangent[i].min(legs[leg] * wanted[i] / demand);
+            }
+        }
+    }
+    Corners {
+        deflection,
+        wanted,
+        tangent,
+    }
 }
 
 /// Points every [`STRAIGHT_STEP_M`] from the last point toward `to` (`to` left out).

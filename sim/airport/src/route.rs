@@ -2,7 +2,9 @@
 //! node, along the named taxiways in order; the shortest such path on the network that admits
 //! the aircraft's code letter, keeps one-way edges' direction, never enters the zone of the
 //! runway it is bound for, and never turns back on itself or through more than
-//! [`MAX_DEFLECTION_DEG`] at a node. `smooth` then rounds it into a path the aircraft can drive.
+//! [`MAX_DEFLECTION_DEG`] at a node; then moved onto the painted taxiway centreline where the
+//! network strays from it ([`crate::paint`]). `smooth` then rounds it into a path the aircraft
+//! can drive.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -70,7 +72,7 @@ pub struct RouteRequest {
     pub code: SizeClass,
 }
 
-/// A route on the network, before smoothing.
+/// A route on the network (moved onto the paint by [`find`]), before smoothing.
 #[derive(Debug, Clone)]
 pub struct NetworkRoute {
     /// Where it starts, as asked.
@@ -78,10 +80,15 @@ pub struct NetworkRoute {
     /// Where it ends, as asked.
     pub to: String,
     /// Its corner points: start, the nodes passed, end (a stand: the point on the taxilane
-    /// abeam it, then the stand).
+    /// abeam it, then the stand); following the paint, the points between where it leaves and
+    /// rejoins a network edge's line.
     pub points: Vec<Vector2<f64>>,
-    /// The network node of each point, if it is one.
+    /// The network node of each point, if it is one (where the paint moved it, a node is no
+    /// longer exactly at the network's position).
     pub nodes: Vec<Option<usize>>,
+    /// The network edge each leg (`points[i]` to `points[i + 1]`) runs along; `None` for the
+    /// lead-in to a stand.
+    pub edges: Vec<Option<usize>>,
     /// Taxiway names in the order driven (each run once).
     pub taxiways: Vec<String>,
     /// Runway ends whose zones it enters on the way (runway crossings).
@@ -126,12 +133,25 @@ impl Graph<'_> {
     }
 }
 
-/// Finds the route asked for on `airport`'s network.
+/// Finds the route asked for on `airport`'s network and moves it onto the painted taxiway
+/// centreline where the network strays from it ([`crate::paint::follow`]).
+///
+/// # Errors
+/// As [`find_on_network`].
+pub fn find(airport: &Airport, request: &RouteRequest) -> Result<NetworkRoute, AirportError> {
+    find_on_network(airport, request).map(|route| crate::paint::follow(airport, &route))
+}
+
+/// Finds the route asked for on `airport`'s network: its geometry is the network's (nodes and
+/// straight edges), as the file draws it.
 ///
 /// # Errors
 /// A place or taxiway name that is not there, or no path admitting the code (`AirportError::Route`,
 /// saying which).
-pub fn find(airport: &Airport, request: &RouteRequest) -> Result<NetworkRoute, AirportError> {
+pub fn find_on_network(
+    airport: &Airport,
+    request: &RouteRequest,
+) -> Result<NetworkRoute, AirportError> {
     let network = &airport.network;
     let fail = |why: String| AirportError::Route {
         from: request.from.to_string(),
@@ -598,6 +618,7 @@ fn assemble(
     let node_of = |p: usize| (p < network.nodes.len()).then_some(p);
     let mut points = vec![graph.points[start]];
     let mut nodes = vec![node_of(start)];
+    let mut edges = Vec::new();
     let mut taxiways: Vec<String> = Vec::new();
     let mut crossings: Vec<String> = Vec::new();
     for &a in arcs {
@@ -606,6 +627,7 @@ fn assemble(
         if (graph.points[arc.head] - points[points.len() - 1]).norm() > 1e-6 {
             points.push(graph.points[arc.head]);
             nodes.push(node_of(arc.head));
+            edges.push(Some(arc.edge));
         }
         if !edge.name.is_empty() && taxiways.last() != Some(&edge.name) {
             taxiways.push(edge.name.clone());
@@ -619,6 +641,7 @@ fn assemble(
     if let Some(stand) = lead_in {
         points.push(stand);
         nodes.push(None);
+        edges.push(None);
     }
     let length_m = points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
     NetworkRoute {
@@ -626,6 +649,7 @@ fn assemble(
         to: String::new(),
         points,
         nodes,
+        edges,
         taxiways,
         crossings,
         length_m,

@@ -24,7 +24,7 @@ pub struct PlannedTaxi {
     pub vehicle: String,
     /// Its code letter.
     pub code: SizeClass,
-    /// The route on the network.
+    /// The route: on the network, moved onto the painted centreline where the network strays.
     pub route: NetworkRoute,
     /// The path driven, with its speed limits.
     pub path: TaxiPath,
@@ -57,7 +57,7 @@ impl PlannedTaxi {
             .fold(f64::INFINITY, f64::min);
         let _ = writeln!(
             out,
-            "  {:.0} m on the network, {:.0} m driven; {} corner points; tightest turn {:.1} m; speed {:.1} m/s on straights, down to {:.1} in turns{}",
+            "  {:.0} m along the taxiways, {:.0} m driven; {} corner points; tightest turn {:.1} m; speed {:.1} m/s on straights, down to {:.1} in turns{}",
             self.route.length_m,
             self.path.length_m,
             self.route.points.len(),
@@ -110,7 +110,19 @@ pub fn plan_taxi(
         lateral_acceleration_m_s2: motion.max_centripetal_acceleration_m_s2,
         deceleration_m_s2: 0.5 * motion.max_deceleration_m_s2,
     };
-    let path = airport::smooth(&route, &options).map_err(|e| Error::Invalid(e.to_string()))?;
+    // On the paint where the network strays; should the paint's line not round for this
+    // aircraft (its turn radius) where the network's does, the network's own line.
+    let (route, path) = match airport::smooth(&route, &options) {
+        Ok(path) => (route, path),
+        Err(on_paint) => {
+            let network = airport::find_on_network(airport, &request)
+                .map_err(|e| Error::Invalid(e.to_string()))?;
+            match airport::smooth(&network, &options) {
+                Ok(path) => (network, path),
+                Err(_) => return Err(Error::Invalid(on_paint.to_string())),
+            }
+        }
+    };
     Ok(PlannedTaxi {
         vehicle: vehicle.spec.name.clone(),
         code,

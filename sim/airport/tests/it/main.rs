@@ -4,6 +4,7 @@
 
 mod fixture;
 mod malformed;
+mod paint;
 mod routes;
 mod shared_data;
 mod small_airports;

@@ -3,7 +3,9 @@
 
 use std::path::PathBuf;
 
-use airport::{Airport, PathOptions, Place, RouteRequest, SizeClass};
+use airport::paint::{MAX_OFFSET_M, centrelines};
+use airport::{Airport, NetworkRoute, PathOptions, Place, RouteRequest, SizeClass};
+use nalgebra::Vector2;
 
 fn ksyr_path() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/airports/KSYR/apt.dat")
@@ -89,22 +91,18 @@ fn ksyr_routes_from_a_gate_to_runway_28() {
         code: SizeClass::C,
     };
     let route = airport::find(&a, &request).expect("route");
-    let path = airport::smooth(
-        &route,
-        &PathOptions {
-            turn_radius_m: 30.0,
-            max_corner_cut_m: 2.5,
-            min_turn_radius_m: 12.0,
-            straight_speed_m_s: 8.0,
-            lateral_acceleration_m_s2: 1.0,
-            deceleration_m_s2: 0.5,
-        },
-    )
-    .expect("path");
-    // Along F, T, B, A1 and A to the hold point nearest 28's threshold, across runway 15/33.
+    let path = airport::smooth(&route, &options(12.0)).expect("path");
+    // Along F, T, B, A1 and A to the hold point nearest 28's threshold, across runway 15/33:
+    // 1,619 m on the network, 1,622 m on the paint where the network strays from it.
     assert_eq!(route.taxiways, ["F", "T", "B", "A1", "A"]);
     assert_eq!(route.crossings, ["15", "33"]);
-    assert!((route.length_m - 1619.0).abs() < 1.0, "{}", route.length_m);
+    let network = airport::find_on_network(&a, &request).expect("route");
+    assert!(
+        (network.length_m - 1619.0).abs() < 1.0,
+        "{}",
+        network.length_m
+    );
+    assert!((route.length_m - 1622.1).abs() < 1.0, "{}", route.length_m);
     assert!(
         path.length_m < route.length_m && path.tightest_radius_m >= 12.0,
         "{} m, {} m radius",
@@ -153,4 +151,171 @@ fn ksyr_routes_keep_off_other_runways_and_join_neighbouring_gates() {
             "hold node {h} is not where a taxiway in no runway's zone begins"
         );
     }
+}
+
+fn options(min_turn_radius_m: f64) -> PathOptions {
+    PathOptions {
+        turn_radius_m: 30.0,
+        max_corner_cut_m: 2.5,
+        min_turn_radius_m,
+        straight_speed_m_s: 8.0,
+        lateral_acceleration_m_s2: 1.0,
+        deceleration_m_s2: 0.5,
+    }
+}
+
+fn segment_distance(p: Vector2<f64>, a: Vector2<f64>, b: Vector2<f64>) -> f64 {
+    let d = b - a;
+    let t = ((p - a).dot(&d) / d.norm_squared().max(1e-12)).clamp(0.0, 1.0);
+    (a + d * t - p).norm()
+}
+
+/// Points along a polyline at most `step` apart.
+fn samples(line: &[Vector2<f64>], step: f64) -> Vec<Vector2<f64>> {
+    let mut out = Vec::new();
+    for w in line.windows(2) {
+        let n = ((w[1] - w[0]).norm() / step).ceil().max(1.0) as usize;
+        out.extend((0..n).map(|k| w[0] + (w[1] - w[0]) * (k as f64 / n as f64)));
+    }
+    out.extend(line.last().copied());
+    out
+}
+
+/// The route's points from node `from` to node `to` (ids).
+fn between(a: &Airport, r: &NetworkRoute, from: u32, to: u32) -> Vec<Vector2<f64>> {
+    let at = |id: u32| {
+        let k = a.network.node_by_id(id).expect("node");
+        r.nodes
+            .iter()
+            .position(|&n| n == Some(k))
+            .expect("on the route")
+    };
+    r.points[at(from)..=at(to)].to_vec()
+}
+
+/// The found scenario `tests/found/ksyr_gear_meets_an_edge_light_on_w.toml` (node 123 to runway
+/// 33 along W, the Praetor-like jet: code B): KSYR's network runs W 9-14 m off its painted
+/// centreline near the runway 10/28 crossing, and the jet's main gear met an edge light there.
+/// On the paint, the route from node 123 across the runway to node 124 stays within 1.5 m of the
+/// centreline (0.2 m; 9.7 m on the network), and node 141 - on the runway's centreline - moves
+/// the 13.6 m along it to where W's paint crosses it.
+#[test]
+#[ignore = "reads ../shared/data"]
+fn shared_data_ksyr_w_follows_its_painted_centreline_across_runway_10_28() {
+    let a = ksyr();
+    let request = RouteRequest {
+        from: Place::parse("node 123"),
+        to: Place::parse("runway 33"),
+        via: vec!["W".to_string()],
+        code: SizeClass::B,
+    };
+    let network = airport::find_on_network(&a, &request).expect("route");
+    let route = airport::find(&a, &request).expect("route");
+    assert_eq!(route.taxiways, ["W"]);
+    // Bound for runway 33: the hold point stays where the network has it.
+    assert_eq!(route.points.last(), network.points.last());
+    let paint: Vec<(Vector2<f64>, Vector2<f64>)> = centrelines(&a)
+        .iter()
+        .flat_map(|run| run.windows(2).map(|w| (w[0], w[1])).collect::<Vec<_>>())
+        .collect();
+    let off_paint = |r: &NetworkRoute| {
+        samples(&between(&a, r, 123, 124), 0.5)
+            .iter()
+            .map(|&p| {
+                paint
+                    .iter()
+                    .map(|&(x, y)| segment_distance(p, x, y))
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(0.0, f64::max)
+    };
+    let (before, after) = (off_paint(&network), off_paint(&route));
+    println!(
+        "node 123 -> 124 across 10/28: furthest from the paint {before:.2} m on the network, {after:.2} m on the paint"
+    );
+    assert!(before > 9.0, "{before}");
+    assert!(after < 1.5, "{after}");
+    // Node 141 on W's paint where it crosses runway 10/28's centreline, 13.6 m from the network's.
+    let k = a.network.node_by_id(141).expect("node 141");
+    let moved = route.points[route.nodes.iter().position(|&n| n == Some(k)).expect("141")];
+    let runway = a
+        .runways
+        .iter()
+        .find(|r| r.name() == "10/28")
+        .expect("10/28");
+    let on_centreline = segment_distance(moved, runway.ends[0].at, runway.ends[1].at);
+    let from_network = (moved - a.network.nodes[k].at).norm();
+    assert!(on_centreline < 0.05, "{on_centreline}");
+    assert!((from_network - 13.6).abs() < 0.3, "{from_network}");
+    // Never further from the network than the limit; rounded as the jet turns.
+    for p in samples(&route.points, 0.5) {
+        let d = network
+            .points
+            .windows(2)
+            .map(|w| segment_distance(p, w[0], w[1]))
+            .fold(f64::INFINITY, f64::min);
+        assert!(d <= MAX_OFFSET_M + 1e-9, "{p}: {d}");
+    }
+    for min in [4.6, 12.0] {
+        airport::smooth(&route, &options(min)).unwrap_or_else(|e| panic!("{e}"));
+    }
+}
+
+/// Every route between KSYR's stands and runway ends, and between every fifth network node: on
+/// the paint, never further from the network's route than [`MAX_OFFSET_M`], and rounded
+/// wherever the network's is (for an aircraft turning no tighter than 4.6 m or 12 m).
+#[test]
+#[ignore = "reads ../shared/data"]
+fn shared_data_ksyr_routes_on_the_paint_stay_near_the_network_and_round() {
+    let a = ksyr();
+    let mut places: Vec<String> = a.stands.iter().map(|s| s.name.clone()).collect();
+    for r in &a.runways {
+        places.extend(r.ends.iter().map(|e| format!("runway {}", e.number)));
+    }
+    places.extend(
+        a.network
+            .nodes
+            .iter()
+            .step_by(5)
+            .map(|n| format!("node {}", n.id)),
+    );
+    let (mut routes, mut moved) = (0, 0);
+    for from in &places {
+        for to in places.iter().filter(|&t| t != from) {
+            let request = RouteRequest {
+                from: Place::parse(from),
+                to: Place::parse(to),
+                via: Vec::new(),
+                code: SizeClass::B,
+            };
+            let (Ok(network), Ok(route)) = (
+                airport::find_on_network(&a, &request),
+                airport::find(&a, &request),
+            ) else {
+                continue;
+            };
+            routes += 1;
+            moved += usize::from(route.points != network.points);
+            assert_eq!(
+                (route.edges.len() + 1, route.nodes.len()),
+                (route.points.len(), route.points.len())
+            );
+            for p in samples(&route.points, 1.0) {
+                let d = network
+                    .points
+                    .windows(2)
+                    .map(|w| segment_distance(p, w[0], w[1]))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(d <= MAX_OFFSET_M + 1e-9, "{from} -> {to}: {p} is {d} m off");
+            }
+            for min in [4.6, 12.0] {
+                if airport::smooth(&network, &options(min)).is_ok() {
+                    airport::smooth(&route, &options(min))
+                        .unwrap_or_else(|e| panic!("{from} -> {to}: {e}"));
+                }
+            }
+        }
+    }
+    println!("{routes} routes, {moved} moved onto the paint");
+    assert!(routes > 2000 && moved > routes / 2, "{routes} {moved}");
 }

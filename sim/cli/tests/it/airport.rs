@@ -30,7 +30,7 @@ fn show_summarises_routes_and_draws_the_fictional_airport() {
         "taxi network: 15 nodes, 17 edges (1 code B, 14 code C, 2 runway, 2 one-way), 4.2 km, 1 component(s)",
         "stands (4): 1 gate code B, 2 gate code C, 1 tie_down code A",
         "route stand S3 -> runway 27 via B, A (praetor600, code B)",
-        "1015 m on the network, 1007 m driven",
+        "1015 m along the taxiways, 1007 m driven",
         "tightest turn 6.0 m; speed 6.0 m/s on straights, down to 2.5 in turns",
     ] {
         assert!(out.contains(line), "{line}\n{out}");
