@@ -474,37 +474,64 @@ pub fn rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
     rows
 }
 
+/// The rows being written, with both sensors' figures at hand.
+struct Rows<'a> {
+    real: &'a Figures,
+    synthetic: &'a Figures,
+    rows: Vec<Row>,
+}
+
+impl<'a> Rows<'a> {
+    fn new(real: &'a Figures, synthetic: &'a Figures) -> Self {
+        Rows {
+            real,
+            synthetic,
+            rows: Vec::new(),
+        }
+    }
+
+    /// A figure of each sensor.
+    fn both(&self, f: &dyn Fn(&Figures) -> String) -> (String, String) {
+        (f(self.real), f(self.synthetic))
+    }
+
+    fn push(
+        &mut self,
+        figure: &'static str,
+        (real, synthetic): (String, String),
+        verdict: Verdict,
+    ) {
+        self.rows.push(Row {
+            figure,
+            real,
+            synthetic,
+            verdict,
+        });
+    }
+}
+
 /// The rows of the firings and their returns.
 fn returns_rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
     use Verdict::{Calibrated, Not};
-    let both = |f: &dyn Fn(&Figures) -> String| (f(real), f(synthetic));
-    let mut rows = Vec::new();
-    let mut push = |figure, (r, s): (String, String), verdict| {
-        rows.push(Row {
-            figure,
-            real: r,
-            synthetic: s,
-            verdict,
-        })
-    };
+    let mut t = Rows::new(real, synthetic);
     let (fr, fs) = (real.firings_per_second, synthetic.firings_per_second);
-    push(
+    t.push(
         "firings a second",
-        both(&|f| format!("{:.0}", f.firings_per_second)),
+        t.both(&|f| format!("{:.0}", f.firings_per_second)),
         Calibrated {
             tolerance: "1 %".into(),
             holds: within(fr, fs, 0.01),
             knob: "columns x rotation_frequency_hz",
         },
     );
-    push(
+    t.push(
         "firings a revolution",
-        both(&|f| format!("{:.0}", f.firings_per_revolution)),
+        t.both(&|f| format!("{:.0}", f.firings_per_revolution)),
         Not("the rotation rate set on the unit: firings a second over revolutions a second"),
     );
-    push(
+    t.push(
         "returns a revolution",
-        both(&|f| format!("{:.0}", f.returns_per_revolution)),
+        t.both(&|f| format!("{:.0}", f.returns_per_revolution)),
         Not("the scene's: the real one has cars, trees and sky, the synthetic flat empty ground"),
     );
     let shadow = shadow_sectors(real);
@@ -521,9 +548,9 @@ fn returns_rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
             s.join(", ") + " deg"
         }
     };
-    push(
+    t.push(
         "sectors where the beams 8 deg or more down miss > 10 %",
-        both(&sectors),
+        t.both(&sectors),
         Not(
             "the mount's shadow or what stands close by (a capture cannot tell which); the \
              simulator casts its own vehicle",
@@ -533,7 +560,7 @@ fn returns_rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
         no_return_outside(real, &shadow),
         no_return_outside(synthetic, &shadow),
     );
-    push(
+    t.push(
         "no return, beams 8 deg or more down, outside those sectors",
         (
             format!("{:.2} %", 100.0 * or),
@@ -545,49 +572,40 @@ fn returns_rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
             knob: "dropoff_general_rate",
         },
     );
-    push(
+    t.push(
         "no return, beams above 8 deg down (mean)",
-        both(&|f| format!("{:.1} %", 100.0 * no_return_mean(f, |w| w > -8.0))),
+        t.both(&|f| format!("{:.1} %", 100.0 * no_return_mean(f, |w| w > -8.0))),
         Not("the scene's: sky and far objects"),
     );
-    push(
+    t.push(
         "ground returns a revolution",
-        both(&|f| format!("{:.0}", f.ground_returns_per_revolution)),
+        t.both(&|f| format!("{:.0}", f.ground_returns_per_revolution)),
         Not("the scene's: what stands on the ground hides it"),
     );
-    push(
+    t.push(
         "height above the fitted ground; pitch, roll",
-        both(&|f| {
+        t.both(&|f| {
             let [p, r] = f.pitch_roll_deg;
             format!("{:.3} m; {p:.2}, {r:.2} deg", f.height_m)
         }),
         Not("the mount's: the synthetic sensor is put at the fitted height, level"),
     );
-    push(
+    t.push(
         "ground spread about the plane (std)",
-        both(&|f| format!("{:.1} mm", 1000.0 * f.ground_spread_m)),
+        t.both(&|f| format!("{:.1} mm", 1000.0 * f.ground_spread_m)),
         Not("the road's shape (crown, camber) against a flat plane"),
     );
-    rows
+    t.rows
 }
 
 /// The rows of the ground: its noise, rings, intensity and false obstacles.
 fn ground_rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
     use Verdict::{Calibrated, Not};
-    let both = |f: &dyn Fn(&Figures) -> String| (f(real), f(synthetic));
-    let mut rows = Vec::new();
-    let mut push = |figure, (r, s): (String, String), verdict| {
-        rows.push(Row {
-            figure,
-            real: r,
-            synthetic: s,
-            verdict,
-        })
-    };
+    let mut t = Rows::new(real, synthetic);
     let (nr, ns) = (real.range_noise_m, synthetic.range_noise_m);
-    push(
+    t.push(
         "range noise along the beam (consecutive firings on the ground)",
-        both(&|f| format!("{:.1} mm", 1000.0 * f.range_noise_m)),
+        t.both(&|f| format!("{:.1} mm", 1000.0 * f.range_noise_m)),
         Calibrated {
             tolerance: "15 %".into(),
             holds: within(nr, ns, 0.15),
@@ -595,18 +613,18 @@ fn ground_rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
         },
     );
     let (er, es) = (ring_error(real), ring_error(synthetic));
-    push(
+    t.push(
         "ground rings against h / tan(elevation) (median error)",
-        both(&|f| ring_error(f).map_or("-".into(), |(m, n)| format!("{m:+.1} % ({n} rings)"))),
+        t.both(&|f| ring_error(f).map_or("-".into(), |(m, n)| format!("{m:+.1} % ({n} rings)"))),
         Calibrated {
             tolerance: "2 percentage points".into(),
             holds: matches!((er, es), (Some((a, _)), Some((b, _))) if (a - b).abs() <= 2.0),
             knob: "lower_fov_deg, upper_fov_deg (the beams' elevations)",
         },
     );
-    push(
+    t.push(
         "ground intensity 10 / 50 / 90 % (0-255)",
-        both(&|f| {
+        t.both(&|f| {
             let d = &f.ground_intensity_deciles;
             format!("{:.0} / {:.0} / {:.0}", d[0], d[4], d[8])
         }),
@@ -616,15 +634,15 @@ fn ground_rows(real: &Figures, synthetic: &Figures) -> Vec<Row> {
              make one",
         ),
     );
-    push(
+    t.push(
         "ground returns taken for obstacles a revolution: level; tilt removed; and no unsafe height",
-        both(&|f| {
+        t.both(&|f| {
             let [a, b, c] = f.false_obstacles_per_revolution;
             format!("{a:.0}; {b:.0}; {c:.0}")
         }),
         Not("the mount's tilt and the road's shape (docs/velodyne.md)"),
     );
-    rows
+    t.rows
 }
 
 /// The comparison as a Markdown table.
