@@ -104,10 +104,14 @@ impl Recording {
 }
 
 /// How `map --pcap` places the sensor.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Placement {
-    /// Where the sensor stands (azimuth 0 along the heading).
+    /// Where the sensor stands (azimuth 0 along the heading), when `poses` is empty.
     pub pose: Isometry2<f64>,
+    /// A moving sensor's poses, `(time, pose)` in time order, time in seconds on the sensor's
+    /// clock (its packets' timestamps: seconds past the hour); each revolution is placed at the
+    /// pose interpolated at its middle firing ([`revolution_poses`]). Empty: standing at `pose`.
+    pub poses: Vec<(f64, Isometry2<f64>)>,
     /// Its height above the ground, metres (`None`: the fitted ground's).
     pub height_m: Option<f64>,
     /// Remove the tilt fitted to the ground (the mount's pitch and roll); else level.
@@ -162,11 +166,14 @@ pub fn map_from_pcap(
     }
     let blocks_dir = out.join("blocks");
     crate::offline_map::clear_blocks(&blocks_dir)?;
-    let center = Point2::from(placement.pose.translation.vector);
+    let poses = revolution_poses(full, placement)
+        .map_err(|e| Error::Invalid(format!("{}: {e}", pcap.display())))?;
+    let center = Point2::from(poses[0].translation.vector);
     let mut map =
         MultiHeightMap::with_stores(config, levels.clone(), center, None, Some(&blocks_dir))?;
-    for (i, frame) in full.iter().enumerate() {
-        let scan = recording.scan(frame, &placement.pose, &vehicle_from_sensor)?;
+    for (i, (frame, pose)) in full.iter().zip(&poses).enumerate() {
+        let scan = recording.scan(frame, pose, &vehicle_from_sensor)?;
+        map.recenter(Point2::from(pose.translation.vector))?;
         map.insert_scan(&scan.scan, None)?;
         progress(i as u64 + 1, full.len() as u64);
     }
@@ -188,6 +195,105 @@ pub fn map_from_pcap(
         ground,
         vehicle_from_sensor,
     })
+}
+
+/// Each revolution's pose: `placement.pose` for a standing sensor; for a moving one the pose
+/// of `placement.poses` at the revolution's middle firing, position and heading interpolated
+/// linearly (the heading the short way round). Motion within a revolution is not undone: every
+/// firing of a revolution is placed at its middle's pose. A revolution outside the poses' time
+/// span is an error naming it and its time.
+pub fn revolution_poses(
+    frames: &[Frame],
+    placement: &Placement,
+) -> std::result::Result<Vec<Isometry2<f64>>, String> {
+    if placement.poses.is_empty() {
+        return Ok(vec![placement.pose; frames.len()]);
+    }
+    let track = &placement.poses;
+    frames
+        .iter()
+        .enumerate()
+        .map(|(i, frame)| {
+            let mut times: Vec<f64> = frame.points.iter().map(|p| p.time_us * 1e-6).collect();
+            times.sort_by(f64::total_cmp);
+            let t = *times
+                .get(times.len() / 2)
+                .ok_or_else(|| format!("full revolution {i} has no return to time it by"))?;
+            let (first, last) = (track[0].0, track[track.len() - 1].0);
+            if !(first..=last).contains(&t) {
+                return Err(format!(
+                    "full revolution {i} (at {t:.6} s on the sensor's clock) is outside the poses'                      {first:.6}-{last:.6} s"
+                ));
+            }
+            let k = track.partition_point(|(s, _)| *s <= t).clamp(1, track.len() - 1);
+            let ((t0, a), (t1, b)) = (track[k - 1], track[k]);
+            let f = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+            let xy = a.translation.vector.lerp(&b.translation.vector, f);
+            let turn = crate::world::wrap_angle(b.rotation.angle() - a.rotation.angle());
+            Ok(Isometry2::new(xy, a.rotation.angle() + f * turn))
+        })
+        .collect()
+}
+
+/// Reads a poses file for `map --pcap --poses`: CSV with the header `time_s,x_m,y_m,yaw_deg`
+/// (time in seconds on the sensor's clock, position in metres, heading in degrees), at least
+/// two rows, times strictly increasing. A wrong line is an error naming the file, the line and
+/// the field.
+pub fn read_poses_csv(path: &Path) -> Result<Vec<(f64, Isometry2<f64>)>> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        what: "reading the poses",
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let bad = |line: usize, why: String| {
+        Error::Invalid(format!("{}: line {line}: {why}", path.display()))
+    };
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    const HEADER: [&str; 4] = ["time_s", "x_m", "y_m", "yaw_deg"];
+    match lines.next() {
+        Some((_, h)) if h.split(',').map(str::trim).eq(HEADER) => {}
+        Some((i, h)) => {
+            return Err(bad(
+                i + 1,
+                format!("the header is `{h}`, want `{}`", HEADER.join(",")),
+            ));
+        }
+        None => return Err(bad(1, "empty: want a header and two poses or more".into())),
+    }
+    let mut poses: Vec<(f64, Isometry2<f64>)> = Vec::new();
+    for (i, line) in lines {
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        if fields.len() != HEADER.len() {
+            return Err(bad(i + 1, format!("{} fields, want 4", fields.len())));
+        }
+        let mut v = [0.0; 4];
+        for (k, (field, name)) in fields.iter().zip(HEADER).enumerate() {
+            v[k] = field
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| bad(i + 1, format!("{name}: `{field}` is not a finite number")))?;
+        }
+        if let Some((t, _)) = poses.last()
+            && v[0] <= *t
+        {
+            return Err(bad(i + 1, format!("time_s: {} is not after {t}", v[0])));
+        }
+        poses.push((
+            v[0],
+            Isometry2::new(nalgebra::Vector2::new(v[1], v[2]), v[3].to_radians()),
+        ));
+    }
+    if poses.len() < 2 {
+        return Err(bad(
+            text.lines().count().max(1),
+            format!("{} poses, want two or more", poses.len()),
+        ));
+    }
+    Ok(poses)
 }
 
 /// The ground under a sensor: the plane `z = a x + b y + c` in the sensor's frame fitted to

@@ -3,7 +3,7 @@
 //! never hang, and never load a non-finite number (map blocks excepted, where NaN means unknown:
 //! their reader refuses infinities itself). Parsers: scenarios (with the pose files they name),
 //! vehicle sidecars, URDFs, campaign files, run configurations, map blocks, map manifests and
-//! ROS map YAML + PGM, ROS 2 point clouds. `TAXI_SIM_FUZZ_CASES` sets the cases per parser (default 64, the quick
+//! ROS map YAML + PGM, ROS 2 point clouds, a capture's pose files. `TAXI_SIM_FUZZ_CASES` sets the cases per parser (default 64, the quick
 //! budget CI runs; README "Hostile input" has the long run).
 
 use std::path::{Path, PathBuf};
@@ -453,4 +453,44 @@ fn velodyne_captures() {
             r.ground(r.full())
         ))
     });
+}
+
+/// A moving sensor's poses (`map --pcap --poses`), fuzzed: read, then each revolution of a
+/// capture placed by them.
+#[test]
+fn velodyne_pose_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("poses.csv");
+    // Two revolutions whose middles are 0.25 s and 0.75 s on the sensor's clock.
+    let frames: Vec<velodyne::Frame> = [0.25e6, 0.75e6]
+        .map(|time_us| velodyne::Frame {
+            points: vec![velodyne::Point {
+                xyz_m: [1.0, 0.0, 0.0],
+                distance_m: 1.0,
+                intensity: 10,
+                laser: 0,
+                azimuth_cdeg: 0,
+                firing: 0,
+                time_us,
+            }],
+        })
+        .to_vec();
+    fuzz(
+        "pose file of a capture",
+        b"time_s,x_m,y_m,yaw_deg\n0.0,0.0,0.0,170.0\n0.5,2.0,1.0,-170.0\n1.0,3.0,1.0,0.0\n"
+            .to_vec(),
+        true,
+        |b| {
+            std::fs::write(&file, b).unwrap();
+            let poses = sim::pcap::read_poses_csv(&file).ok()?;
+            let placement = sim::pcap::Placement {
+                pose: nalgebra::Isometry2::identity(),
+                poses: poses.clone(),
+                height_m: None,
+                level: false,
+            };
+            let placed = sim::pcap::revolution_poses(&frames, &placement);
+            Some(format!("{poses:?} {placed:?}"))
+        },
+    );
 }

@@ -123,6 +123,7 @@ fn a_built_capture_maps_its_wall_on_every_level() {
     let pose = Isometry2::new(Vector2::new(10.0, -5.0), 0.0);
     let placement = sim::pcap::Placement {
         pose,
+        poses: Vec::new(),
         height_m: None,
         level: false,
     };
@@ -282,6 +283,7 @@ fn a_tilted_sensors_ground_is_clear_once_levelled() {
     let occupied = |level: bool| {
         let placement = sim::pcap::Placement {
             pose: Isometry2::identity(),
+            poses: Vec::new(),
             height_m: None,
             level,
         };
@@ -382,5 +384,123 @@ fn shared_data_the_default_sensor_is_calibrated_on_monterey() {
                 row.figure, row.real, row.synthetic
             );
         }
+    }
+}
+
+/// Writes `text` as `name` in `dir`.
+fn write_in(dir: &std::path::Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// `map --pcap --poses`: each full revolution is placed at the pose interpolated at its middle
+/// firing - the built capture's revolutions 1 and 2 are timed by their packets (553 us apart,
+/// 150 a revolution: middles at 0.1244 and 0.2074 s) - the heading the short way round; poses
+/// that all equal one place map as a sensor standing there.
+#[test]
+fn a_moving_sensor_is_placed_at_each_revolutions_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("built.pcap");
+    std::fs::write(&file, capture()).unwrap();
+    let recording = sim::pcap::read(&file, None).unwrap();
+    let csv = "time_s,x_m,y_m,yaw_deg\n0.0,0.0,0.0,170.0\n1.0,10.0,-4.0,-170.0\n";
+    let poses = sim::pcap::read_poses_csv(&write_in(dir.path(), "poses.csv", csv)).unwrap();
+    let placement = sim::pcap::Placement {
+        pose: Isometry2::identity(),
+        poses,
+        height_m: None,
+        level: false,
+    };
+    let at = sim::pcap::revolution_poses(recording.full(), &placement).unwrap();
+    assert_eq!(at.len(), 2);
+    for (pose, k) in at.iter().zip([1.0, 2.0]) {
+        let t = 553e-6 * (150.0 * k + 75.0);
+        let p = pose.translation.vector;
+        assert!(
+            (p.x - 10.0 * t).abs() < 0.01 && (p.y + 4.0 * t).abs() < 0.005,
+            "{p} at {t}"
+        );
+        let yaw = pose.rotation.angle().to_degrees().rem_euclid(360.0);
+        assert!((yaw - (170.0 + 20.0 * t)).abs() < 0.02, "{yaw} at {t}");
+    }
+    // A revolution before the first pose is an error naming it.
+    let late = "time_s,x_m,y_m,yaw_deg\n0.15,0,0,0\n1.0,1,0,0\n";
+    let placement = sim::pcap::Placement {
+        poses: sim::pcap::read_poses_csv(&write_in(dir.path(), "late.csv", late)).unwrap(),
+        ..placement
+    };
+    let e = sim::pcap::revolution_poses(recording.full(), &placement).unwrap_err();
+    assert!(
+        e.contains("full revolution 0 (at 0.12") && e.contains("outside the poses"),
+        "{e}"
+    );
+    // Standing at (10, -5) as poses or as a pose: the same map.
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenarios/straight_cone_under_wing.toml");
+    let s = Scenario::from_file(&path).unwrap();
+    let config = RunConfig::default();
+    let levels = sim::offline_map::levels_of(&s, &config).unwrap();
+    let pose = Isometry2::new(Vector2::new(10.0, -5.0), 0.0);
+    let occupied = |poses: Vec<(f64, Isometry2<f64>)>, out: &str| {
+        let placement = sim::pcap::Placement {
+            pose,
+            poses,
+            height_m: None,
+            level: false,
+        };
+        let r = sim::pcap::map_from_pcap(
+            &file,
+            None,
+            &placement,
+            &levels,
+            sim::offline_map::map_config(&config),
+            &dir.path().join(out),
+            &mut |_, _| {},
+        )
+        .unwrap();
+        assert_eq!(r.revolutions, 2);
+        r.manifest.occupied_cells
+    };
+    let standing = occupied(Vec::new(), "standing");
+    assert!(standing[0] > 0);
+    assert_eq!(occupied(vec![(0.0, pose), (1.0, pose)], "posed"), standing);
+}
+
+/// A poses file's mistakes are errors naming the file, the line and the field.
+#[test]
+fn a_wrong_poses_file_is_a_located_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            "t,x,y,yaw\n0,0,0,0\n1,0,0,0\n",
+            "bad.csv: line 1: the header is `t,x,y,yaw`",
+        ),
+        (
+            "time_s,x_m,y_m,yaw_deg\n0,0,0,0\n1,0,north,0\n",
+            "line 3: y_m: `north` is not a finite number",
+        ),
+        (
+            "time_s,x_m,y_m,yaw_deg\n0,0,0,0\n0,1,0,0\n",
+            "line 3: time_s: 0 is not after 0",
+        ),
+        (
+            "time_s,x_m,y_m,yaw_deg\n0,0,0\n",
+            "line 2: 3 fields, want 4",
+        ),
+        (
+            "time_s,x_m,y_m,yaw_deg\n0,0,0,0\n",
+            "1 poses, want two or more",
+        ),
+        (
+            "time_s,x_m,y_m,yaw_deg\n0,0,0,NaN\n1,0,0,0\n",
+            "line 2: yaw_deg: `NaN` is not a finite number",
+        ),
+    ];
+    for (text, want) in cases {
+        let e = sim::pcap::read_poses_csv(&write_in(dir.path(), "bad.csv", text))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("bad.csv") && e.contains(want), "{e}");
     }
 }

@@ -58,7 +58,7 @@ pub struct MapArgs {
     #[arg(long, requires = "from_bag")]
     pub columns: Option<usize>,
     /// Build the map from this Velodyne capture (pcap or pcapng; HDL-32E, VLP-16): its full
-    /// revolutions, the sensor standing at `--pose`.
+    /// revolutions, the sensor standing at `--pose` or moving along `--poses`.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["from_bag", "record"])]
     pub pcap: Option<PathBuf>,
     /// The sensor's VeloView calibration file (XML; default: its built-in table).
@@ -72,6 +72,11 @@ pub struct MapArgs {
         requires = "pcap"
     )]
     pub pose: String,
+    /// A moving sensor: its poses, CSV `time_s,x_m,y_m,yaw_deg` (time in seconds on the sensor's
+    /// clock - its packets' timestamps, seconds past the hour); each revolution is placed at the
+    /// pose interpolated at its middle firing.
+    #[arg(long, value_name = "FILE", requires = "pcap", conflicts_with = "pose")]
+    pub poses: Option<PathBuf>,
     /// The sensor's height above the ground, metres (default: the ground fitted to its returns).
     #[arg(long, value_name = "M", requires = "pcap")]
     pub sensor_height: Option<f64>,
@@ -124,8 +129,13 @@ fn from_pcap(
     });
     let levels = levels_of(scenario, config)?;
     let progress = crate::bar(0, "mapping the capture");
+    let poses = match &args.poses {
+        Some(file) => sim::pcap::read_poses_csv(file)?,
+        None => Vec::new(),
+    };
     let placement = sim::pcap::Placement {
         pose,
+        poses,
         height_m: args.sensor_height,
         level: args.level,
     };

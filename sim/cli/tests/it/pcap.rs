@@ -108,6 +108,39 @@ fn bad_pcap_arguments_exit_2_naming_them() {
     let (code, _, err) = taxi_sim(&["map", scenario, "--pcap", f, "--pose", "1,2"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("--pose 1,2"), "{err}");
+    // A moving sensor's poses that end before the capture's revolutions: the revolution named.
+    let poses = dir.path().join("poses.csv");
+    std::fs::write(&poses, "time_s,x_m,y_m,yaw_deg\n0,0,0,0\n0.01,1,0,0\n").unwrap();
+    let map = dir.path().join("map");
+    let (code, _, err) = taxi_sim(&[
+        "map",
+        scenario,
+        "--pcap",
+        f,
+        "--poses",
+        poses.to_str().unwrap(),
+        "--out",
+        map.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("ground.pcap")
+            && err.contains("full revolution 0")
+            && err.contains("outside the poses"),
+        "{err}"
+    );
+    let (code, _, err) = taxi_sim(&[
+        "map",
+        scenario,
+        "--pcap",
+        f,
+        "--pose",
+        "1,2,0",
+        "--poses",
+        poses.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--poses") || err.contains("--pose"), "{err}");
     let (code, _, err) = taxi_sim(&["compare-lidar", "--pcap", scenario]);
     assert_eq!(code, 2, "{err}");
     assert!(
