@@ -314,6 +314,7 @@ fn every_shipped_campaign_reads_and_its_first_variants_are_valid_scenarios() {
             "jet_wing_and_engine_paths",
             "low_debris_car",
             "parking_lot_random",
+            "sensor_bias",
             "smoke",
             "traffic_airliner",
             "traffic_jet",
