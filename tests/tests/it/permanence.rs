@@ -66,9 +66,9 @@ fn with_time_based_forgetting_the_jet_strikes_the_unit_it_stopped_for() {
 /// sensor as it was before its calibration on a real HDL-32E (2 cm of range noise, no drop-off).
 /// FIXME (README, Known problems): with the calibrated sensor (4 mm, 1.3 %) the cart's top near
 /// its front corner, at (99.7, 5.5), is last hit 1.5 s before the stop and hidden from then on;
-/// once the rest of the cart is seen towed away that cell stays occupied (unseen is not gone, and
-/// the departing cart does not take it), and the airliner waits for it until the pilot is
-/// called. Asserted as it is.
+/// when the cart vanishes at 60 s (the scenario's tow, `disappears_s`) the rest of it is seen
+/// gone, but no beam can pass through that cell (unseen is not gone), and the airliner waits for
+/// it until the pilot is called. Asserted as it is.
 #[test]
 fn the_airliner_waits_for_a_cart_in_its_engines_path_until_it_sees_it_towed_away() {
     let dir = tempfile::tempdir().unwrap();
