@@ -110,7 +110,8 @@ fn node_at(a: &Airport, r: &NetworkRoute, id: u32) -> V2 {
     r.points[i]
 }
 
-fn segment_distance(p: V2, a: V2, b: V2) -> f64 {
+/// Distance from `p` to the segment `a`-`b` (to `a` when it has no length).
+pub(crate) fn segment_distance(p: V2, a: V2, b: V2) -> f64 {
     let d = b - a;
     let t = if d.norm_squared() > 0.0 {
         ((p - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0)
@@ -127,7 +128,7 @@ fn polyline_distance(p: V2, line: &[V2]) -> f64 {
 }
 
 /// Points along a polyline at most `step` apart.
-fn samples(line: &[V2], step: f64) -> Vec<V2> {
+pub(crate) fn samples(line: &[V2], step: f64) -> Vec<V2> {
     let mut out = Vec::new();
     for w in line.windows(2) {
         let n = ((w[1] - w[0]).norm() / step).ceil().max(1.0) as usize;

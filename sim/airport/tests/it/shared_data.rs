@@ -7,6 +7,8 @@ use airport::paint::{MAX_OFFSET_M, centrelines};
 use airport::{Airport, NetworkRoute, PathOptions, Place, RouteRequest, SizeClass};
 use nalgebra::Vector2;
 
+use crate::paint::{samples, segment_distance};
+
 fn ksyr_path() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/airports/KSYR/apt.dat")
 }
@@ -162,23 +164,6 @@ fn options(min_turn_radius_m: f64) -> PathOptions {
         lateral_acceleration_m_s2: 1.0,
         deceleration_m_s2: 0.5,
     }
-}
-
-fn segment_distance(p: Vector2<f64>, a: Vector2<f64>, b: Vector2<f64>) -> f64 {
-    let d = b - a;
-    let t = ((p - a).dot(&d) / d.norm_squared().max(1e-12)).clamp(0.0, 1.0);
-    (a + d * t - p).norm()
-}
-
-/// Points along a polyline at most `step` apart.
-fn samples(line: &[Vector2<f64>], step: f64) -> Vec<Vector2<f64>> {
-    let mut out = Vec::new();
-    for w in line.windows(2) {
-        let n = ((w[1] - w[0]).norm() / step).ceil().max(1.0) as usize;
-        out.extend((0..n).map(|k| w[0] + (w[1] - w[0]) * (k as f64 / n as f64)));
-    }
-    out.extend(line.last().copied());
-    out
 }
 
 /// The route's points from node `from` to node `to` (ids).
