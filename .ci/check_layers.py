@@ -9,7 +9,7 @@ import pathlib
 import re
 import sys
 
-LAYERS = ["toml_file", "chart", "error", "world", "airports", "scenario", "offline_map", "engine", "replay",
+LAYERS = ["toml_file", "error", "chart", "world", "airports", "scenario", "offline_map", "engine", "replay",
           "rosbag", "pcap", "studies", "campaign", "tune", "bench"]
 
 def strip_comments(text):

@@ -17,10 +17,13 @@
 //! - [`synthetic`]: analytic scenes and a synthetic HDL-32E for tests and benchmarks.
 //! - [`tracking`]: moving objects, so what they leave can be cleared on evidence.
 //! - [`workloads`]: the inputs of the headline benchmarks.
+//! - [`voxel`], [`elevation`]: a dense 3D voxel grid and a 2.5D elevation-interval map, the
+//!   representations the multi-height grids are compared against.
 
 pub mod blocks;
 pub mod collision;
 pub mod edt;
+pub mod elevation;
 pub mod error;
 pub mod export;
 pub mod grid;
@@ -34,6 +37,7 @@ pub mod scan;
 pub mod self_hits;
 pub mod synthetic;
 pub mod tracking;
+pub mod voxel;
 pub mod workloads;
 
 pub use blocks::{Block, BlockIndex, BlockSpec, BlockStore, write_atomically};

@@ -1,9 +1,18 @@
 //! The charts' font: the bundled DejaVu Sans (`sim/assets/fonts`) registered as plotters'
-//! `sans-serif`, so a machine without fonts draws the same pictures (tuning, campaign summaries).
+//! `sans-serif`, so a machine without fonts draws the same pictures (tuning, campaign summaries,
+//! the representation comparison), and a picture drawn as SVG and PNG both.
 
+use std::path::Path;
 use std::sync::Once;
 
+use plotters::coord::Shift;
+use plotters::prelude::*;
 use plotters::style::FontStyle;
+
+use crate::error::{Error, Result};
+
+/// What a drawing closure returns: plotters' error as text.
+pub(crate) type DrawResult = std::result::Result<(), String>;
 
 static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
@@ -15,4 +24,43 @@ pub(crate) fn register_font() {
         // The bundled file is a valid font (a test draws with it): nothing to report here.
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
     });
+}
+
+/// Draws `f` into `<dir>/<stem>.svg` and `<dir>/<stem>.png`, each written atomically.
+pub(crate) fn both(
+    dir: &Path,
+    stem: &str,
+    size: (u32, u32),
+    svg: impl Fn(DrawingArea<SVGBackend<'_>, Shift>) -> DrawResult,
+    png: impl Fn(DrawingArea<BitMapBackend<'_>, Shift>) -> DrawResult,
+) -> Result<()> {
+    register_font();
+    let located = |e: String, ext: &str| {
+        Error::Invalid(format!(
+            "{}: drawing: {e}",
+            dir.join(format!("{stem}.{ext}")).display()
+        ))
+    };
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        svg(root).map_err(|e| located(e, "svg"))?;
+    }
+    mapper::write_atomically(&dir.join(format!("{stem}.svg")), text.as_bytes())?;
+    let mut buf = vec![0u8; (size.0 * size.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, size).into_drawing_area();
+        png(root).map_err(|e| located(e, "png"))?;
+    }
+    let mut bytes = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut bytes),
+        &buf,
+        size.0,
+        size.1,
+        image::ExtendedColorType::Rgb8,
+    )
+    .map_err(|e| located(e.to_string(), "png"))?;
+    mapper::write_atomically(&dir.join(format!("{stem}.png")), &bytes)?;
+    Ok(())
 }

@@ -5,3 +5,4 @@ mod collision;
 mod export;
 mod map;
 mod overhead;
+mod representations;

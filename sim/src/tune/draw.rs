@@ -12,49 +12,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::SettingFigures;
-use crate::chart::register_font;
-use crate::error::{Error, Result};
-
-type DrawResult = std::result::Result<(), String>;
-
-/// Draws `f` into `<dir>/<stem>.svg` and `<dir>/<stem>.png`, each written atomically.
-fn both(
-    dir: &Path,
-    stem: &str,
-    size: (u32, u32),
-    svg: impl Fn(DrawingArea<SVGBackend<'_>, Shift>) -> DrawResult,
-    png: impl Fn(DrawingArea<BitMapBackend<'_>, Shift>) -> DrawResult,
-) -> Result<()> {
-    register_font();
-    let located = |e: String, ext: &str| {
-        Error::Invalid(format!(
-            "{}: drawing: {e}",
-            dir.join(format!("{stem}.{ext}")).display()
-        ))
-    };
-    let mut text = String::new();
-    {
-        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
-        svg(root).map_err(|e| located(e, "svg"))?;
-    }
-    mapper::write_atomically(&dir.join(format!("{stem}.svg")), text.as_bytes())?;
-    let mut buf = vec![0u8; (size.0 * size.1 * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, size).into_drawing_area();
-        png(root).map_err(|e| located(e, "png"))?;
-    }
-    let mut bytes = Vec::new();
-    image::ImageEncoder::write_image(
-        image::codecs::png::PngEncoder::new(&mut bytes),
-        &buf,
-        size.0,
-        size.1,
-        image::ExtendedColorType::Rgb8,
-    )
-    .map_err(|e| located(e.to_string(), "png"))?;
-    mapper::write_atomically(&dir.join(format!("{stem}.png")), &bytes)?;
-    Ok(())
-}
+use crate::chart::{DrawResult, both};
+use crate::error::Result;
 
 /// A colour for a cost between `lo` and `hi` (viridis-like: dark blue cheap, yellow dear).
 fn cost_colour(x: f64, lo: f64, hi: f64) -> RGBColor {

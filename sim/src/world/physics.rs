@@ -104,6 +104,8 @@ pub struct World {
     min_clearance_m: Vec<f64>,
     /// Per vehicle part, the distance to the nearest active object in range at the current pose.
     part_clearance_m: Vec<f64>,
+    /// Per vehicle part, that nearest object (index into `scene.solids`).
+    part_nearest: Vec<Option<usize>>,
 }
 
 impl World {
@@ -196,6 +198,7 @@ impl World {
             contacts: Vec::new(),
             min_clearance_m: vec![f64::INFINITY; n],
             part_clearance_m: vec![f64::INFINITY; vehicle.parts.len()],
+            part_nearest: vec![None; vehicle.parts.len()],
         };
         world.refresh();
         world
@@ -294,6 +297,7 @@ impl World {
     fn update_clearances(&mut self, pose: &Isometry2<f64>) {
         let (vx, vy) = (pose.translation.x, pose.translation.y);
         self.part_clearance_m.fill(f64::INFINITY);
+        self.part_nearest.fill(None);
         let parts: Vec<(&Collider, Aabb)> = self
             .parts
             .iter()
@@ -328,7 +332,10 @@ impl World {
                 ) {
                     let d = d.distance as f64;
                     *per_object = per_object.min(d);
-                    *per_part = per_part.min(d);
+                    if d < *per_part {
+                        *per_part = d;
+                        self.part_nearest[p] = Some(i);
+                    }
                 }
             }
         }
@@ -405,6 +412,17 @@ impl World {
     /// the object's footprint radius plus 15 m (infinity if none).
     pub fn part_clearances_m(&self) -> &[f64] {
         &self.part_clearance_m
+    }
+
+    /// Ground truth at the current pose: the object nearest to any vehicle part (indexed like
+    /// `scene().solids`) and that distance, metres (0 when touching); `None` when no object is
+    /// within range (see [`World::part_clearances_m`]).
+    pub fn nearest_object_now(&self) -> Option<(usize, f64)> {
+        self.part_clearance_m
+            .iter()
+            .zip(&self.part_nearest)
+            .filter_map(|(d, o)| o.map(|o| (o, *d)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
     }
 
     /// Who owns a collider.

@@ -10,6 +10,7 @@ mod fuzz;
 mod map_files;
 mod pcap;
 mod replay;
+mod representations;
 mod rosbag;
 mod scenario;
 mod short_obstacles;

@@ -21,9 +21,11 @@ pub struct BenchArgs {
     /// schedule, in alternation, default 1 - it then says it ran once).
     #[arg(long)]
     pub samples: Option<usize>,
-    /// Scenario of `bench loop` and `bench blocks`.
-    #[arg(long, default_value = "scenarios/parking_lot.toml")]
-    pub scenario: PathBuf,
+    /// Scenario of `bench loop`, `bench blocks` and `bench localization` (default
+    /// `scenarios/parking_lot.toml`); `bench representations`: the scenes, repeatable (default:
+    /// the parking lot, the aerodrome, the low bridge, the footbridge and the parked jet).
+    #[arg(long)]
+    pub scenario: Vec<PathBuf>,
     /// Laps of `bench loop` (default 1; 0: the scenario's own).
     #[arg(long, default_value_t = 1)]
     pub laps: u32,
@@ -51,6 +53,9 @@ pub struct BenchArgs {
     /// `.ci/check_figures`.
     #[arg(long, value_name = "FILE")]
     pub json_out: Option<PathBuf>,
+    /// `bench representations`: how they are compared.
+    #[command(flatten)]
+    pub representations: super::representations::RepresentationArgs,
 }
 
 /// What `taxi-sim bench` measures.
@@ -72,6 +77,10 @@ pub enum BenchTarget {
     /// The particle filter on `--scenario`'s offline map (built if missing): one revolution's
     /// update, the weighing's tables against the straightforward way (one thread each).
     Localization,
+    /// The thesis' multi-height grids against 3D voxels, OctoMap (through its Python binding,
+    /// when installed) and a 2.5D map on the same revolutions: memory, time, wrong answers
+    /// against the exact collision (`--out DIR`: tables, JSON and pictures).
+    Representations,
     /// The README's deterministic figures of a first and a later run (offline map on disk,
     /// blocks, occupied cells, peak memory), from `taxi-sim run` child processes on the
     /// aerodrome and the parking lot; run from the repository's root (a few minutes).
@@ -88,6 +97,18 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             json_out: args.json_out.as_deref(),
         });
     }
+    if let BenchTarget::Representations = args.what {
+        return super::representations::run(
+            &args.scenario,
+            args.out.as_deref(),
+            &args.representations,
+        );
+    }
+    let scenario = args
+        .scenario
+        .first()
+        .cloned()
+        .unwrap_or_else(|| PathBuf::from("scenarios/parking_lot.toml"));
     let campaign = sim::bench::campaign::CampaignBench {
         campaign: &args.campaign,
         variants: args.variants,
@@ -101,7 +122,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         args.what,
         args.json,
         args.samples,
-        (&args.scenario, args.laps),
+        (&scenario, args.laps),
         &campaign,
     )
 }
@@ -126,7 +147,9 @@ fn bench(
         BenchTarget::Localization => {
             sim::bench::localization::figures_for(scenario, samples.unwrap_or(15), &mut report)?
         }
-        BenchTarget::Figures => unreachable!("dispatched in run"),
+        BenchTarget::Figures | BenchTarget::Representations => {
+            unreachable!("dispatched in run")
+        }
     };
     progress.finish_and_clear();
     let mut t = String::new();

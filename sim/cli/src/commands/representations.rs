@@ -1,0 +1,163 @@
+//! `taxi-sim bench representations`: the thesis' multi-height grids against a dense 3D voxel
+//! grid, OctoMap and a 2.5D map on the same revolutions, per scene: tables on stdout, and with
+//! `--out DIR` the JSON, the tables and a picture per scene.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use indicatif::{ProgressBar, ProgressStyle};
+use sim::studies::representations::{
+    self as study, OctoMapOptions, Options, SceneResult, drive::Stretch, truth::PoseDraw,
+};
+
+use crate::emit;
+
+/// The scenes compared when none is given.
+const DEFAULT_SCENES: [&str; 5] = [
+    "scenarios/parking_lot.toml",
+    "scenarios/aerodrome.toml",
+    "scenarios/low_bridge_jet.toml",
+    "scenarios/footbridge_jet.toml",
+    "scenarios/airliner_wing_over_parked_jet.toml",
+];
+
+/// Options of `bench representations`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RepresentationArgs {
+    /// Poses judged per scene, drawn near the objects the drive passed.
+    #[arg(long, default_value_t = 10_000)]
+    pub poses: usize,
+    /// Seed of the poses' draw.
+    #[arg(long, default_value_t = 1)]
+    pub pose_seed: u64,
+    /// Route driven per scene, metres, centred on `--at-m` (default: the route's middle).
+    #[arg(long, default_value_t = 200.0)]
+    pub stretch_m: f64,
+    /// Where along the route the window is centred, metres.
+    #[arg(long)]
+    pub at_m: Option<f64>,
+    /// Distance between revolutions, metres (default 1; 0: one every 0.1 s at the route's
+    /// speed, as the mapping drive casts them).
+    #[arg(long, default_value_t = 1.0)]
+    pub spacing_m: f64,
+    /// The Python with the `octomap-python` binding (`pip install octomap-python==1.10.0.0`);
+    /// without it OctoMap is left out and the report says so.
+    #[arg(long, value_name = "PYTHON")]
+    pub octomap_python: Option<PathBuf>,
+    /// OctoMap's leaf sizes, metres.
+    #[arg(long, value_delimiter = ',', default_value = "0.2,0.1")]
+    pub octomap_resolutions: Vec<f64>,
+    /// Poses checked through the binding itself (timed, and compared with our answers on its
+    /// voxels).
+    #[arg(long, default_value_t = 200)]
+    pub octomap_timed_poses: usize,
+}
+
+fn options(args: &RepresentationArgs, out: Option<&Path>) -> anyhow::Result<Options> {
+    anyhow::ensure!(args.poses > 0, "--poses: must be at least 1");
+    anyhow::ensure!(
+        args.stretch_m.is_finite() && args.stretch_m > 0.0,
+        "--stretch-m: {} is not a positive length",
+        args.stretch_m
+    );
+    anyhow::ensure!(
+        args.spacing_m.is_finite() && args.spacing_m >= 0.0,
+        "--spacing-m: {} is not a length",
+        args.spacing_m
+    );
+    for r in &args.octomap_resolutions {
+        anyhow::ensure!(
+            r.is_finite() && *r >= 0.05,
+            "--octomap-resolutions: {r} (at least 0.05 m)"
+        );
+    }
+    let scratch = out.map_or_else(
+        || std::env::temp_dir().join("taxi-sim-octomap"),
+        |d| d.join("octomap"),
+    );
+    Ok(Options {
+        stretch: Stretch {
+            at_m: args.at_m,
+            length_m: args.stretch_m,
+            spacing_m: (args.spacing_m > 0.0).then_some(args.spacing_m),
+        },
+        draw: PoseDraw {
+            count: args.poses,
+            seed: args.pose_seed,
+            near_m: 2.0,
+            seen_m: 40.0,
+        },
+        octomap: args.octomap_python.clone().map(|python| OctoMapOptions {
+            python,
+            resolutions_m: args.octomap_resolutions.clone(),
+            dir: scratch,
+            timed_poses: args.octomap_timed_poses,
+        }),
+    })
+}
+
+/// Runs `taxi-sim bench representations`.
+pub fn run(
+    scenes: &[PathBuf],
+    out: Option<&Path>,
+    args: &RepresentationArgs,
+) -> anyhow::Result<()> {
+    let options = options(args, out)?;
+    let scenes: Vec<PathBuf> = if scenes.is_empty() {
+        DEFAULT_SCENES.iter().map(PathBuf::from).collect()
+    } else {
+        scenes.to_vec()
+    };
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let mut results: Vec<SceneResult> = Vec::new();
+    for path in &scenes {
+        let scenario = sim::scenario::Scenario::from_file(path)?;
+        let config = sim::scenario::RunConfig::for_scenario(&scenario, None)?;
+        let bar = ProgressBar::new(1).with_style(
+            ProgressStyle::with_template("{msg:>28} [{bar:30}] {pos}/{len} {elapsed}")?
+                .progress_chars("=> "),
+        );
+        let name = path.display().to_string();
+        let result =
+            study::compare_scene(&scenario, &config, &options, &mut |stage, done, total| {
+                bar.set_message(format!("{name}: {stage}"));
+                bar.set_length(total as u64);
+                bar.set_position(done as u64);
+            })
+            .with_context(|| format!("{}: the comparison", path.display()))?;
+        bar.finish_and_clear();
+        if let Some(dir) = out {
+            let stem = path
+                .file_stem()
+                .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+            study::chart::draw(&result, dir, &stem)?;
+        }
+        emit(&study::table::scene_table(&result))?;
+        emit("\n")?;
+        results.push(result);
+    }
+    let mut text =
+        String::from("Against the thesis' representation (multi-height, cumulative):\n\n");
+    text.push_str(&study::table::headline(&results));
+    emit(&text)?;
+    if let Some(dir) = out {
+        let mut md = String::new();
+        for r in &results {
+            writeln!(md, "{}", study::table::scene_table(r))?;
+            for n in &r.notes {
+                writeln!(md, "- {n}")?;
+            }
+            writeln!(md)?;
+        }
+        md.push_str(&text);
+        mapper::write_atomically(&dir.join("representations.md"), md.as_bytes())?;
+        mapper::write_atomically(
+            &dir.join("representations.json"),
+            serde_json::to_string_pretty(&results)?.as_bytes(),
+        )?;
+    }
+    Ok(())
+}

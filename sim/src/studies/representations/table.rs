@@ -1,0 +1,94 @@
+//! The comparison as Markdown tables: one per scene, and the headline ratios against the
+//! thesis' representation.
+
+use std::fmt::Write as _;
+
+use super::truth::Near;
+use super::{Row, SceneResult};
+
+fn mb(bytes: u64) -> String {
+    let m = bytes as f64 / 1e6;
+    if m >= 100.0 {
+        format!("{m:.0}")
+    } else if m >= 1.0 {
+        format!("{m:.1}")
+    } else {
+        format!("{m:.2}")
+    }
+}
+
+fn near_cell(r: &Row, near: Near) -> String {
+    r.judged.by_near.get(&near).map_or("-".into(), |e| {
+        format!("{} / {} of {}", e.false_alarms, e.misses, e.colliding)
+    })
+}
+
+/// One scene's table: cost and wrong answers per representation.
+pub fn scene_table(s: &SceneResult) -> String {
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "**{}** ({}; {} revolutions over {:.0} m; {} poses near objects, {} colliding; the route's map: {} blocks)\n",
+        s.scenario, s.vehicle, s.revolutions, s.driven_m, s.poses.0, s.poses.1, s.route_blocks
+    );
+    let nears: Vec<Near> = Near::ALL
+        .into_iter()
+        .filter(|n| s.rows.iter().any(|r| r.judged.by_near.contains_key(n)))
+        .collect();
+    let mut head = "| representation | memory, window / route (MB) | insert (ms/rev) | distance update (ms) | pose check (us) | false alarms | misses |".to_string();
+    for n in &nears {
+        let _ = write!(head, " {}: false alarms / misses of colliding |", n.name());
+    }
+    let _ = writeln!(t, "{head}");
+    let _ = writeln!(t, "|{}", "---|".repeat(7 + nears.len()));
+    for r in &s.rows {
+        let update = r
+            .update_ms
+            .map_or_else(|| "-".into(), |u| format!("{u:.2} ({})", r.update_kind));
+        let _ = write!(
+            t,
+            "| {} | {} / {} | {:.2} | {} | {:.2} | {} | {} |",
+            r.name,
+            mb(r.memory_window_bytes),
+            mb(r.memory_route_bytes),
+            r.insert_ms,
+            update,
+            r.judged.pose_check_ns / 1e3,
+            r.judged.all.false_alarms,
+            r.judged.all.misses
+        );
+        for n in &nears {
+            let _ = write!(t, " {} |", near_cell(r, *n));
+        }
+        let _ = writeln!(t);
+    }
+    t
+}
+
+/// The headline: per scene, how many times less memory and insertion time the thesis'
+/// representation takes than each other one, and the wrong answers side by side.
+pub fn headline(results: &[SceneResult]) -> String {
+    let mut t = String::from(
+        "| scene | against | memory: times less | insertion: times less | wrong answers, thesis' vs other (false alarms + misses) |\n|---|---|---|---|---|\n",
+    );
+    for s in results {
+        let Some(thesis) = s.rows.first() else {
+            continue;
+        };
+        for r in s.rows.iter().skip(1) {
+            let _ = writeln!(
+                t,
+                "| {} | {} | {:.1} | {:.1} | {} + {} vs {} + {} |",
+                s.scenario,
+                r.name,
+                r.memory_window_bytes as f64 / thesis.memory_window_bytes.max(1) as f64,
+                r.insert_ms / thesis.insert_ms.max(1e-9),
+                thesis.judged.all.false_alarms,
+                thesis.judged.all.misses,
+                r.judged.all.false_alarms,
+                r.judged.all.misses
+            );
+        }
+    }
+    t
+}
