@@ -425,6 +425,28 @@ impl World {
             .min_by(|a, b| a.1.total_cmp(&b.1))
     }
 
+    /// Ground truth at the current pose: how deep the vehicle's deepest touching part is inside
+    /// an object, metres (parry's contact; 0 when nothing touches or they only graze).
+    pub fn deepest_penetration_m(&self) -> f64 {
+        self.touching
+            .iter()
+            .filter_map(|&(o, p)| {
+                let obj = self.physics.colliders.get(*self.objects.get(o)?)?;
+                let part = self.physics.colliders.get(self.parts.get(p)?.0)?;
+                parry3d::query::contact(
+                    part.position(),
+                    part.shape(),
+                    obj.position(),
+                    obj.shape(),
+                    0.0,
+                )
+                .ok()
+                .flatten()
+                .map(|c| (-c.dist as f64).max(0.0))
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// Who owns a collider.
     pub fn owner(&self, handle: ColliderHandle) -> Option<Owner> {
         self.owners.get(&handle).copied()

@@ -28,9 +28,11 @@ fn compare(name: &str, poses: usize) -> SceneResult {
             count: poses,
             seed: 3,
             near_m: 2.0,
+            max_depth_m: 0.3,
             seen_m: 40.0,
         },
         octomap: None,
+        carving_diagnostic: false,
     };
     compare_scene(&s, &config, &options, &mut |_, _, _| {}).expect("the comparison")
 }
@@ -55,12 +57,24 @@ fn under_a_bridge_each_representation_keeps_its_property_pose_by_pose() {
     let cumulative = &row(&r, "multi-height, cumulative").judged;
     let banded = &row(&r, "multi-height, banded").judged;
     let voxels = &row(&r, "3D voxels").judged;
-    let elevation = &row(&r, "2.5D").judged;
-    // A level holds everything above its height: the thesis' grids never miss what the 3D grid
-    // holds at a part's height.
-    assert!(covers(&cumulative.answers, &voxels.answers));
-    // An interval map keeps every hit and clears none: it never misses what the 3D grid holds.
-    assert!(covers(&elevation.answers, &voxels.answers));
+    // A level holds everything above its height, so the thesis' grids miss what the 3D grid
+    // holds at a part's height only where their own update loses it (a small object's cell
+    // cleared in 2D that its voxel keeps - docs/representations.md): under 1 % of the poses the
+    // 3D grid says colliding (17 of 2,945 in the parking lot with 10,000 poses).
+    let voxel_says = voxels.answers.iter().filter(|a| **a).count();
+    let lost = row(&r, "multi-height, cumulative").vs_voxels.1;
+    assert!(
+        lost * 100 <= voxel_says,
+        "{lost} of {voxel_says} poses clear in the grids, colliding in 3D"
+    );
+    // An interval map keeps every hit and clears none: it misses what the 3D grid holds only
+    // where a voxel's centre lies in a part's span and its hits just outside it (at most a
+    // layer's thickness): rare.
+    let interval_lost = row(&r, "2.5D").vs_voxels.1;
+    assert!(
+        interval_lost * 100 <= voxel_says,
+        "{interval_lost} of {voxel_says} poses clear in the interval map, colliding in 3D"
+    );
     // A band is part of its cumulative level: banded never says colliding where cumulative
     // does not (for this two-level jet they are the same grids).
     assert!(covers(&cumulative.answers, &banded.answers));
@@ -106,4 +120,50 @@ fn a_circles_span_is_the_parts_it_covers_within_the_vehicle() {
             "{name}: some raised part's circle spans less than the whole height"
         );
     }
+}
+
+#[test]
+fn a_banded_check_ignores_bands_above_the_parts_a_circle_covers() {
+    use mapper::edt::EdtScratch;
+    use mapper::{DistanceMap, DistanceMaps, GridGeometry, LevelMode};
+    use nalgebra::{Isometry2, Point2};
+    use sim::studies::representations::answers::banded;
+    use sim::studies::representations::spans::SpanCircle;
+
+    // Three bands (A320-like: the gear's, the wings' from 1.1 m, the tail's from 5 m) over a
+    // 20 m square; one obstacle cell at (10, 10), in the band `obstacle_band`.
+    let g = GridGeometry::new(Point2::new(0.0, 0.0), 0.2, 100, 100).expect("a geometry");
+    let heights = [0.0, 1.1, 5.0];
+    let maps = |obstacle_band: usize| {
+        let at = g.index_of(&Point2::new(10.0, 10.0)).expect("inside");
+        let mut scratch = EdtScratch::default();
+        let levels = (0..3)
+            .map(|k| DistanceMap::compute(g, 30.0, |i| k == obstacle_band && i == at, &mut scratch))
+            .collect();
+        DistanceMaps::new(LevelMode::Banded, levels).expect("three bands")
+    };
+    // A wing's circle: level 1, its parts between 1.2 and 3.5 m, centred on the obstacle.
+    let wing = [SpanCircle {
+        centre: Point2::new(0.0, 0.0),
+        radius_m: 1.0,
+        level: 1,
+        z_lo_m: 1.2,
+        z_hi_m: 3.5,
+    }];
+    let pose = Isometry2::new(nalgebra::Vector2::new(10.0, 10.0), 0.0);
+    // In its own band: colliding.
+    assert!(banded(&wing, &maps(1), &heights)(&pose));
+    // In the band above the wing's top (the tail's band, from 5 m): not the wing's concern.
+    assert!(!banded(&wing, &maps(2), &heights)(&pose));
+    // Below the wing's level: the gear's band is not checked by the wing.
+    assert!(!banded(&wing, &maps(0), &heights)(&pose));
+    // The same obstacle 1.5 m away: out of reach in any band.
+    let aside = Isometry2::new(nalgebra::Vector2::new(11.5, 10.0), 0.0);
+    assert!(!banded(&wing, &maps(1), &heights)(&aside));
+    // A tail circle reaching 6 m checks the band from 5 m.
+    let tail = [SpanCircle {
+        z_hi_m: 6.0,
+        ..wing[0]
+    }];
+    assert!(banded(&tail, &maps(2), &heights)(&pose));
 }

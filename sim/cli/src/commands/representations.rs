@@ -52,6 +52,10 @@ pub struct RepresentationArgs {
     /// voxels).
     #[arg(long, default_value_t = 200)]
     pub octomap_timed_poses: usize,
+    /// Also the dense 3D grid without free-space carving: which of its misses come from beams
+    /// carving away what they grazed (a diagnostic row).
+    #[arg(long)]
+    pub carving_diagnostic: bool,
 }
 
 fn options(args: &RepresentationArgs, out: Option<&Path>) -> anyhow::Result<Options> {
@@ -86,6 +90,7 @@ fn options(args: &RepresentationArgs, out: Option<&Path>) -> anyhow::Result<Opti
             count: args.poses,
             seed: args.pose_seed,
             near_m: 2.0,
+            max_depth_m: 0.3,
             seen_m: 40.0,
         },
         octomap: args.octomap_python.clone().map(|python| OctoMapOptions {
@@ -94,6 +99,7 @@ fn options(args: &RepresentationArgs, out: Option<&Path>) -> anyhow::Result<Opti
             dir: scratch,
             timed_poses: args.octomap_timed_poses,
         }),
+        carving_diagnostic: args.carving_diagnostic,
     })
 }
 

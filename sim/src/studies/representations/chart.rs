@@ -96,6 +96,7 @@ fn draw_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, scene: &SceneResult
     let time: Vec<Point> = scene
         .rows
         .iter()
+        .filter(|r| r.insert_ms.is_finite())
         .map(|r| (r.name.clone(), r.insert_ms, wrong(r)))
         .collect();
     panel(

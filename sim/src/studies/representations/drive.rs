@@ -37,6 +37,9 @@ pub struct Representations {
     pub voxels: VoxelGrid,
     /// Per cell the lowest and highest obstacle height seen.
     pub elevation: ElevationMap,
+    /// A diagnostic: the dense 3D grid with free space all but uncounted (`l_free` -1e-6), which
+    /// tells misses from what was never seen apart from misses from what beams carved away.
+    pub voxels_hits_only: Option<VoxelGrid>,
 }
 
 /// Seconds each representation spent, summed over the drive, and per revolution.
@@ -62,7 +65,12 @@ pub const FLOOR_M: f64 = 0.05;
 
 impl Representations {
     /// Empty representations over the map window centred on `centre`.
-    pub fn new(scenario: &Scenario, config: &RunConfig, centre: Point2<f64>) -> Result<Self> {
+    pub fn new(
+        scenario: &Scenario,
+        config: &RunConfig,
+        centre: Point2<f64>,
+        carving_diagnostic: bool,
+    ) -> Result<Self> {
         let levels = crate::offline_map::levels_of(scenario, config)?;
         let banded = Levels::new(
             levels.heights_m().to_vec(),
@@ -74,7 +82,14 @@ impl Representations {
         let banded = MultiHeightMap::new(map_config, banded, centre)?;
         let geometry = *cumulative.geometry();
         let top = scenario.vehicle.vehicle.ceiling_m();
+        let hits_only = mapper::OccupancyParams {
+            l_free: -1e-6,
+            ..map_config.occupancy
+        };
         Ok(Representations {
+            voxels_hits_only: carving_diagnostic
+                .then(|| VoxelGrid::new(geometry, FLOOR_M, top, hits_only))
+                .transpose()?,
             voxels: VoxelGrid::new(geometry, FLOOR_M, top, map_config.occupancy)?,
             elevation: ElevationMap::new(geometry, FLOOR_M, top)?,
             cumulative,
@@ -98,6 +113,9 @@ impl Representations {
         let start = Instant::now();
         self.elevation.insert_scan(scan);
         t[3] = start.elapsed().as_secs_f64();
+        if let Some(v) = &mut self.voxels_hits_only {
+            v.insert_scan(scan);
+        }
         times.per_revolution.push(t);
         let start = Instant::now();
         self.cumulative.update_distance_maps();

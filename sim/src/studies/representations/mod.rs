@@ -42,6 +42,8 @@ pub struct Options {
     pub draw: PoseDraw,
     /// OctoMap through its binding, if wanted.
     pub octomap: Option<OctoMapOptions>,
+    /// Also the dense 3D grid without free-space carving (a diagnostic row).
+    pub carving_diagnostic: bool,
 }
 
 /// How OctoMap is run.
@@ -76,6 +78,9 @@ pub struct Row {
     pub judged: Judged,
     /// Poses it says colliding where the dense voxel grid says clear, and the reverse.
     pub vs_voxels: (usize, usize),
+    /// Up to five poses of the second kind (clear here, colliding in the voxel grid): x, y,
+    /// heading (rad), truly colliding, exact clearance (m).
+    pub clear_where_voxels_collide: Vec<(f64, f64, f64, bool, f64)>,
 }
 
 /// One scene's comparison.
@@ -118,7 +123,7 @@ pub fn compare_scene(
         .num_threads(1)
         .build()
         .map_err(|e| Error::Invalid(format!("a one-thread pool: {e}")))?;
-    let mut reps = Representations::new(scenario, config, centre)?;
+    let mut reps = Representations::new(scenario, config, centre, options.carving_diagnostic)?;
     let g = *reps.cumulative.geometry();
     let (lo, hi) = (
         g.origin_m(),
@@ -258,6 +263,17 @@ fn judge_all(
             reps.elevation.span_collides(c, r, a, b)
         }),
     );
+    let hits_only = reps.voxels_hits_only.as_mut().map(|v| {
+        v.update_distances();
+        let bytes = v.memory_bytes() as u64;
+        (
+            bytes,
+            judge(
+                truth,
+                answers::spans(&circles, |c, r, a, b| v.span_collides(c, r, a, b)),
+            ),
+        )
+    });
     let full_cumulative = full_2d_update_s(reps.cumulative.distance_maps()) * 1e3;
     let levels = heights.len();
     let row =
@@ -270,6 +286,7 @@ fn judge_all(
                 update_ms: upd,
                 update_kind: kind,
                 vs_voxels: versus(&judged.answers, &voxels.answers),
+                clear_where_voxels_collide: examples(&judged.answers, &voxels.answers, truth),
                 judged,
             }
         };
@@ -307,6 +324,17 @@ fn judge_all(
             elevation,
         ),
     ];
+    let mut rows = rows;
+    if let Some((bytes, judged)) = hits_only {
+        rows.push(row(
+            "3D voxels, no carving (diagnostic)",
+            bytes,
+            f64::NAN,
+            None,
+            "full 3D EDT",
+            judged,
+        ));
+    }
     let mut notes = vec![format!(
         "2D distance maps recomputed whole: {full_cumulative:.1} ms (all levels); the loop updates them incrementally"
     )];
@@ -328,6 +356,31 @@ fn judge_all(
         octomap_agreement: Vec::new(),
         notes,
     })
+}
+
+/// Up to five poses where `answers` says clear and `reference` colliding.
+fn examples(
+    answers: &[bool],
+    reference: &[bool],
+    truth: &[TruthPose],
+) -> Vec<(f64, f64, f64, bool, f64)> {
+    answers
+        .iter()
+        .zip(reference)
+        .zip(truth)
+        .filter(|((a, r), _)| !**a && **r)
+        .take(5)
+        .map(|(_, t)| {
+            let p = t.pose.translation.vector;
+            (
+                p.x,
+                p.y,
+                t.pose.rotation.angle(),
+                t.colliding,
+                t.clearance_m,
+            )
+        })
+        .collect()
 }
 
 /// The median of `v` (sorted in place; NaN when empty).
@@ -402,6 +455,7 @@ fn octomap_rows(
             update_ms: None,
             update_kind: "none (tree queried)",
             vs_voxels: versus(&judged.answers, &voxel_answers),
+            clear_where_voxels_collide: examples(&judged.answers, &voxel_answers, truth),
             judged,
         });
     }

@@ -47,11 +47,15 @@ pub fn scene_table(s: &SceneResult) -> String {
             .map_or_else(|| "-".into(), |u| format!("{u:.2} ({})", r.update_kind));
         let _ = write!(
             t,
-            "| {} | {} / {} | {:.2} | {} | {:.2} | {} | {} |",
+            "| {} | {} / {} | {} | {} | {:.2} | {} | {} |",
             r.name,
             mb(r.memory_window_bytes),
             mb(r.memory_route_bytes),
-            r.insert_ms,
+            if r.insert_ms.is_finite() {
+                format!("{:.2}", r.insert_ms)
+            } else {
+                "-".into()
+            },
             update,
             r.judged.pose_check_ns / 1e3,
             r.judged.all.false_alarms,
@@ -75,7 +79,12 @@ pub fn headline(results: &[SceneResult]) -> String {
         let Some(thesis) = s.rows.first() else {
             continue;
         };
-        for r in s.rows.iter().skip(1) {
+        for r in s
+            .rows
+            .iter()
+            .skip(1)
+            .filter(|r| !r.name.contains("diagnostic"))
+        {
             let _ = writeln!(
                 t,
                 "| {} | {} | {:.1} | {:.1} | {} + {} vs {} + {} |",

@@ -67,6 +67,9 @@ pub struct PoseDraw {
     pub seed: u64,
     /// A pose is kept when some part is within this distance of an object, metres.
     pub near_m: f64,
+    /// ... or inside one by at most this much, metres: the first touch, which a check must
+    /// catch, not a vehicle sunk into a building.
+    pub max_depth_m: f64,
     /// Objects farther than this from every revolution's origin are not drawn near, metres.
     pub seen_m: f64,
 }
@@ -74,7 +77,8 @@ pub struct PoseDraw {
 /// Poses near the objects of `world` that the drive passed within `seen_m` of: an object drawn
 /// at random, the vehicle's origin within its bounding circle's reach of it, any heading; kept
 /// when its bounding circle lies inside `inside` (the window less a margin) and the exact
-/// clearance is under `near_m`. Stops after 50 tries a pose.
+/// clearance is under `near_m` or the deepest part is at most `max_depth_m` inside an object.
+/// Stops after 50 tries a pose.
 pub fn draw_poses(
     world: &mut World,
     drive: &[Isometry2<f64>],
@@ -129,9 +133,13 @@ pub fn draw_poses(
         if d >= draw.near_m {
             continue;
         }
+        let colliding = d <= 0.0 || !world.touching_now().is_empty();
+        if colliding && world.deepest_penetration_m() > draw.max_depth_m {
+            continue;
+        }
         out.push(TruthPose {
             pose,
-            colliding: d <= 0.0 || !world.touching_now().is_empty(),
+            colliding,
             near: Near::of(&world.scene().solids[nearest]),
             clearance_m: d,
         });
