@@ -221,6 +221,34 @@ fn full_2d_update_s(maps: &DistanceMaps) -> f64 {
     start.elapsed().as_secs_f64()
 }
 
+/// The diagnostic grid without carving, if kept: its bytes and answers.
+fn judge_hits_only(
+    reps: &mut Representations,
+    truth: &[TruthPose],
+    circles: &[spans::SpanCircle],
+) -> Option<(u64, Judged)> {
+    let v = reps.voxels_hits_only.as_mut()?;
+    v.update_distances();
+    let v = &*v;
+    let judged = judge(
+        truth,
+        answers::spans(circles, |c, r, a, b| v.span_collides(c, r, a, b)),
+    );
+    Some((v.memory_bytes() as u64, judged))
+}
+
+/// Median insertion per representation and distance update per 2D map, ms.
+fn medians_ms(times: &InsertTimes) -> ([f64; 4], [f64; 2]) {
+    let of = |v: Vec<f64>| {
+        let mut v = v;
+        median(&mut v) * 1e3
+    };
+    (
+        std::array::from_fn(|k| of(times.per_revolution.iter().map(|t| t[k]).collect())),
+        std::array::from_fn(|k| of(times.distance_update.iter().map(|t| t[k]).collect())),
+    )
+}
+
 fn judge_all(
     scenario: &Scenario,
     config: &RunConfig,
@@ -232,14 +260,7 @@ fn judge_all(
     let model = config.collision_model(vehicle)?;
     let circles = spans::span_circles(&model, vehicle);
     let heights = model.level_heights_m().to_vec();
-    let col = |k: usize| {
-        let mut v: Vec<f64> = times.per_revolution.iter().map(|t| t[k]).collect();
-        median(&mut v) * 1e3
-    };
-    let upd = |k: usize| {
-        let mut v: Vec<f64> = times.distance_update.iter().map(|t| t[k]).collect();
-        median(&mut v) * 1e3
-    };
+    let (col, upd) = medians_ms(times);
     let start = Instant::now();
     reps.voxels.update_distances();
     let voxel_update = start.elapsed().as_secs_f64() * 1e3;
@@ -263,17 +284,7 @@ fn judge_all(
             reps.elevation.span_collides(c, r, a, b)
         }),
     );
-    let hits_only = reps.voxels_hits_only.as_mut().map(|v| {
-        v.update_distances();
-        let bytes = v.memory_bytes() as u64;
-        (
-            bytes,
-            judge(
-                truth,
-                answers::spans(&circles, |c, r, a, b| v.span_collides(c, r, a, b)),
-            ),
-        )
-    });
+    let hits_only = judge_hits_only(reps, truth, &circles);
     let full_cumulative = full_2d_update_s(reps.cumulative.distance_maps()) * 1e3;
     let levels = heights.len();
     let row =
@@ -294,23 +305,23 @@ fn judge_all(
         row(
             "multi-height, cumulative",
             map_bytes(levels),
-            col(0),
-            Some(upd(0)),
+            col[0],
+            Some(upd[0]),
             "incremental",
             cumulative,
         ),
         row(
             "multi-height, banded",
             map_bytes(levels),
-            col(1),
-            Some(upd(1)),
+            col[1],
+            Some(upd[1]),
             "incremental",
             banded,
         ),
         row(
             "3D voxels (dense)",
             reps.voxels.memory_bytes() as u64,
-            col(2),
+            col[2],
             Some(voxel_update),
             "full 3D EDT",
             voxels.clone(),
@@ -318,7 +329,7 @@ fn judge_all(
         row(
             "2.5D elevation interval",
             reps.elevation.memory_bytes() as u64,
-            col(3),
+            col[3],
             None,
             "none (cells enumerated)",
             elevation,
@@ -335,15 +346,18 @@ fn judge_all(
             judged,
         ));
     }
-    let mut notes = vec![format!(
-        "2D distance maps recomputed whole: {full_cumulative:.1} ms (all levels); the loop updates them incrementally"
-    )];
-    notes.push(format!(
-        "memory: 2D maps count log-odds and distance per level (f32); the window is {} x {} cells of {} m",
-        reps.cumulative.geometry().width(),
-        reps.cumulative.geometry().height(),
-        reps.cumulative.geometry().resolution_m()
-    ));
+    let g = reps.cumulative.geometry();
+    let notes = vec![
+        format!(
+            "2D distance maps recomputed whole: {full_cumulative:.1} ms (all levels); the loop updates them incrementally"
+        ),
+        format!(
+            "memory: 2D maps count log-odds and distance per level (f32); the window is {} x {} cells of {} m",
+            g.width(),
+            g.height(),
+            g.resolution_m()
+        ),
+    ];
     Ok(SceneResult {
         scenario: scenario.name.clone(),
         path: scenario.path.display().to_string(),
