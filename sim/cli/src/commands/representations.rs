@@ -56,6 +56,10 @@ pub struct RepresentationArgs {
     /// carving away what they grazed (a diagnostic row).
     #[arg(long)]
     pub carving_diagnostic: bool,
+    /// Draw the pictures and write the tables again from `DIR/representations.json` (a run's
+    /// `--out`), measuring nothing.
+    #[arg(long, value_name = "DIR")]
+    pub redraw: Option<PathBuf>,
 }
 
 fn options(args: &RepresentationArgs, out: Option<&Path>) -> anyhow::Result<Options> {
@@ -109,6 +113,9 @@ pub fn run(
     out: Option<&Path>,
     args: &RepresentationArgs,
 ) -> anyhow::Result<()> {
+    if let Some(dir) = &args.redraw {
+        return redraw(dir);
+    }
     let options = options(args, out)?;
     let scenes: Vec<PathBuf> = if scenes.is_empty() {
         DEFAULT_SCENES.iter().map(PathBuf::from).collect()
@@ -145,13 +152,18 @@ pub fn run(
         emit("\n")?;
         results.push(result);
     }
+    write_all(&results, out)
+}
+
+/// The headline on stdout; with `out`, the tables and the JSON in it.
+fn write_all(results: &[SceneResult], out: Option<&Path>) -> anyhow::Result<()> {
     let mut text =
         String::from("Against the thesis' representation (multi-height, cumulative):\n\n");
-    text.push_str(&study::table::headline(&results));
+    text.push_str(&study::table::headline(results));
     emit(&text)?;
     if let Some(dir) = out {
         let mut md = String::new();
-        for r in &results {
+        for r in results {
             writeln!(md, "{}", study::table::scene_table(r))?;
             for n in &r.notes {
                 writeln!(md, "- {n}")?;
@@ -162,8 +174,26 @@ pub fn run(
         mapper::write_atomically(&dir.join("representations.md"), md.as_bytes())?;
         mapper::write_atomically(
             &dir.join("representations.json"),
-            serde_json::to_string_pretty(&results)?.as_bytes(),
+            serde_json::to_string_pretty(results)?.as_bytes(),
         )?;
     }
     Ok(())
+}
+
+/// Pictures and tables again from a run's JSON.
+fn redraw(dir: &Path) -> anyhow::Result<()> {
+    let path = dir.join("representations.json");
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let results: Vec<SceneResult> = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not a comparison's results", path.display()))?;
+    for r in &results {
+        let stem = Path::new(&r.path)
+            .file_stem()
+            .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+        study::chart::draw(r, dir, &stem)?;
+        emit(&study::table::scene_table(r))?;
+        emit("\n")?;
+    }
+    write_all(&results, Some(dir))
 }

@@ -6,14 +6,14 @@ use std::time::Instant;
 
 use mapper::{CollisionModel, DistanceMaps};
 use nalgebra::Isometry2;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::spans::{SpanCircle, placed};
 use super::truth::{Near, TruthPose};
 use crate::error::Result;
 
 /// Wrong answers of one representation on one kind of neighbour.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Errors {
     /// Poses judged.
     pub poses: usize,
@@ -42,7 +42,7 @@ impl Errors {
 
 /// A representation's answers over the poses: per kind of neighbour and in all, the time of one
 /// pose check, and the answers themselves (for comparing representations pose by pose).
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct Judged {
     /// In all.
     pub all: Errors,
@@ -51,7 +51,7 @@ pub struct Judged {
     /// Mean time of one pose check, ns (one thread).
     pub pose_check_ns: f64,
     /// The answer at each pose, in pose order.
-    #[serde(skip)]
+    #[serde(skip, default)]
     pub answers: Vec<bool>,
 }
 

@@ -1,5 +1,6 @@
 //! The comparison's picture per scene (plotters, SVG and PNG): memory against wrong answers and
-//! insertion time against wrong answers, one point per representation, log-scaled costs.
+//! insertion time against wrong answers, per representation (one colour each) its false alarms
+//! (discs) and misses (triangles) in percent of the poses, log-scaled costs.
 
 use std::path::Path;
 
@@ -31,7 +32,8 @@ pub fn draw(scene: &SceneResult, dir: &Path, stem: &str) -> Result<()> {
     )
 }
 
-type Point = (String, f64, f64);
+/// (name, colour index, cost, false alarms %, misses %).
+type Point = (String, usize, f64, f64, f64);
 
 fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
@@ -40,9 +42,9 @@ fn panel<DB: DrawingBackend>(
 ) -> DrawResult {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     let (x_lo, x_hi) = points.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
-        (lo.min(p.1), hi.max(p.1))
+        (lo.min(p.2), hi.max(p.2))
     });
-    let y_hi = points.iter().map(|p| p.2).fold(1.0, f64::max) * 1.2;
+    let y_hi = points.iter().map(|p| p.3.max(p.4)).fold(1.0, f64::max) * 1.3;
     let mut chart = ChartBuilder::on(area)
         .margin(16)
         .x_label_area_size(44)
@@ -55,14 +57,17 @@ fn panel<DB: DrawingBackend>(
     chart
         .configure_mesh()
         .x_desc(x_desc)
-        .y_desc("wrong answers, % of poses")
+        .y_desc("% of poses: false alarms (disc), misses (triangle)")
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(e)?;
-    for (k, (name, x, y)) in points.iter().enumerate() {
+    for (name, k, x, alarms, misses) in points {
         let colour = COLOURS[k % COLOURS.len()];
         chart
-            .draw_series([Circle::new((*x, *y), 6, colour.filled())])
+            .draw_series([TriangleMarker::new((*x, *misses), 7, colour.filled())])
+            .map_err(e)?;
+        chart
+            .draw_series([Circle::new((*x, *alarms), 6, colour.filled())])
             .map_err(e)?
             .label(name.as_str())
             .legend(move |(a, b)| Circle::new((a + 8, b), 5, colour.filled()));
@@ -87,17 +92,28 @@ fn draw_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, scene: &SceneResult
     );
     let root = root.titled(&title, ("sans-serif", 18)).map_err(e)?;
     let panels = root.split_evenly((1, 2));
-    let wrong = |r: &super::Row| r.judged.all.wrong_percent();
+    let percent = |n: usize| 100.0 * n as f64 / scene.poses.0.max(1) as f64;
+    let point = |k: usize, r: &super::Row, cost: f64| -> Point {
+        let a = &r.judged.all;
+        (
+            r.name.clone(),
+            k,
+            cost,
+            percent(a.false_alarms),
+            percent(a.misses),
+        )
+    };
     let memory: Vec<Point> = scene
         .rows
         .iter()
-        .map(|r| (r.name.clone(), r.memory_window_bytes as f64 / 1e6, wrong(r)))
+        .enumerate()
+        .map(|(k, r)| point(k, r, r.memory_window_bytes as f64 / 1e6))
         .collect();
     let time: Vec<Point> = scene
         .rows
         .iter()
-        .filter(|r| r.insert_ms.is_finite())
-        .map(|r| (r.name.clone(), r.insert_ms, wrong(r)))
+        .enumerate()
+        .filter_map(|(k, r)| r.insert_ms.map(|ms| point(k, r, ms)))
         .collect();
     panel(
         &panels[0],

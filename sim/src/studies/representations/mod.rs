@@ -25,7 +25,7 @@ use std::time::Instant;
 use mapper::edt::EdtScratch;
 use mapper::{DistanceMap, DistanceMaps};
 use nalgebra::{Isometry2, Point2, Vector2};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use self::answers::{Judged, judge};
 use self::drive::{Cloud, InsertTimes, Representations, Stretch};
@@ -60,7 +60,7 @@ pub struct OctoMapOptions {
 }
 
 /// One representation on one scene.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Row {
     /// Its name.
     pub name: String,
@@ -69,11 +69,11 @@ pub struct Row {
     /// The same over the whole route's blocks (dense ones exactly; OctoMap scaled by area).
     pub memory_route_bytes: u64,
     /// Median insertion of one revolution (free space included), ms, one thread.
-    pub insert_ms: f64,
+    pub insert_ms: Option<f64>,
     /// Median distance-structure update after one revolution, ms (`None`: it has none).
     pub update_ms: Option<f64>,
     /// How that update is made.
-    pub update_kind: &'static str,
+    pub update_kind: String,
     /// Wrong answers and the time of one pose check.
     pub judged: Judged,
     /// Poses it says colliding where the dense voxel grid says clear, and the reverse.
@@ -83,8 +83,9 @@ pub struct Row {
     pub clear_where_voxels_collide: Vec<(f64, f64, f64, bool, f64)>,
 }
 
-/// One scene's comparison.
-#[derive(Clone, Debug, Serialize)]
+/// One scene's comparison (as `--out DIR/representations.json` holds it; the answers pose by
+/// pose are not written).
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SceneResult {
     /// The scenario's name.
     pub scenario: String,
@@ -293,9 +294,9 @@ fn judge_all(
                 name: name.into(),
                 memory_window_bytes: mem,
                 memory_route_bytes: 0,
-                insert_ms: ins,
+                insert_ms: ins.is_finite().then_some(ins),
                 update_ms: upd,
-                update_kind: kind,
+                update_kind: kind.into(),
                 vs_voxels: versus(&judged.answers, &voxels.answers),
                 clear_where_voxels_collide: examples(&judged.answers, &voxels.answers, truth),
                 judged,
@@ -465,9 +466,9 @@ fn octomap_rows(
             name: format!("OctoMap {res} m"),
             memory_window_bytes: run.memory_bytes,
             memory_route_bytes: 0,
-            insert_ms: run.insert_ms.median,
+            insert_ms: Some(run.insert_ms.median),
             update_ms: None,
-            update_kind: "none (tree queried)",
+            update_kind: "none (tree queried)".into(),
             vs_voxels: versus(&judged.answers, &voxel_answers),
             clear_where_voxels_collide: examples(&judged.answers, &voxel_answers, truth),
             judged,

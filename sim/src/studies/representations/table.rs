@@ -51,11 +51,8 @@ pub fn scene_table(s: &SceneResult) -> String {
             r.name,
             mb(r.memory_window_bytes),
             mb(r.memory_route_bytes),
-            if r.insert_ms.is_finite() {
-                format!("{:.2}", r.insert_ms)
-            } else {
-                "-".into()
-            },
+            r.insert_ms
+                .map_or_else(|| "-".into(), |ms| format!("{ms:.2}")),
             update,
             r.judged.pose_check_ns / 1e3,
             r.judged.all.false_alarms,
@@ -91,7 +88,7 @@ pub fn headline(results: &[SceneResult]) -> String {
                 s.scenario,
                 r.name,
                 r.memory_window_bytes as f64 / thesis.memory_window_bytes.max(1) as f64,
-                r.insert_ms / thesis.insert_ms.max(1e-9),
+                r.insert_ms.unwrap_or(f64::NAN) / thesis.insert_ms.unwrap_or(f64::NAN).max(1e-9),
                 thesis.judged.all.false_alarms,
                 thesis.judged.all.misses,
                 r.judged.all.false_alarms,

@@ -4,12 +4,12 @@
 use mapper::BoundingCircle;
 use nalgebra::{Isometry2, Point2, Vector2};
 use rand::{RngExt as _, SeedableRng as _};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::world::{ObjectKind, Solid, World};
 
 /// What was nearest to the vehicle at a pose.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Near {
     /// Standing on the ground: cones, containers, markers, buildings, piers.
