@@ -56,6 +56,10 @@ pub struct RepresentationArgs {
     /// carving away what they grazed (a diagnostic row).
     #[arg(long)]
     pub carving_diagnostic: bool,
+    /// Read OctoMap's figures and voxels from an earlier run's `--out DIR/octomap/` instead of
+    /// inserting again (the same options give the same revolutions and poses).
+    #[arg(long)]
+    pub octomap_reuse: bool,
     /// Draw the pictures and write the tables again from `DIR/representations.json` (a run's
     /// `--out`), measuring nothing.
     #[arg(long, value_name = "DIR")]
@@ -102,6 +106,7 @@ fn options(args: &RepresentationArgs, out: Option<&Path>) -> anyhow::Result<Opti
             resolutions_m: args.octomap_resolutions.clone(),
             dir: scratch,
             timed_poses: args.octomap_timed_poses,
+            reuse: args.octomap_reuse,
         }),
         carving_diagnostic: args.carving_diagnostic,
     })

@@ -57,6 +57,8 @@ pub struct OctoMapOptions {
     pub dir: PathBuf,
     /// Poses checked through the binding itself (timed; the rest judged on its voxels).
     pub timed_poses: usize,
+    /// Read a finished run's files from `dir` instead of running the script again.
+    pub reuse: bool,
 }
 
 /// One representation on one scene.
@@ -441,7 +443,7 @@ fn octomap_rows(
         .map(|r| r.judged.answers.clone())
         .unwrap_or_default();
     for &res in &o.resolutions_m {
-        let Some((run, voxels)) = exchange.run(&o.python, res)? else {
+        let Some((run, voxels)) = exchange.run(&o.python, res, o.reuse)? else {
             result
                 .notes
                 .push("OctoMap not run: the octomap-python binding is not installed".into());

@@ -187,23 +187,46 @@ impl Exchange {
     }
 
     /// Runs the script with `python` at `resolution_m`: `Ok(None)` when the binding is not
-    /// installed (the script exits 3), its figures and occupied voxels otherwise.
+    /// installed (the script exits 3), its figures and occupied voxels otherwise. With `reuse`,
+    /// a finished run's files already in the directory are read instead (the drive and the
+    /// poses are reproducible: the same options give the same exchange).
     pub fn run(
         &self,
         python: &Path,
         resolution_m: f64,
+        reuse: bool,
     ) -> Result<Option<(OctoMapRun, Vec<[f32; 3]>)>> {
-        let script = script_path()?;
         let json = self.dir.join(format!("octomap_{resolution_m}.json"));
         let voxels = self.dir.join(format!("octomap_{resolution_m}_voxels.npy"));
+        if !(reuse && json.is_file() && voxels.is_file())
+            && self
+                .run_script(python, resolution_m, (&json, &voxels))?
+                .is_none()
+        {
+            return Ok(None);
+        }
+        let text =
+            std::fs::read_to_string(&json).map_err(io("reading OctoMap's figures", &json))?;
+        let run: OctoMapRun = serde_json::from_str(&text)
+            .map_err(|e| Error::Invalid(format!("{}: {e}", json.display())))?;
+        Ok(Some((run, read_points_npy(&voxels)?)))
+    }
+
+    fn run_script(
+        &self,
+        python: &Path,
+        resolution_m: f64,
+        (json, voxels): (&Path, &Path),
+    ) -> Result<Option<()>> {
+        let script = script_path()?;
         let output = Command::new(python)
             .arg(&script)
             .arg(&self.dir)
             .args(["--resolution", &resolution_m.to_string()])
             .arg("--out")
-            .arg(&json)
+            .arg(json)
             .arg("--voxels")
-            .arg(&voxels)
+            .arg(voxels)
             .output()
             .map_err(io("running the OctoMap script", python))?;
         std::io::stderr().write_all(&output.stderr).ok();
@@ -219,11 +242,7 @@ impl Exchange {
                 )));
             }
         }
-        let text =
-            std::fs::read_to_string(&json).map_err(io("reading OctoMap's figures", &json))?;
-        let run: OctoMapRun = serde_json::from_str(&text)
-            .map_err(|e| Error::Invalid(format!("{}: {e}", json.display())))?;
-        Ok(Some((run, read_points_npy(&voxels)?)))
+        Ok(Some(()))
     }
 }
 
@@ -248,9 +267,15 @@ pub struct VoxelSet {
     geometry: GridGeometry,
 }
 
+/// The centre of the cell of side `res` (on multiples of it) holding `x`.
+fn snap(x: f64, res: f64) -> f64 {
+    ((x / res).floor() + 0.5) * res
+}
+
 impl VoxelSet {
     /// The set of `voxels` (centres) at `resolution_m`; queries snap a circle's centre to the
-    /// cell of `geometry` holding it, as the 2D maps read their distance maps.
+    /// centre of the lattice column holding it (as the 2D maps read their distance maps at their
+    /// own cells) and answer as colliding outside `geometry` (as they read 0 there).
     pub fn new(voxels: &[[f32; 3]], resolution_m: f64, geometry: GridGeometry) -> Self {
         let key = |v: &[f32; 3]| {
             (
@@ -269,11 +294,11 @@ impl VoxelSet {
     /// Whether an occupied voxel whose centre lies within [z_lo, z_hi] has its column's centre
     /// nearer than `radius_m` to the centre of the map cell holding `centre`.
     pub fn span_collides(&self, centre: Point2<f64>, radius_m: f64, z_lo: f64, z_hi: f64) -> bool {
-        let Some(cell) = self.geometry.cell_of(&centre) else {
+        if self.geometry.cell_of(&centre).is_none() {
             return true;
-        };
-        let c = self.geometry.center_of(cell);
+        }
         let res = self.resolution_m;
+        let c = Point2::new(snap(centre.x, res), snap(centre.y, res));
         let k0 = ((z_lo - FLOOR_M) / res - 0.5).ceil() as i32;
         let k1 = ((z_hi - FLOOR_M) / res - 0.5).floor() as i32;
         let (x0, x1) = (
