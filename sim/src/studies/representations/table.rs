@@ -17,6 +17,17 @@ fn mb(bytes: u64) -> String {
     }
 }
 
+/// A ratio: one decimal from 1 up, two significant digits below.
+fn ratio(x: f64) -> String {
+    if !x.is_finite() {
+        "-".into()
+    } else if x >= 1.0 {
+        format!("{x:.1}")
+    } else {
+        format!("{x:.2}")
+    }
+}
+
 fn near_cell(r: &Row, near: Near) -> String {
     r.judged.by_near.get(&near).map_or("-".into(), |e| {
         format!("{} / {} of {}", e.false_alarms, e.misses, e.colliding)
@@ -84,11 +95,14 @@ pub fn headline(results: &[SceneResult]) -> String {
         {
             let _ = writeln!(
                 t,
-                "| {} | {} | {:.1} | {:.1} | {} + {} vs {} + {} |",
+                "| {} | {} | {} | {} | {} + {} vs {} + {} |",
                 s.scenario,
                 r.name,
-                r.memory_window_bytes as f64 / thesis.memory_window_bytes.max(1) as f64,
-                r.insert_ms.unwrap_or(f64::NAN) / thesis.insert_ms.unwrap_or(f64::NAN).max(1e-9),
+                ratio(r.memory_window_bytes as f64 / thesis.memory_window_bytes.max(1) as f64),
+                ratio(
+                    r.insert_ms.unwrap_or(f64::NAN)
+                        / thesis.insert_ms.unwrap_or(f64::NAN).max(1e-9)
+                ),
                 thesis.judged.all.false_alarms,
                 thesis.judged.all.misses,
                 r.judged.all.false_alarms,
