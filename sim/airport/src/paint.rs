@@ -20,7 +20,11 @@
 //! - **At a node** (`nodes`): where the two legs' paint lines meet - going straight on, the
 //!   point on the paint abeam the node; turning, where the lines cross, or the point of the
 //!   paint's curve round the turn nearest that. A node on a runway's centreline that the route
-//!   crosses goes where the paint crosses that centreline. The route's two ends move only
+//!   crosses goes where the paint crosses that centreline. Where one leg's paint stops short
+//!   of the node (and goes on nowhere) and the other leg has none there, the node goes where the
+//!   paint's line, extended, meets the unpainted leg's network line, so that leg keeps it - or
+//!   stays where the network has it if that point is more than [`MAX_OFFSET_M`] away or the
+//!   lines are near parallel (the painted leg then tapers back). The route's two ends move only
 //!   sideways, onto the paint abeam them; a route bound for a runway keeps its hold point where
 //!   the network has it (moved sideways it could come nearer the runway).
 //! - **Where the paint ends**, or a leg has none near it (`profile`): back to the network's
@@ -158,6 +162,8 @@ pub fn follow(airport: &Airport, route: &NetworkRoute) -> NetworkRoute {
             legs[k].last = None;
             legs[k].first_direct = None;
             legs[k].last_direct = None;
+            legs[k].first_stops = false;
+            legs[k].last_stops = false;
             pinned[k] = true;
             pinned[k + 1] = true;
         }

@@ -102,7 +102,41 @@ impl Chain {
         }
         (None, None)
     }
+
+    /// Whether the paint stops short of the node at the leg's end (`at_end`) or start: the
+    /// chain's paint there is off the network, ends more than [`MIN_LINE_M`] before abeam the
+    /// node, and goes on nowhere (no curve or other run takes it further).
+    fn stops_short(&self, paint: &Paint, frame: &Frame, at_end: bool) -> bool {
+        let (point, (segment, on_network), into) = if at_end {
+            let last = self.points.len() - 1;
+            (
+                self.points[last],
+                self.spans[last - 1],
+                self.into_end.is_some(),
+            )
+        } else {
+            (self.points[0], self.spans[0], self.into_start)
+        };
+        if on_network || into {
+            return false;
+        }
+        let (a, b) = paint.ends(segment);
+        // Which way along the run the chain heads toward the node, and the paint's end there.
+        let up = ((b - a).dot(&frame.u) > 0.0) == at_end;
+        let end = frame.sd(if up { b } else { a });
+        let short = if at_end {
+            end.x < frame.length - MIN_LINE_M
+        } else {
+            end.x > MIN_LINE_M
+        };
+        // The chain reaches the paint's end (is not cut off there by the band round the leg).
+        let reached = (end - point).norm() <= STOP_MATCH_M;
+        short && reached && paint.walk(segment, up).next().is_none()
+    }
 }
+
+/// A chain's end is where its paint ends if within this of it (m).
+const STOP_MATCH_M: f64 = 1e-3;
 
 /// A leg of the route and the paint along it.
 #[derive(Debug, Clone)]
@@ -123,6 +157,31 @@ pub(super) struct Leg {
     pub(super) first_direct: Option<Line>,
     /// ... its end, for its last point.
     pub(super) last_direct: Option<Line>,
+    /// The paint of `first` stops short of the leg's start: its line is the paint's last
+    /// there, ending more than [`MIN_LINE_M`] before abeam the node.
+    pub(super) first_stops: bool,
+    /// ... of `last`, short of its end.
+    pub(super) last_stops: bool,
+}
+
+impl Leg {
+    /// Whether the leg has no paint of its own at its end (`at_end`) or start: no straight
+    /// off the network near the node, nor a curve followed into it.
+    pub(super) fn bare_at(&self, at_end: bool) -> bool {
+        let (line, chain) = if at_end {
+            (self.last, self.chains.last())
+        } else {
+            (self.first, self.chains.first())
+        };
+        let into = chain.is_some_and(|c| {
+            if at_end {
+                c.into_end.is_some()
+            } else {
+                c.into_start
+            }
+        });
+        line.is_none() && !into
+    }
 }
 
 /// The legs, their paint chosen in order along the route (each continuing the last).
@@ -144,6 +203,8 @@ pub(super) fn legs(airport: &Airport, route: &NetworkRoute, paint: &Paint) -> Ve
             last: None,
             first_direct: None,
             last_direct: None,
+            first_stops: false,
+            last_stops: false,
         };
         let Some(frame) = frame.filter(|_| leg.followed) else {
             reference = frame.map(|f| f.line());
@@ -177,6 +238,11 @@ pub(super) fn legs(airport: &Airport, route: &NetworkRoute, paint: &Paint) -> Ve
         };
         (leg.first, leg.first_direct) = lines(chains.first(), false);
         (leg.last, leg.last_direct) = lines(chains.last(), true);
+        let stops = |c: Option<&Chain>, at_end: bool| {
+            c.is_some_and(|c| c.stops_short(paint, &frame, at_end))
+        };
+        leg.first_stops = leg.first.is_some() && stops(chains.first(), false);
+        leg.last_stops = leg.last.is_some() && stops(chains.last(), true);
         // The next leg continues the paint this one ends on.
         carry = chains.last().and_then(|c| c.into_end);
         reference = match chains.last() {

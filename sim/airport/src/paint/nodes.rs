@@ -87,6 +87,9 @@ fn place_node(
     if paint_a.is_none() && paint_b.is_none() {
         return Vec::new();
     }
+    if let Some(places) = short_of_bare(p, (a, fa), (b, fb)) {
+        return places;
+    }
     let feet: Vec<V2> = [paint_a, paint_b]
         .iter()
         .flatten()
@@ -112,6 +115,23 @@ fn place_node(
     }
     places.push(abeam);
     places
+}
+
+/// Where a node goes whose one leg's paint stops short of it while the other leg has none
+/// there (`None`: not such a node): where the paint's line, extended, meets the bare leg's
+/// network line, so that leg keeps it; where the network has it if that point is further than
+/// [`MAX_OFFSET_M`] or the lines are near parallel ([`COLLINEAR_DEG`]).
+fn short_of_bare(p: V2, (a, fa): (&Leg, Frame), (b, fb): (&Leg, Frame)) -> Option<Vec<V2>> {
+    let (line, bare) = match (a.last, b.first) {
+        (Some(line), _) if a.last_stops && b.bare_at(false) => (line, fb.line()),
+        (_, Some(line)) if b.first_stops && a.bare_at(true) => (line, fa.line()),
+        _ => return None,
+    };
+    let meet = (line.sin_to(&bare) >= COLLINEAR_DEG.to_radians().sin())
+        .then(|| line.meet(&bare))
+        .flatten()
+        .filter(|q| (q - p).norm() <= MAX_OFFSET_M);
+    Some(meet.into_iter().collect())
 }
 
 /// Whether a paint segment from `a` to `b` heads between directions `u` and `v` (either way

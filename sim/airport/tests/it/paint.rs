@@ -504,30 +504,81 @@ fn paint_at_absurd_coordinates_is_passed_over() {
     assert_eq!(r.points, clean.points);
 }
 
-/// Paint that ends 10 m short of a right-angle corner, 10 m off the network's line: the route
-/// still rounds for every turning radius checked and never strays past the lateral limit.
-/// FIXME (docs/known-problems.md): the corner node moves to where the paint ends, (90, -10),
-/// not to where the paint's line meets the unpainted next leg's, (100, -10); so the next leg,
-/// with no paint along it, leaves the network's line by 10 m at its start (5 degrees off it).
-/// Asserted as it is.
-#[test]
-fn fixme_paint_ending_before_a_corner_moves_the_corner_to_its_end() {
-    let a = Drawing::new()
+/// The route's points from the route point of node `id` on, at most 0.5 m apart.
+fn from_node(a: &Airport, r: &NetworkRoute, id: u32) -> Vec<V2> {
+    let k = a.network.node_by_id(id).expect("node");
+    let i = r
+        .nodes
+        .iter()
+        .position(|&n| n == Some(k))
+        .expect("on the route");
+    samples(&r.points[i..], 0.5)
+}
+
+/// Nodes 0 (0, 0), 1 (100, 0), 2 (100, 100): east, then a left turn north; taxiway A.
+fn corner(paint: &[(f64, f64)], name: &str) -> Airport {
+    Drawing::new()
         .node(0, 0.0, 0.0)
         .node(1, 100.0, 0.0)
         .node(2, 100.0, 100.0)
         .edge(0, 1, "taxiway_E", "A")
         .edge(1, 2, "taxiway_E", "A")
-        .paint(1, &[(0.0, -10.0), (90.0, -10.0)])
-        .read("corner");
+        .paint(1, paint)
+        .read(name)
+}
+
+/// Paint along the first leg 10 m off it that ends 10 m short of the corner: the corner moves
+/// to where the paint's line, extended, meets the unpainted second leg's network line, so the
+/// second leg keeps the network's line; the route still rounds for every turning radius
+/// checked and strays no further than the lateral limit.
+#[test]
+fn paint_ending_before_a_corner_is_extended_to_the_corner() {
+    let a = corner(&[(0.0, -10.0), (90.0, -10.0)], "corner");
     let (network, r) = routes(&a, "node 0", "node 2", &[]);
     drivable(&network);
     drivable(&r);
     assert!(furthest_from_network(&network, &r) <= MAX_OFFSET_M);
-    assert_eq!(r.points.last(), network.points.last());
-    let corner = node_at(&a, &r, 1);
     assert!(
-        (corner - V2::new(90.0, -10.0)).norm() < 0.02,
-        "FIXME fixed? {corner}"
+        (r.points[0] - V2::new(0.0, -10.0)).norm() < 0.02,
+        "{}",
+        r.points[0]
     );
+    for x in (1..100).map(f64::from) {
+        assert!((y_at(&r, x) + 10.0).abs() < 0.03, "{x}: {}", y_at(&r, x));
+    }
+    let corner = node_at(&a, &r, 1);
+    assert!((corner - V2::new(100.0, -10.0)).norm() < 0.02, "{corner}");
+    let second = from_node(&a, &r, 1);
+    assert!(second.len() > 200, "{}", second.len());
+    for p in second {
+        assert!((p.x - 100.0).abs() < 0.05 && p.y >= -10.02, "{p}");
+    }
+    assert_eq!(r.points.last(), network.points.last());
+}
+
+/// The mirror case: paint along the second leg 10 m off it that starts 10 m past the corner
+/// (drawn from the route's end towards it): the corner moves to where the paint's line meets
+/// the unpainted first leg's network line, and the first leg stays on it.
+#[test]
+fn paint_starting_after_a_corner_is_extended_back_to_the_corner() {
+    let a = corner(&[(110.0, 100.0), (110.0, 10.0)], "corner_after");
+    let (network, r) = routes(&a, "node 0", "node 2", &[]);
+    drivable(&network);
+    drivable(&r);
+    assert!(furthest_from_network(&network, &r) <= MAX_OFFSET_M);
+    assert_eq!(r.points[0], network.points[0]);
+    for x in (0..110).map(f64::from) {
+        // The network's line, to the drawing's round trip through latitude and longitude.
+        assert!(y_at(&r, x).abs() < 1e-3, "{x}: {}", y_at(&r, x));
+    }
+    let corner = node_at(&a, &r, 1);
+    assert!((corner - V2::new(110.0, 0.0)).norm() < 0.02, "{corner}");
+    let second = from_node(&a, &r, 1);
+    assert!(second.len() > 200, "{}", second.len());
+    for p in second {
+        assert!((p.x - 110.0).abs() < 0.05 && p.y >= -0.02, "{p}");
+    }
+    // The route's end moves sideways onto the paint abeam it.
+    let end = r.points[r.points.len() - 1];
+    assert!((end - V2::new(110.0, 100.0)).norm() < 0.02, "{end}");
 }
