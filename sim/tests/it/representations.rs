@@ -167,3 +167,53 @@ fn a_banded_check_ignores_bands_above_the_parts_a_circle_covers() {
     }];
     assert!(banded(&tail, &maps(2), &heights)(&pose));
 }
+
+#[test]
+fn octomaps_voxels_answer_as_a_brute_force_search_of_them() {
+    use mapper::GridGeometry;
+    use nalgebra::Point2;
+    use rand::{RngExt as _, SeedableRng as _};
+    use sim::studies::representations::octomap::VoxelSet;
+
+    let g = GridGeometry::new(Point2::new(-20.0, 40.0), 0.2, 100, 100).expect("a geometry");
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    for res in [0.2, 0.1] {
+        // Voxel centres on OctoMap's lattice (its layers from 0.05 m), a few outside the window.
+        let voxels: Vec<[f32; 3]> = (0..400)
+            .map(|_| {
+                let mut c = |lo: f64, n: i64| lo + (rng.random_range(0..n) as f64 + 0.5) * res;
+                [
+                    c(-22.0, (24.0 / res) as i64) as f32,
+                    c(38.0, (24.0 / res) as i64) as f32,
+                    c(0.05, (6.0 / res) as i64) as f32,
+                ]
+            })
+            .collect();
+        let set = VoxelSet::new(&voxels, res, g);
+        let inside = |v: &[f32; 3]| g.contains(&Point2::new(v[0] as f64, v[1] as f64));
+        for _ in 0..3000 {
+            let centre = Point2::new(rng.random_range(-19.0..-1.0), rng.random_range(41.0..59.0));
+            let r = rng.random_range(0.05..3.0);
+            let (lo, hi) = (rng.random_range(0.0..4.0), rng.random_range(0.0..6.5));
+            let snapped = |x: f64| ((x / res).floor() + 0.5) * res;
+            let c = Point2::new(snapped(centre.x), snapped(centre.y));
+            let brute = voxels.iter().filter(|v| inside(v)).any(|v| {
+                let d = (v[0] as f64 - c.x).hypot(v[1] as f64 - c.y);
+                d < r - 1e-6 && (v[2] as f64) >= lo - 1e-6 && (v[2] as f64) <= hi + 1e-6
+            });
+            let near_edge = voxels.iter().any(|v| {
+                let d = (v[0] as f64 - c.x).hypot(v[1] as f64 - c.y);
+                (d - r).abs() < 1e-4
+                    || ((v[2] as f64) - lo).abs() < 1e-4
+                    || ((v[2] as f64) - hi).abs() < 1e-4
+            });
+            if !near_edge {
+                assert_eq!(
+                    set.span_collides(centre, r, lo, hi),
+                    brute,
+                    "res {res}, centre {centre}, r {r}, span [{lo}, {hi}]"
+                );
+            }
+        }
+    }
+}

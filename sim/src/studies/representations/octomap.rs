@@ -3,7 +3,6 @@
 //! the `octomap-python` binding (the library's C++ insertion and queries), its occupied voxels
 //! read back and every pose judged on them as the dense voxel grid's are.
 
-use std::collections::HashSet;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -259,11 +258,15 @@ fn script_path() -> Result<PathBuf> {
         .ok_or_else(|| Error::Invalid("sim/scripts/octomap_bench.py not found (run from the repository's root or set TAXI_SIM_OCTOMAP_SCRIPT)".into()))
 }
 
-/// OctoMap's occupied voxels as a set of keys on its own lattice (x, y on multiples of the
-/// resolution; z layers from the floor), for the same span check as the dense grid's.
+/// OctoMap's occupied voxels by column on its own lattice (x, y on multiples of the resolution;
+/// z layers from the floor) over the window, for the same span check as the dense grid's: per
+/// column its occupied layers, sorted (compressed rows: `starts[column]..starts[column + 1]`).
 pub struct VoxelSet {
-    keys: HashSet<(i32, i32, i32)>,
+    starts: Vec<u32>,
+    layers: Vec<i32>,
     resolution_m: f64,
+    origin: (i64, i64),
+    size: (usize, usize),
     geometry: GridGeometry,
 }
 
@@ -273,47 +276,88 @@ fn snap(x: f64, res: f64) -> f64 {
 }
 
 impl VoxelSet {
-    /// The set of `voxels` (centres) at `resolution_m`; queries snap a circle's centre to the
-    /// centre of the lattice column holding it (as the 2D maps read their distance maps at their
-    /// own cells) and answer as colliding outside `geometry` (as they read 0 there).
+    /// The set of `voxels` (centres) at `resolution_m` over `geometry`'s extent (voxels outside
+    /// it dropped); queries snap a circle's centre to the centre of the lattice column holding it
+    /// (as the 2D maps read their distance maps at their own cells) and answer as colliding
+    /// outside `geometry` (as they read 0 there).
     pub fn new(voxels: &[[f32; 3]], resolution_m: f64, geometry: GridGeometry) -> Self {
-        let key = |v: &[f32; 3]| {
-            (
-                (v[0] as f64 / resolution_m).floor() as i32,
-                (v[1] as f64 / resolution_m).floor() as i32,
-                ((v[2] as f64 - FLOOR_M) / resolution_m).floor() as i32,
-            )
-        };
+        let res = resolution_m;
+        let g = &geometry;
+        let origin = (
+            (g.origin_m().x / res).round() as i64,
+            (g.origin_m().y / res).round() as i64,
+        );
+        let scale = g.resolution_m() / res;
+        let size = (
+            (g.width() as f64 * scale).ceil() as usize,
+            (g.height() as f64 * scale).ceil() as usize,
+        );
+        let mut keyed: Vec<(usize, i32)> = voxels
+            .iter()
+            .filter_map(|v| {
+                let x = (v[0] as f64 / res).floor() as i64 - origin.0;
+                let y = (v[1] as f64 / res).floor() as i64 - origin.1;
+                let k = ((v[2] as f64 - FLOOR_M) / res).floor() as i32;
+                (x >= 0 && y >= 0 && (x as usize) < size.0 && (y as usize) < size.1)
+                    .then(|| (y as usize * size.0 + x as usize, k))
+            })
+            .collect();
+        keyed.sort_unstable();
+        keyed.dedup();
+        let mut starts = vec![0u32; size.0 * size.1 + 1];
+        for (column, _) in &keyed {
+            starts[column + 1] += 1;
+        }
+        for i in 1..starts.len() {
+            starts[i] += starts[i - 1];
+        }
         VoxelSet {
-            keys: voxels.iter().map(key).collect(),
+            starts,
+            layers: keyed.into_iter().map(|(_, k)| k).collect(),
             resolution_m,
+            origin,
+            size,
             geometry,
         }
     }
 
+    /// Whether the column at lattice `(x, y)` has an occupied layer within `k0..=k1`.
+    fn column_has(&self, x: i64, y: i64, (k0, k1): (i32, i32)) -> bool {
+        let (cx, cy) = (x - self.origin.0, y - self.origin.1);
+        if cx < 0 || cy < 0 || cx as usize >= self.size.0 || cy as usize >= self.size.1 {
+            return false;
+        }
+        let column = cy as usize * self.size.0 + cx as usize;
+        let layers = &self.layers[self.starts[column] as usize..self.starts[column + 1] as usize];
+        let first = layers.partition_point(|k| *k < k0);
+        layers.get(first).is_some_and(|k| *k <= k1)
+    }
+
     /// Whether an occupied voxel whose centre lies within [z_lo, z_hi] has its column's centre
-    /// nearer than `radius_m` to the centre of the map cell holding `centre`.
+    /// nearer than `radius_m` to the centre of the lattice column holding `centre`.
     pub fn span_collides(&self, centre: Point2<f64>, radius_m: f64, z_lo: f64, z_hi: f64) -> bool {
         if self.geometry.cell_of(&centre).is_none() {
             return true;
         }
         let res = self.resolution_m;
         let c = Point2::new(snap(centre.x, res), snap(centre.y, res));
-        let k0 = ((z_lo - FLOOR_M) / res - 0.5).ceil() as i32;
+        let k0 = (((z_lo - FLOOR_M) / res - 0.5).ceil() as i32).max(0);
         let k1 = ((z_hi - FLOOR_M) / res - 0.5).floor() as i32;
+        if k1 < k0 {
+            return false;
+        }
         let (x0, x1) = (
-            ((c.x - radius_m) / res).floor() as i32,
-            ((c.x + radius_m) / res).ceil() as i32,
+            ((c.x - radius_m) / res).floor() as i64,
+            ((c.x + radius_m) / res).ceil() as i64,
         );
         let (y0, y1) = (
-            ((c.y - radius_m) / res).floor() as i32,
-            ((c.y + radius_m) / res).ceil() as i32,
+            ((c.y - radius_m) / res).floor() as i64,
+            ((c.y + radius_m) / res).ceil() as i64,
         );
         (x0..=x1).any(|x| {
             (y0..=y1).any(|y| {
                 let (vx, vy) = ((x as f64 + 0.5) * res, (y as f64 + 0.5) * res);
-                (vx - c.x).hypot(vy - c.y) < radius_m
-                    && (k0.max(0)..=k1).any(|k| self.keys.contains(&(x, y, k)))
+                (vx - c.x).hypot(vy - c.y) < radius_m && self.column_has(x, y, (k0, k1))
             })
         })
     }
