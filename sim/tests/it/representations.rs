@@ -217,3 +217,53 @@ fn octomaps_voxels_answer_as_a_brute_force_search_of_them() {
         }
     }
 }
+
+#[test]
+#[ignore = "reads ../shared/data"]
+fn shared_data_a_real_recording_goes_through_every_representation() {
+    let pcap = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/data/velodyne/monterey-first-100-packets.pcap");
+    let s = scenario("straight_cone_under_wing.toml");
+    let config = RunConfig::for_scenario(&s, None).expect("its configuration");
+    let options = Options {
+        stretch: Stretch {
+            at_m: None,
+            length_m: 200.0,
+            spacing_m: None,
+        },
+        draw: PoseDraw {
+            count: 1,
+            seed: 1,
+            near_m: 2.0,
+            max_depth_m: 0.3,
+            seen_m: 40.0,
+        },
+        octomap: None,
+        carving_diagnostic: false,
+    };
+    let r = sim::studies::representations::recording::compare_recording(
+        &pcap,
+        &s,
+        &config,
+        &options,
+        &mut |_, _, _| {},
+    )
+    .expect("the recording compared");
+    // VeloView cuts 19 revolutions from these packets, the first and last partial.
+    assert_eq!(r.revolutions, 17);
+    assert_eq!(r.poses, (0, 0), "nothing judged without ground truth");
+    assert_eq!(r.rows.len(), 4);
+    for row in &r.rows {
+        assert!(row.insert_ms.is_some_and(|ms| ms > 0.0), "{}", row.name);
+        assert!(
+            row.judged.pose_check_ns.is_nan(),
+            "{}: no pose timed",
+            row.name
+        );
+    }
+    // The real street holds obstacles in every representation's memory: the dense grid's bytes
+    // are fixed by its box, over five times the two levels'.
+    assert!(
+        row(&r, "3D voxels").memory_window_bytes > 5 * row(&r, "multi-height").memory_window_bytes
+    );
+}

@@ -60,6 +60,14 @@ pub struct RepresentationArgs {
     /// inserting again (the same options give the same revolutions and poses).
     #[arg(long)]
     pub octomap_reuse: bool,
+    /// A real Velodyne capture (pcap) as one more scene (alone when no `--scenario` is given):
+    /// memory and time only (no ground truth), the sensor standing, levelled on the ground
+    /// fitted under it.
+    #[arg(long, value_name = "FILE")]
+    pub pcap: Option<PathBuf>,
+    /// The scenario whose vehicle (levels, ceiling) the capture is mapped for.
+    #[arg(long, default_value = "scenarios/straight_cone_under_wing.toml")]
+    pub pcap_scenario: PathBuf,
     /// Draw the pictures and write the tables again from `DIR/representations.json` (a run's
     /// `--out`), measuring nothing.
     #[arg(long, value_name = "DIR")]
@@ -122,7 +130,7 @@ pub fn run(
         return redraw(dir);
     }
     let options = options(args, out)?;
-    let scenes: Vec<PathBuf> = if scenes.is_empty() {
+    let scenes: Vec<PathBuf> = if scenes.is_empty() && args.pcap.is_none() {
         DEFAULT_SCENES.iter().map(PathBuf::from).collect()
     } else {
         scenes.to_vec()
@@ -153,6 +161,27 @@ pub fn run(
                 .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
             study::chart::draw(&result, dir, &stem)?;
         }
+        emit(&study::table::scene_table(&result))?;
+        emit("\n")?;
+        results.push(result);
+    }
+    if let Some(pcap) = &args.pcap {
+        let scenario = sim::scenario::Scenario::from_file(&args.pcap_scenario)?;
+        let config = sim::scenario::RunConfig::for_scenario(&scenario, None)?;
+        let bar = ProgressBar::new(1);
+        let result = study::recording::compare_recording(
+            pcap,
+            &scenario,
+            &config,
+            &options,
+            &mut |stage, done, total| {
+                bar.set_message(stage.to_string());
+                bar.set_length(total as u64);
+                bar.set_position(done as u64);
+            },
+        )
+        .with_context(|| format!("{}: the comparison", pcap.display()))?;
+        bar.finish_and_clear();
         emit(&study::table::scene_table(&result))?;
         emit("\n")?;
         results.push(result);
@@ -196,7 +225,9 @@ fn redraw(dir: &Path) -> anyhow::Result<()> {
         let stem = Path::new(&r.path)
             .file_stem()
             .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-        study::chart::draw(r, dir, &stem)?;
+        if r.poses.0 > 0 {
+            study::chart::draw(r, dir, &stem)?;
+        }
         emit(&study::table::scene_table(r))?;
         emit("\n")?;
     }

@@ -15,6 +15,7 @@ pub mod answers;
 pub mod chart;
 pub mod drive;
 pub mod octomap;
+pub mod recording;
 pub mod spans;
 pub mod table;
 pub mod truth;
@@ -203,7 +204,7 @@ fn route_blocks(route: &autonomy::RoutePath, config: &RunConfig) -> usize {
 }
 
 /// Memory over the route: the window's bytes per block times the route's blocks.
-fn scale_route_memory(result: &mut SceneResult) {
+pub(crate) fn scale_route_memory(result: &mut SceneResult) {
     for row in &mut result.rows {
         row.memory_route_bytes =
             (row.memory_window_bytes as f64 / 9.0 * result.route_blocks as f64) as u64;
@@ -252,7 +253,7 @@ fn medians_ms(times: &InsertTimes) -> ([f64; 4], [f64; 2]) {
     )
 }
 
-fn judge_all(
+pub(crate) fn judge_all(
     scenario: &Scenario,
     config: &RunConfig,
     reps: &mut Representations,
@@ -418,7 +419,7 @@ fn versus(answers: &[bool], reference: &[bool]) -> (usize, usize) {
 
 /// OctoMap's rows: the drive inserted by the script at each resolution, every pose judged on its
 /// occupied voxels, a sample checked by the binding itself (timed, and its answers compared).
-fn octomap_rows(
+pub(crate) fn octomap_rows(
     (scenario, reps, circles): (&Scenario, &Representations, &[spans::SpanCircle]),
     truth: &[TruthPose],
     clouds: &[Cloud],
@@ -428,7 +429,7 @@ fn octomap_rows(
     let vehicle = &scenario.vehicle.vehicle;
     let g = *reps.cumulative.geometry();
     let hi = g.origin_m() + Vector2::new(g.width() as f64, g.height() as f64) * g.resolution_m();
-    let dir = o.dir.join(file_stem(&scenario.path));
+    let dir = o.dir.join(file_stem(Path::new(&result.path)));
     let exchange = octomap::Exchange::create(&dir)?;
     let timed: Vec<Isometry2<f64>> = truth.iter().take(o.timed_poses).map(|p| p.pose).collect();
     exchange.write(

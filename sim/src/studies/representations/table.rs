@@ -34,6 +34,15 @@ fn near_cell(r: &Row, near: Near) -> String {
     })
 }
 
+/// A count of wrong answers, or "-" where nothing was judged (a real recording).
+fn judged(s: &SceneResult, n: usize) -> String {
+    if s.poses.0 == 0 {
+        "-".into()
+    } else {
+        n.to_string()
+    }
+}
+
 /// One scene's table: cost and wrong answers per representation.
 pub fn scene_table(s: &SceneResult) -> String {
     let mut t = String::new();
@@ -58,16 +67,20 @@ pub fn scene_table(s: &SceneResult) -> String {
             .map_or_else(|| "-".into(), |u| format!("{u:.2} ({})", r.update_kind));
         let _ = write!(
             t,
-            "| {} | {} / {} | {} | {} | {:.2} | {} | {} |",
+            "| {} | {} / {} | {} | {} | {} | {} | {} |",
             r.name,
             mb(r.memory_window_bytes),
             mb(r.memory_route_bytes),
             r.insert_ms
                 .map_or_else(|| "-".into(), |ms| format!("{ms:.2}")),
             update,
-            r.judged.pose_check_ns / 1e3,
-            r.judged.all.false_alarms,
-            r.judged.all.misses
+            if r.judged.pose_check_ns.is_finite() {
+                format!("{:.2}", r.judged.pose_check_ns / 1e3)
+            } else {
+                "-".into()
+            },
+            judged(s, r.judged.all.false_alarms),
+            judged(s, r.judged.all.misses)
         );
         for n in &nears {
             let _ = write!(t, " {} |", near_cell(r, *n));
@@ -103,10 +116,10 @@ pub fn headline(results: &[SceneResult]) -> String {
                     r.insert_ms.unwrap_or(f64::NAN)
                         / thesis.insert_ms.unwrap_or(f64::NAN).max(1e-9)
                 ),
-                thesis.judged.all.false_alarms,
-                thesis.judged.all.misses,
-                r.judged.all.false_alarms,
-                r.judged.all.misses
+                judged(s, thesis.judged.all.false_alarms),
+                judged(s, thesis.judged.all.misses),
+                judged(s, r.judged.all.false_alarms),
+                judged(s, r.judged.all.misses)
             );
         }
     }
