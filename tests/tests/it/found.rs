@@ -211,6 +211,55 @@ fn a_truck_lost_toward_the_standing_jet_is_waited_for() {
     );
 }
 
+/// FIXME (README, Known problems): found by the traffic campaign on the calibrated LiDAR
+/// (variant 559 of 1000 on aa8261c): a van crossing diagonally at 4.5 m/s meets the left wing tip
+/// of the jet slowing at 1.07 m/s - at fault. Not yet read run by run. Asserted as it is.
+#[test]
+fn fixme_a_van_crosses_the_slowing_jets_wing() {
+    let r = run_found_with(&found("van_crosses_under_the_braking_jets_wing"), |_| {});
+    let c: Vec<(&str, &str)> = r
+        .contacts_judged
+        .iter()
+        .map(|c| (c.contact.object.as_str(), c.contact.part.as_str()))
+        .collect();
+    assert_eq!(c, [("van_1", "wing_left")], "FIXME fixed?");
+    assert_eq!(
+        r.contacts_at_fault, 1,
+        "FIXME fixed? {:?}",
+        r.contacts_judged
+    );
+    assert!(r.contacts_judged[0].vehicle_speed_m_s > 0.5);
+}
+
+/// FIXME (README, Known problems): found by the traffic campaign on the calibrated LiDAR
+/// (variant 592 of 1000 on aa8261c): a fuel truck crossing square to the route at 1.23 m/s is met
+/// by the jet creeping at 0.82 m/s (its fuselage, then its right wing), which then waits for a
+/// hidden obstacle. It looks like variant 560 (a long truck read too slow to be predicted); not
+/// yet read run by run. Asserted as it is.
+#[test]
+fn fixme_a_slow_fuel_truck_meets_the_creeping_fuselage() {
+    let r = run_found_with(
+        &found("slow_fuel_truck_meets_the_creeping_fuselage"),
+        |_| {},
+    );
+    let c: Vec<(&str, &str)> = r
+        .contacts_judged
+        .iter()
+        .map(|c| (c.contact.object.as_str(), c.contact.part.as_str()))
+        .collect();
+    assert_eq!(
+        c,
+        [("fuel_truck_2", "fuselage"), ("fuel_truck_2", "wing_right")],
+        "FIXME fixed?"
+    );
+    assert_eq!(
+        r.contacts_at_fault, 2,
+        "FIXME fixed? {:?}",
+        r.contacts_judged
+    );
+    assert_eq!(r.end, sim::engine::EndReason::WaitingForHiddenObstacle);
+}
+
 /// Not a case any stack can pass, kept as the evidence for the campaign's change: a follow-me car
 /// appeared (`appears_s` 29.6 s) 3.2 m left of the centreline ahead of the jet at 8 m/s - inside
 /// its stopping distance - and drove toward it. The stack braked at once (from the speed at the
