@@ -33,6 +33,14 @@ fn calibrated_sensor(c: &mut RunConfig) {
     c.lidar = sim::world::LidarConfig::default();
 }
 
+/// Each judged contact as (object, vehicle part), in time order.
+fn contact_parts(r: &sim::engine::RunReport) -> Vec<(&str, &str)> {
+    r.contacts_judged
+        .iter()
+        .map(|c| (c.contact.object.as_str(), c.contact.part.as_str()))
+        .collect()
+}
+
 fn found(name: &str) -> Scenario {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("found")
@@ -183,11 +191,7 @@ fn a_truck_lost_toward_the_standing_jet_is_waited_for() {
     let r = run_found_with(&found("fuel_truck_meets_the_stopping_jets_nacelle"), |_| {});
     assert_eq!(r.contacts_at_fault, 0, "{:?}", r.contacts_judged);
     assert_eq!(r.end, sim::engine::EndReason::WaitingForHiddenObstacle);
-    let c: Vec<(&str, &str)> = r
-        .contacts_judged
-        .iter()
-        .map(|c| (c.contact.object.as_str(), c.contact.part.as_str()))
-        .collect();
+    let c = contact_parts(&r);
     assert_eq!(c, [("fuel_truck_1", "nacelle_left")]);
     // FIXME (README, Known problems): with the calibrated sensor the same case is at fault again:
     // struck standing (50.1 s), the jet then creeps at 0.055 m/s while the slow truck still
@@ -217,11 +221,7 @@ fn a_truck_lost_toward_the_standing_jet_is_waited_for() {
 #[test]
 fn fixme_a_van_crosses_the_slowing_jets_wing() {
     let r = run_found_with(&found("van_crosses_under_the_braking_jets_wing"), |_| {});
-    let c: Vec<(&str, &str)> = r
-        .contacts_judged
-        .iter()
-        .map(|c| (c.contact.object.as_str(), c.contact.part.as_str()))
-        .collect();
+    let c = contact_parts(&r);
     assert_eq!(c, [("van_1", "wing_left")], "FIXME fixed?");
     assert_eq!(
         r.contacts_at_fault, 1,
@@ -242,11 +242,7 @@ fn fixme_a_slow_fuel_truck_meets_the_creeping_fuselage() {
         &found("slow_fuel_truck_meets_the_creeping_fuselage"),
         |_| {},
     );
-    let c: Vec<(&str, &str)> = r
-        .contacts_judged
-        .iter()
-        .map(|c| (c.contact.object.as_str(), c.contact.part.as_str()))
-        .collect();
+    let c = contact_parts(&r);
     assert_eq!(
         c,
         [("fuel_truck_2", "fuselage"), ("fuel_truck_2", "wing_right")],
@@ -267,11 +263,7 @@ fn fixme_a_slow_fuel_truck_meets_the_creeping_fuselage() {
 #[test]
 fn fixme_the_jet_moves_off_into_a_slow_fuel_truck() {
     let r = run_found_with(&found("jet_moves_off_into_a_slow_fuel_truck"), |_| {});
-    let c: Vec<(&str, &str)> = r
-        .contacts_judged
-        .iter()
-        .map(|c| (c.contact.object.as_str(), c.contact.part.as_str()))
-        .collect();
+    let c = contact_parts(&r);
     assert_eq!(c, [("fuel_truck_1", "wing_left")], "FIXME fixed?");
     assert_eq!(
         r.contacts_at_fault, 1,

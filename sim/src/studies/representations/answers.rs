@@ -56,17 +56,11 @@ pub struct Judged {
 }
 
 /// Judges `check` over `poses`: the answers against the truth, then the checks timed over
-/// repeated passes (at least 20 ms).
+/// repeated passes (at least 20 ms; `pose_check_ns` NaN without poses).
 pub fn judge(poses: &[TruthPose], mut check: impl FnMut(&Isometry2<f64>) -> bool) -> Judged {
-    let mut out = Judged::default();
-    for p in poses {
-        let said = check(&p.pose);
-        out.answers.push(said);
-        out.all.add((p.colliding, said));
-        out.by_near
-            .entry(p.near)
-            .or_default()
-            .add((p.colliding, said));
+    let mut out = judge_untimed(poses, &mut check);
+    if poses.is_empty() {
+        return out;
     }
     let (mut reps, mut sink) = (0u64, 0usize);
     let t = Instant::now();
@@ -77,11 +71,28 @@ pub fn judge(poses: &[TruthPose], mut check: impl FnMut(&Isometry2<f64>) -> bool
         reps += 1;
     }
     std::hint::black_box(sink);
-    out.pose_check_ns = if poses.is_empty() {
-        f64::NAN
-    } else {
-        t.elapsed().as_nanos() as f64 / (reps as f64 * poses.len() as f64)
+    out.pose_check_ns = t.elapsed().as_nanos() as f64 / (reps as f64 * poses.len() as f64);
+    out
+}
+
+/// [`judge`] without the timing (`pose_check_ns` NaN): for answers timed elsewhere.
+pub fn judge_untimed(
+    poses: &[TruthPose],
+    mut check: impl FnMut(&Isometry2<f64>) -> bool,
+) -> Judged {
+    let mut out = Judged {
+        pose_check_ns: f64::NAN,
+        ..Judged::default()
     };
+    for p in poses {
+        let said = check(&p.pose);
+        out.answers.push(said);
+        out.all.add((p.colliding, said));
+        out.by_near
+            .entry(p.near)
+            .or_default()
+            .add((p.colliding, said));
+    }
     out
 }
 

@@ -158,37 +158,44 @@ pub fn drive_poses(
         .collect()
 }
 
-/// `scan` without the returns on the vehicle itself (its circles, with the map's margin), and
-/// the cloud OctoMap is given.
-pub fn without_self_hits(
-    scan: &Scan,
-    vehicle: &CollisionModel,
-    margin_m: f64,
-) -> Result<(Scan, Cloud)> {
+impl Cloud {
+    /// Every return of `scan`, from its first column's sensor origin (a still sweep: every
+    /// column's).
+    pub fn of(scan: &Scan) -> Result<Cloud> {
+        let origin = scan
+            .columns()
+            .first()
+            .map(|c| Point3::from(c.world_from_sensor.translation.vector))
+            .ok_or_else(|| Error::Invalid("a revolution with no column".into()))?;
+        let points = scan
+            .returns()
+            .iter()
+            .flatten()
+            .map(|r| {
+                let p = r.point_in_world;
+                [p.x as f32, p.y as f32, p.z as f32]
+            })
+            .collect();
+        Ok(Cloud { origin, points })
+    }
+}
+
+/// `scan` without the returns on the vehicle itself (its circles, with the map's margin).
+pub fn without_self_hits(scan: &Scan, vehicle: &CollisionModel, margin_m: f64) -> Result<Scan> {
     let beams = scan.beams();
     let mut returns = scan.returns().to_vec();
-    let mut points = Vec::with_capacity(returns.len());
     for (c, col) in scan.columns().iter().enumerate() {
         let from_world = col.world_from_vehicle.inverse();
         for r in &mut returns[c * beams..(c + 1) * beams] {
-            let Some(ret) = r else { continue };
-            let p = ret.point_in_world;
-            if vehicle.is_self_hit(&(from_world * Point2::new(p.x, p.y)), p.z, margin_m) {
-                *r = None;
-            } else {
-                points.push([p.x as f32, p.y as f32, p.z as f32]);
+            if let Some(ret) = r {
+                let p = ret.point_in_world;
+                if vehicle.is_self_hit(&(from_world * Point2::new(p.x, p.y)), p.z, margin_m) {
+                    *r = None;
+                }
             }
         }
     }
-    let origin = scan
-        .columns()
-        .first()
-        .map(|c| Point3::from(c.world_from_sensor.translation.vector))
-        .ok_or_else(|| Error::Invalid("a revolution with no column".into()))?;
-    Ok((
-        Scan::new(beams, scan.columns().to_vec(), returns)?,
-        Cloud { origin, points },
-    ))
+    Ok(Scan::new(beams, scan.columns().to_vec(), returns)?)
 }
 
 /// Casts the revolution at `pose` (index `k`) in `world`.

@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use mapper::edt::EdtScratch;
-use mapper::{DistanceMap, DistanceMaps};
+use mapper::{CollisionModel, DistanceMap, DistanceMaps};
 use nalgebra::{Isometry2, Point2, Vector2};
 use serde::{Deserialize, Serialize};
 
@@ -152,10 +152,10 @@ pub fn compare_scene(
     let (mut times, mut clouds) = (InsertTimes::default(), Vec::new());
     for (k, pose) in poses.iter().enumerate() {
         let scan = drive::cast(&lidar, &mut world, pose, k, scenario.seed);
-        let (scan, cloud) = drive::without_self_hits(&scan, &self_filter, margin)?;
+        let scan = drive::without_self_hits(&scan, &self_filter, margin)?;
         one.install(|| reps.insert(&scan, &mut times))?;
         if options.octomap.is_some() {
-            clouds.push(cloud);
+            clouds.push(Cloud::of(&scan)?);
         }
         progress("drive", k + 1, poses.len());
     }
@@ -168,13 +168,15 @@ pub fn compare_scene(
         (lo + Vector2::new(5.0, 5.0), hi - Vector2::new(5.0, 5.0)),
         &options.draw,
     );
-    let mut result = one.install(|| judge_all(scenario, config, &mut reps, &truth, &times))?;
+    let circles = spans::span_circles(&model, vehicle);
+    let vehicle_model = (&model, circles.as_slice());
+    let mut result =
+        one.install(|| judge_all(scenario, vehicle_model, &mut reps, &truth, &times))?;
     result.revolutions = poses.len();
     result.driven_m = spacing * (poses.len().saturating_sub(1)) as f64;
     result.route_blocks = route_blocks(&route, config);
     if let Some(o) = &options.octomap {
         progress("OctoMap", 0, 1);
-        let circles = spans::span_circles(&model, vehicle);
         let ctx = (scenario, &reps, circles.as_slice());
         octomap_rows(ctx, &truth, &clouds, o, &mut result)?;
     } else {
@@ -253,16 +255,15 @@ fn medians_ms(times: &InsertTimes) -> ([f64; 4], [f64; 2]) {
     )
 }
 
+/// Every representation judged on `truth` with the vehicle's `model` and its circles' `circles`.
 pub(crate) fn judge_all(
     scenario: &Scenario,
-    config: &RunConfig,
+    (model, circles): (&CollisionModel, &[spans::SpanCircle]),
     reps: &mut Representations,
     truth: &[TruthPose],
     times: &InsertTimes,
 ) -> Result<SceneResult> {
     let vehicle = &scenario.vehicle.vehicle;
-    let model = config.collision_model(vehicle)?;
-    let circles = spans::span_circles(&model, vehicle);
     let heights = model.level_heights_m().to_vec();
     let (col, upd) = medians_ms(times);
     let start = Instant::now();
@@ -272,23 +273,23 @@ pub(crate) fn judge_all(
     let map_bytes = |levels: usize| cells * levels as u64 * 8;
     let voxels = judge(
         truth,
-        answers::spans(&circles, |c, r, a, b| reps.voxels.span_collides(c, r, a, b)),
+        answers::spans(circles, |c, r, a, b| reps.voxels.span_collides(c, r, a, b)),
     );
     let cumulative = judge(
         truth,
-        answers::cumulative(&model, reps.cumulative.distance_maps())?,
+        answers::cumulative(model, reps.cumulative.distance_maps())?,
     );
     let banded = judge(
         truth,
-        answers::banded(&circles, reps.banded.distance_maps(), &heights),
+        answers::banded(circles, reps.banded.distance_maps(), &heights),
     );
     let elevation = judge(
         truth,
-        answers::spans(&circles, |c, r, a, b| {
+        answers::spans(circles, |c, r, a, b| {
             reps.elevation.span_collides(c, r, a, b)
         }),
     );
-    let hits_only = judge_hits_only(reps, truth, &circles);
+    let hits_only = judge_hits_only(reps, truth, circles);
     let full_cumulative = full_2d_update_s(reps.cumulative.distance_maps()) * 1e3;
     let levels = heights.len();
     let row =
@@ -451,7 +452,8 @@ pub(crate) fn octomap_rows(
             return Ok(());
         };
         let set = octomap::VoxelSet::new(&voxels, res, g);
-        let mut judged = judge(
+        // Timed through the binding itself (below), not here.
+        let mut judged = answers::judge_untimed(
             truth,
             answers::spans(circles, |c, r, a, b| set.span_collides(c, r, a, b)),
         );

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use nalgebra::{Isometry2, Point2, Point3};
+use nalgebra::{Isometry2, Point2};
 
 use super::drive::{Cloud, InsertTimes, Representations};
 use super::{Options, SceneResult};
@@ -40,21 +40,16 @@ pub fn compare_recording(
         let scan = recording.scan(frame, &pose, &vehicle_from_sensor)?.scan;
         one.install(|| reps.insert(&scan, &mut times))?;
         if options.octomap.is_some() {
-            let origin = Point3::from(vehicle_from_sensor.translation.vector);
-            let points = scan
-                .returns()
-                .iter()
-                .flatten()
-                .map(|r| {
-                    let p = r.point_in_world;
-                    [p.x as f32, p.y as f32, p.z as f32]
-                })
-                .collect();
-            clouds.push(Cloud { origin, points });
+            clouds.push(Cloud::of(&scan)?);
         }
         progress("recording", k + 1, full.len());
     }
-    let mut result = one.install(|| super::judge_all(scenario, config, &mut reps, &[], &times))?;
+    let vehicle = &scenario.vehicle.vehicle;
+    let model = config.collision_model(vehicle)?;
+    let circles = super::spans::span_circles(&model, vehicle);
+    let vehicle_model = (&model, circles.as_slice());
+    let mut result =
+        one.install(|| super::judge_all(scenario, vehicle_model, &mut reps, &[], &times))?;
     result.scenario = format!(
         "real HDL-32E recording {}",
         pcap.file_name()
@@ -70,9 +65,6 @@ pub fn compare_recording(
     ));
     if let Some(o) = &options.octomap {
         progress("OctoMap", 0, 1);
-        let vehicle = &scenario.vehicle.vehicle;
-        let model = config.collision_model(vehicle)?;
-        let circles = super::spans::span_circles(&model, vehicle);
         let ctx = (scenario, &reps, circles.as_slice());
         super::octomap_rows(ctx, &[], &clouds, o, &mut result)?;
     }
