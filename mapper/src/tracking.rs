@@ -25,6 +25,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::map::WorldCell;
 
+/// A track's peak speed ([`TrackState::peak_speed_m_s`]) is the fastest over this long,
+/// seconds.
+pub const PEAK_SPEED_S: f64 = 3.0;
+
 /// What the tracker of moving objects does.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -203,6 +207,9 @@ struct Track {
     last_t_s: f64,
     /// Sum of the centre's steps, metres.
     path_m: f64,
+    /// Its speed on each revolution of the last [`PEAK_SPEED_S`] it was seen moving steadily, as
+    /// (time, m/s), oldest first.
+    recent_speeds: std::collections::VecDeque<(f64, f64)>,
     /// Largest extent (bounding-box diagonal) it was seen with, metres.
     max_extent_m: f64,
     /// Its cells this revolution: bounding box (world cells), when seen.
@@ -265,6 +272,10 @@ pub struct TrackState {
     pub bbox: (WorldCell, WorldCell),
     /// That box's size along x and y, metres.
     pub size_m: [f64; 2],
+    /// The fastest its velocity was over about the last [`PEAK_SPEED_S`] seconds it was seen
+    /// moving steadily (at least its speed now), m/s: a mover going into the shadow of a wing
+    /// seems to slow as its visible part shrinks, and is lost at that lower speed.
+    pub peak_speed_m_s: f64,
 }
 
 impl TrackState {
@@ -390,6 +401,7 @@ impl Tracker {
             last: cluster.center,
             last_t_s: t_s,
             path_m: 0.0,
+            recent_speeds: std::collections::VecDeque::new(),
             max_extent_m: 0.0,
             bbox: None,
             last_bbox: cluster.bbox,
@@ -455,6 +467,7 @@ impl Tracker {
             }
             track.first = cluster.center;
             track.path_m = 0.0;
+            track.recent_speeds.clear();
             track.motion = Motion::new(
                 cluster.center,
                 if another { Vector2::zeros() } else { velocity },
@@ -469,6 +482,15 @@ impl Tracker {
         }
         if track.smooth {
             track.steady += 1;
+            let speed = track.motion.velocity().norm();
+            track.recent_speeds.push_back((t_s, speed));
+            while track
+                .recent_speeds
+                .front()
+                .is_some_and(|&(t, _)| t_s - t > PEAK_SPEED_S)
+            {
+                track.recent_speeds.pop_front();
+            }
         }
         track.seen += 1;
         track.last = cluster.center;
@@ -602,6 +624,11 @@ impl Tracker {
             levels: t.levels,
             confirmed: t.moving,
             travel_m: (t.last - t.origin).norm(),
+            peak_speed_m_s: t
+                .recent_speeds
+                .iter()
+                .map(|&(_, v)| v)
+                .fold(t.motion.velocity().norm(), f64::max),
         }
     }
 
@@ -914,6 +941,34 @@ mod tests {
         let (candidate, mover) = (candidate.unwrap(), mover.unwrap());
         assert!(candidate <= 12, "a candidate at revolution {candidate}");
         assert!((42..=50).contains(&mover), "a mover at revolution {mover}");
+    }
+
+    /// A van seen at 4 m/s that seems to slow to 1 m/s (its visible part shrinking as it goes into
+    /// the shadow of a wing) keeps its peak speed for about [`PEAK_SPEED_S`]; then the peak gives
+    /// way to the speed measured since.
+    #[test]
+    fn a_movers_peak_speed_is_kept_for_a_few_seconds() {
+        let mut t = Tracker::new(TrackerConfig::default(), 0.2);
+        let mut y: f64 = 0.0;
+        let speed_at = |k: u32| if k < 40 { 4.0 } else { 1.0 };
+        let mut peaks = Vec::new();
+        for k in 0..120 {
+            y += speed_at(k) * 0.1;
+            t.update(k as f64 * 0.1, &block(0, (y / 0.2).round() as i64, 9, 22));
+            if let Some(m) = t.movers().first() {
+                peaks.push((k, m.peak_speed_m_s, m.velocity.norm()));
+            }
+        }
+        let at = |k: u32| peaks.iter().find(|p| p.0 == k).copied().unwrap();
+        // Slowed a second ago: its velocity is below 2 m/s, its peak still about 4.
+        assert!(
+            at(50).2 < 2.0 && (at(50).1 - 4.0).abs() < 0.4,
+            "{:?}",
+            at(50)
+        );
+        // Long slowed: the peak is the speed now.
+        assert!((at(119).1 - 1.0).abs() < 0.3, "{:?}", at(119));
+        assert!(peaks.iter().all(|p| p.1 >= p.2 - 1e-12));
     }
 
     /// A parked car revealed from one end (its visible part grows over 3 s, as a vehicle

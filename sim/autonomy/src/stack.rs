@@ -14,7 +14,7 @@ use crate::planner::{
 use crate::route::{RoutePath, wrap_angle};
 use crate::traffic::{
     Conflict, Prediction, SpeedProfile, TimedPath, at_body, first_conflict,
-    moved_beyond_its_extent, predict,
+    moved_beyond_its_extent, predict, predict_keeping,
 };
 
 /// Half length of the stretch of route searched around the last progress when the estimate is
@@ -142,6 +142,11 @@ const DROPPED_AT_BODY_S: f64 = 2.0;
 /// heavy faults spurious returns make one-cell tracks that jump at 5-14 m/s and are dropped
 /// within a second.
 const COASTED_S: f64 = 2.0;
+
+/// ... and only one seen and predicted on consecutive plans for at least this long, seconds
+/// (three revolutions): one revolution's jump of a one-cell track is no evidence of a mover (a
+/// parked car a stale map does not hold).
+const SEEN_MOVING_S: f64 = 0.15;
 
 /// A track seen and predicted as a mover on consecutive plans.
 #[derive(Clone, Copy, Debug)]
@@ -509,7 +514,14 @@ impl Driver {
             self.predictions.clear();
             return None;
         }
-        self.predictions = predict(movers, now_s, traffic);
+        // A mover known to move (by the body hold's evidence) and in view stays predicted
+        // slower than the floor: its visible part slows as the airframe hides the rest of it.
+        let kept: Vec<u32> = movers
+            .iter()
+            .filter(|t| now_s - t.t_s <= 0.25 && self.arriving(t, now_s, traffic))
+            .map(|t| t.id)
+            .collect();
+        self.predictions = predict_keeping(movers, now_s, traffic, &kept);
         if self.predictions.is_empty() {
             return None;
         }
@@ -598,10 +610,12 @@ impl Driver {
                 .collect::<Vec<_>>();
             body.extend(dropped);
         }
-        // Movers predicted out of view now, confirmed and beyond what revealing a static object
-        // explains: checked again if their track drops (seen too briefly for a streak, maybe).
-        // Unconfirmed ones are not: a one-cell track jumping at 7 m/s at the edge of view, lost
-        // for 6 s, would be predicted onto the body from 50 m away.
+        // Movers predicted out of view now, confirmed, beyond what revealing a static object
+        // explains, and seen predicted on a few revolutions on end: checked again if their
+        // track drops (seen too briefly for a streak, maybe: a van seen in fragments for under
+        // a second each). Others are not: a one-cell track jumping at 7 m/s at the edge of
+        // view, lost for 6 s, would be predicted onto the body from 50 m away (one seen longer
+        // still is: README, Known problems).
         self.coasting = movers
             .iter()
             .filter(|t| {
@@ -609,6 +623,10 @@ impl Driver {
                     && t.confirmed
                     && moved_beyond_its_extent(t, cfg)
                     && self.predictions.iter().any(|p| p.track.id == t.id)
+                    && self
+                        .streaks
+                        .iter()
+                        .any(|r| r.id == t.id && r.last_s - r.since_s >= SEEN_MOVING_S)
             })
             .cloned()
             .collect();

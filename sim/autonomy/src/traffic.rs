@@ -209,26 +209,45 @@ pub struct Conflict {
 
 /// The predictable movers of `tracks` seen at `now_s`, with their discs over the horizon.
 pub fn predict(tracks: &[TrackState], now_s: f64, cfg: &TrafficConfig) -> Vec<Prediction> {
+    predict_keeping(tracks, now_s, cfg, &[])
+}
+
+/// [`predict`], and the tracks of `kept` (movers already known to move) down to half the speed
+/// floor: a truck near the vehicle whose front the airframe hides seems to slow to half its
+/// speed as only its back stays in view, and left to the map it would be a photograph. One
+/// that stopped is the map's again (a parked car a stale map does not hold, once merged into a
+/// track that jumped, would stand predicted by the path for ever).
+pub fn predict_keeping(
+    tracks: &[TrackState],
+    now_s: f64,
+    cfg: &TrafficConfig,
+    kept: &[u32],
+) -> Vec<Prediction> {
     tracks
         .iter()
         .filter(|t| {
             // Moving, and surely: faster than `sigmas` standard deviations of its speed.
             let c = &t.covariance;
             let speed_sigma = c[(2, 2)].max(c[(3, 3)]).max(0.0).sqrt();
-            t.velocity.norm() >= cfg.min_speed_m_s.max(cfg.sigmas * speed_sigma)
+            let speed = t.velocity.norm();
+            if kept.contains(&t.id) {
+                speed >= 0.5 * cfg.min_speed_m_s
+            } else {
+                speed >= cfg.min_speed_m_s.max(cfg.sigmas * speed_sigma)
+            }
         })
         .map(|t| {
             let steps = (cfg.horizon_s / 0.5).ceil() as usize;
             let discs = (0..=steps)
                 .map(|k| {
                     let dt_s = k as f64 * 0.5;
-                    let (center, sigma) = t.predict((now_s + dt_s - t.t_s).max(0.0));
+                    let (slow, fast, sigma) = reach(t, (now_s + dt_s - t.t_s).max(0.0));
                     let f = Footprint::of(t, cfg);
                     PredictedDisc {
                         dt_s,
-                        center,
+                        center: nalgebra::center(&slow, &fast),
                         radius_m: f.half_width_m + cfg.sigmas * sigma,
-                        half_length_m: f.half_length_m,
+                        half_length_m: f.half_length_m + 0.5 * (fast - slow).norm(),
                         heading_rad: f.along.y.atan2(f.along.x),
                     }
                 })
@@ -310,6 +329,20 @@ impl Footprint {
     }
 }
 
+/// Where the centre of mover `t` may be `dt_s` after it was last seen, along its motion: from
+/// where its velocity now puts it (`slow`) to where it would be at the peak speed it was seen
+/// with lately (`fast`; [`TrackState::peak_speed_m_s`]: one that seemed to slow as it went into
+/// the shadow of a wing may not have), and the standard deviation of its position then.
+fn reach(t: &TrackState, dt_s: f64) -> (Point2<f64>, Point2<f64>, f64) {
+    let (slow, sigma) = t.predict(dt_s);
+    let speed = t.velocity.norm();
+    if speed < 1e-9 {
+        return (slow, slow, sigma);
+    }
+    let faster = (t.peak_speed_m_s - speed).max(0.0);
+    (slow, slow + t.velocity / speed * faster * dt_s, sigma)
+}
+
 /// The capsule the mover sweeps from `from_s` to `to_s` (absolute times): its axis' ends and
 /// its radius.
 fn swept(
@@ -319,8 +352,8 @@ fn swept(
     cfg: &TrafficConfig,
 ) -> (Point2<f64>, Point2<f64>, f64) {
     let f = Footprint::of(t, cfg);
-    let (a, _) = t.predict((from_s - t.t_s).max(0.0));
-    let (b, sigma) = t.predict((to_s - t.t_s).max(0.0));
+    let (a, _, _) = reach(t, (from_s - t.t_s).max(0.0));
+    let (_, b, sigma) = reach(t, (to_s - t.t_s).max(0.0));
     (
         a - f.along * f.half_length_m,
         b + f.along * f.half_length_m,
@@ -562,6 +595,7 @@ mod tests {
                 (x.floor() as i64, y.floor() as i64),
             ),
             size_m: [1.0, 1.0],
+            peak_speed_m_s: vx.hypot(vy),
         }
     }
 
@@ -739,5 +773,53 @@ mod tests {
         let cfg = TrafficConfig::default();
         assert!(predict(&[mover(5.0, 0.0, 0.1, 0.0, 1)], 0.0, &cfg).is_empty());
         assert_eq!(predict(&[mover(5.0, 0.0, 1.0, 0.0, 1)], 0.0, &cfg).len(), 1);
+    }
+
+    /// A mover known to move stays predicted down to half the speed floor (a truck whose front
+    /// the airframe hides seems to slow to half its speed); an unknown one that slow does not.
+    #[test]
+    fn a_known_mover_that_seems_to_slow_stays_predicted() {
+        let cfg = TrafficConfig::default();
+        let slow = mover(5.0, 0.0, 0.0, -0.6, 1);
+        assert!(predict_keeping(std::slice::from_ref(&slow), 0.0, &cfg, &[8]).is_empty());
+        let p = predict_keeping(std::slice::from_ref(&slow), 0.0, &cfg, &[7]);
+        assert_eq!(p.len(), 1);
+        assert!(
+            (p[0].discs[4].center.y - -1.2).abs() < 1e-9,
+            "{:?}",
+            p[0].discs[4]
+        );
+        // Stopped (under half the floor): the map's again.
+        let stopped = mover(5.0, 0.0, 0.0, -0.3, 1);
+        assert!(predict_keeping(std::slice::from_ref(&stopped), 0.0, &cfg, &[7]).is_empty());
+    }
+
+    /// A van last seen at 1.5 m/s, having been seen at 4.5 m/s: its predicted footprint reaches
+    /// from where its speed now puts it to where the peak would; with no peak above its speed,
+    /// the footprint is where its speed puts it.
+    #[test]
+    fn a_movers_footprint_stretches_to_where_its_peak_speed_would_take_it() {
+        let cfg = TrafficConfig::default();
+        let van = TrackState {
+            peak_speed_m_s: 4.5,
+            ..mover(0.0, 20.0, 0.0, -1.5, 1)
+        };
+        let p = &predict(std::slice::from_ref(&van), 0.0, &cfg)[0];
+        let d = p.discs.iter().find(|d| d.dt_s == 4.0).unwrap();
+        let f = Footprint::of(&van, &cfg);
+        // 4 s on: 6 m (its speed) to 18 m (its peak) towards -y.
+        assert!((d.center.y - 8.0).abs() < 1e-9, "{d:?}");
+        assert!(
+            (d.half_length_m - (f.half_length_m + 6.0)).abs() < 1e-9,
+            "{d:?}"
+        );
+        let (_, b, _) = swept(&van, 0.0, 4.0, &cfg);
+        assert!((b.y - (2.0 - f.half_length_m)).abs() < 1e-9, "{b:?}");
+        let steady = mover(0.0, 20.0, 0.0, -1.5, 1);
+        let p = &predict(std::slice::from_ref(&steady), 0.0, &cfg)[0];
+        let d = p.discs.iter().find(|d| d.dt_s == 4.0).unwrap();
+        assert!(
+            (d.center.y - 14.0).abs() < 1e-9 && (d.half_length_m - f.half_length_m).abs() < 1e-9
+        );
     }
 }

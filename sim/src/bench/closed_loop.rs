@@ -132,6 +132,7 @@ fn traffic_figures(samples: usize) -> Vec<Figure> {
                 travel_m: 20.0,
                 bbox: ((0, 0), (22, 8)),
                 size_m: [4.6, 1.8],
+                peak_speed_m_s: if i % 3 == 0 { 3.0 } else { 2.0 },
             }
         })
         .collect();

@@ -116,8 +116,9 @@ fn the_airliner_s_wing_passes_over_a_parked_jet_s_wing() {
         (1.1..1.4).contains(&levels[2]) && levels[1] > 1.3 && levels[0] > 3.0,
         "{levels:?}"
     );
-    // FIXME (README, Known problems): the parked jet's wing, seen a slice at a time as the
-    // airliner closes in, makes a track whose centre slides 2.8 m in 2 s; predicted across the
-    // taxilane, it holds the airliner for 5 s.
-    assert_eq!(r.stops.len(), 1, "{:?}", r.stops);
+    // The parked jet's wing, seen a slice at a time as the airliner closes in, made a track whose
+    // centre slid 2.8 m in 2 s; predicted across the taxilane, it held the airliner for 5 s.
+    // Since the slow-mover changes of 2026-11-28 the airliner passes without stopping (not read
+    // run by run why).
+    assert!(r.stops.is_empty(), "{:?}", r.stops);
 }
