@@ -6,7 +6,9 @@
 //!   it, at least half its largest extent) and half its width across, each plus `hidden_m`
 //!   (what of it the sensor may not see), widened by `sigmas` standard deviations of its
 //!   predicted position, which grow with time. Over a stretch of time it sweeps a longer
-//!   capsule, since it moves along its own length. A mover occupies the levels it was hit in: a
+//!   capsule, since it moves along its own length, stretched on to where the fastest speed it
+//!   was seen at lately would take it (a mover going into a wing's shadow seems to slow as its
+//!   visible part shrinks: [`mapper::TrackState::peak_speed_m_s`]). A mover occupies the levels it was hit in: a
 //!   baggage cart lower than a wing's level is checked against the gear and fuselage only.
 //! - **Space-time check**: the vehicle's arrival time at each pose of the chosen path (from its
 //!   speed now, accelerating to the speed it wants), and each circle of a level the mover
@@ -23,7 +25,9 @@
 //!   While yielding, the margin after grows by `resume_margin_s`, so the vehicle does not creep
 //!   off and stop again.
 //! - Movers slower than `min_speed_m_s`, or than `sigmas` standard deviations of their speed,
-//!   are left to the map (their cells are obstacles there).
+//!   are left to the map (their cells are obstacles there) - but a mover known to move, in
+//!   view, down to half that ([`predict_keeping`]: its visible part slows as the airframe hides
+//!   the rest of it).
 //! - **Caution**: a candidate mover - seen to travel a metre, not yet beyond what revealing a
 //!   static object explains - checked the same way caps the speed at `caution_speed_m_s`
 //!   instead of stopping the vehicle: slow for what may move, stop for what does.

@@ -9,7 +9,9 @@ mod world;
 
 pub use draw::{RouteOverlay, draw_airport};
 pub use summary::summary;
-pub use taxi::{DEFAULT_TAXI_SPEED_M_S, DEFAULT_TURN_RADIUS_M, PlannedTaxi, plan_taxi};
+pub use taxi::{
+    DEFAULT_TAXI_SPEED_M_S, DEFAULT_TURN_RADIUS_M, PlannedTaxi, path_options, plan_taxi,
+};
 pub use world::{
     AirportWorld, EDGE_LIGHT_SPACING_M, Furniture, GRASS_REMISSION, airport_world, sign_glyphs,
 };

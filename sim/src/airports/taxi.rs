@@ -74,6 +74,20 @@ impl PlannedTaxi {
     }
 }
 
+/// How a route is rounded for `vehicle` at `turn_radius_m` (no tighter than it turns) and
+/// `speed_m_s` on straights (no faster than it goes).
+pub fn path_options(vehicle: &Vehicle, turn_radius_m: f64, speed_m_s: f64) -> PathOptions {
+    let motion = &vehicle.spec.motion;
+    PathOptions {
+        turn_radius_m: turn_radius_m.max(vehicle.min_turn_radius_m()),
+        max_corner_cut_m: MAX_CORNER_CUT_M,
+        min_turn_radius_m: vehicle.min_turn_radius_m(),
+        straight_speed_m_s: speed_m_s.min(motion.max_speed_m_s),
+        lateral_acceleration_m_s2: motion.max_centripetal_acceleration_m_s2,
+        deceleration_m_s2: 0.5 * motion.max_deceleration_m_s2,
+    }
+}
+
 /// Plans a taxi of `vehicle` on `airport` from `from` to `to` along `via`.
 ///
 /// # Errors
@@ -101,15 +115,7 @@ pub fn plan_taxi(
         code,
     };
     let route = airport::find(airport, &request).map_err(|e| Error::Invalid(e.to_string()))?;
-    let motion = &vehicle.spec.motion;
-    let options = PathOptions {
-        turn_radius_m: turn_radius_m.max(vehicle.min_turn_radius_m()),
-        max_corner_cut_m: MAX_CORNER_CUT_M,
-        min_turn_radius_m: vehicle.min_turn_radius_m(),
-        straight_speed_m_s: speed_m_s.min(motion.max_speed_m_s),
-        lateral_acceleration_m_s2: motion.max_centripetal_acceleration_m_s2,
-        deceleration_m_s2: 0.5 * motion.max_deceleration_m_s2,
-    };
+    let options = path_options(vehicle, turn_radius_m, speed_m_s);
     // On the paint where the network strays; should the paint's line not round for this
     // aircraft (its turn radius) where the network's does, the network's own line.
     let (route, path) = match airport::smooth(&route, &options) {

@@ -5,9 +5,9 @@
 //! line is taken.
 
 use aircraft::Vehicle;
-use airport::{Airport, LatLon, LocalFrame, PathOptions, Place, RouteRequest, SizeClass};
+use airport::{Airport, LatLon, LocalFrame, Place, RouteRequest, SizeClass};
 use nalgebra::Vector2;
-use sim::airports::{DEFAULT_TAXI_SPEED_M_S, DEFAULT_TURN_RADIUS_M, plan_taxi};
+use sim::airports::{DEFAULT_TAXI_SPEED_M_S, DEFAULT_TURN_RADIUS_M, path_options, plan_taxi};
 
 /// An airport whose taxiway A runs east from node 0 (0, 0) to node 1 (100, 0), then turns left
 /// to node 2 (100, `north_m`); centreline paint 10 m north of the first leg (inside the turn)
@@ -63,19 +63,6 @@ fn wide_turning_airliner() -> Vehicle {
     v
 }
 
-/// The smoothing options `plan_taxi` makes for the jet at the default turn radius and speed.
-fn options(v: &Vehicle) -> PathOptions {
-    let m = &v.spec.motion;
-    PathOptions {
-        turn_radius_m: DEFAULT_TURN_RADIUS_M.max(v.min_turn_radius_m()),
-        max_corner_cut_m: 2.5,
-        min_turn_radius_m: v.min_turn_radius_m(),
-        straight_speed_m_s: DEFAULT_TAXI_SPEED_M_S.min(m.max_speed_m_s),
-        lateral_acceleration_m_s2: m.max_centripetal_acceleration_m_s2,
-        deceleration_m_s2: 0.5 * m.max_deceleration_m_s2,
-    }
-}
-
 /// The second leg is 25 m long on the network and 15 m on the paint's line: the paint's corner
 /// rounds at 15 m (the paint keeps it), not at the airliner's 20; the plan takes the network's
 /// line, which rounds at 20. The Praetor-like jet (4.6 m) keeps the paint.
@@ -95,7 +82,11 @@ fn where_the_paints_line_leaves_no_room_to_turn_the_networks_is_taken() {
         (corner - Vector2::new(100.0, 10.0)).norm() < 0.05,
         "{corner}"
     );
-    let err = airport::smooth(&on_paint, &options(&v)).expect_err("no room on the paint");
+    let err = airport::smooth(
+        &on_paint,
+        &path_options(&v, DEFAULT_TURN_RADIUS_M, DEFAULT_TAXI_SPEED_M_S),
+    )
+    .expect_err("no room on the paint");
     assert!(err.to_string().contains("turn too sharp"), "{err}");
     let network = airport::find_on_network(&a, &request).expect("a route on the network");
     let plan = |v: &Vehicle| {
