@@ -79,6 +79,11 @@ pub struct AutonomyConfig {
     /// Waiting for a hidden obstacle this long, the vehicle calls for a pilot (the thesis'
     /// pilot intervention): the run ends, seconds. Default 10.
     pub pilot_call_after_s: f64,
+    /// Stopped this long for obstacles (in view or hidden, with no pause), the vehicle calls
+    /// for a pilot: its path is blocked (debris on the centreline, a vehicle parked across the
+    /// taxiway), and an aircraft never steers round. The run ends, seconds. Default 60: longer
+    /// than any wait for a mover to clear.
+    pub blocked_call_after_s: f64,
     /// The range at which the smallest obstacle the vehicle must avoid is surely mapped, metres
     /// (`taxi-sim small-obstacles` measures it): the avoider never goes faster than it can
     /// stop within it. Default none (no cap): for the IARA car, every obstacle of 0.12 m and up
@@ -142,6 +147,7 @@ impl Default for AutonomyConfig {
             lookahead_gain_s: 1.2,
             hidden_after_s: 2.0,
             pilot_call_after_s: 10.0,
+            blocked_call_after_s: 60.0,
             detection_range_m: None,
             watchdog_s: 0.3,
             uncertainty_sigmas: 2.0,

@@ -79,6 +79,15 @@ pub enum DriverStatus {
     },
 }
 
+/// Why the driver calls for a pilot (the thesis' pilot intervention).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PilotCall {
+    /// It stopped for an obstacle the sensor can no longer see, and cannot see it go.
+    HiddenObstacle,
+    /// It has stood for obstacles in its path for `blocked_call_after_s`: the way is blocked.
+    Blocked,
+}
+
 /// Planner, avoider, behaviour and follower over a route.
 pub struct Driver {
     route: RoutePath,
@@ -108,6 +117,9 @@ pub struct Driver {
     last_conflict_s: Option<f64>,
     /// When a plan last found a candidate mover's motion meeting the path, seconds.
     last_caution_s: Option<f64>,
+    /// Since when the plans have stopped the vehicle for obstacles without a pause (`StoppedFor`
+    /// or `WaitingForHiddenObstacle`), seconds.
+    stopped_since_s: Option<f64>,
     /// The line the vehicle holds short of for a mover: its track, the route arc length,
     /// when the conflict was last found.
     hold: Option<(u32, f64, f64)>,
@@ -203,6 +215,7 @@ impl Driver {
             conflict: None,
             last_conflict_s: None,
             last_caution_s: None,
+            stopped_since_s: None,
             hold: None,
             at_body: Vec::new(),
             coasting: Vec::new(),
@@ -254,6 +267,7 @@ impl Driver {
     /// start over.
     pub fn restart(&mut self) {
         self.status = DriverStatus::Driving;
+        self.stopped_since_s = None;
         self.last_conflict_s = None;
         self.last_caution_s = None;
         self.at_body.clear();
@@ -351,6 +365,12 @@ impl Driver {
                 mover_at: conflict.map_or(here, |c| c.mover_at),
             },
             _ => self.stopped_status(&p, map, estimate.t_s),
+        };
+        self.stopped_since_s = match self.status {
+            DriverStatus::StoppedFor { .. } | DriverStatus::WaitingForHiddenObstacle { .. } => {
+                Some(self.stopped_since_s.unwrap_or(estimate.t_s))
+            }
+            _ => None,
         };
         if conflict.is_some() {
             self.last_conflict_s = Some(estimate.t_s);
@@ -766,11 +786,18 @@ impl Driver {
         self.status
     }
 
-    /// Whether the driver has waited for a hidden obstacle longer than `pilot_call_after_s` at
-    /// `now_s`: it calls for a pilot.
-    pub fn calls_for_pilot(&self, now_s: f64) -> bool {
-        matches!(self.status, DriverStatus::WaitingForHiddenObstacle { since_s, .. }
+    /// Whether the driver calls for a pilot at `now_s`, and why: it has waited for a hidden
+    /// obstacle longer than `pilot_call_after_s`, or stood for obstacles longer than
+    /// `blocked_call_after_s`.
+    pub fn calls_for_pilot(&self, now_s: f64) -> Option<PilotCall> {
+        if matches!(self.status, DriverStatus::WaitingForHiddenObstacle { since_s, .. }
             if now_s - since_s >= self.config.pilot_call_after_s)
+        {
+            return Some(PilotCall::HiddenObstacle);
+        }
+        self.stopped_since_s
+            .filter(|since| now_s - since >= self.config.blocked_call_after_s)
+            .map(|_| PilotCall::Blocked)
     }
 
     /// The command now: the avoider's speed, and pure pursuit's steering onto the chosen path

@@ -5,6 +5,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
+use autonomy::PilotCall;
 use nalgebra::Isometry2;
 
 use super::observer::{Observer, RevolutionFrame, StepFrame};
@@ -34,8 +35,10 @@ impl Rig<'_> {
             if self.t_s > self.timeout_s {
                 return Ok(EndReason::TimedOut);
             }
-            if self.driver.calls_for_pilot(self.t_s) {
-                return Ok(EndReason::WaitingForHiddenObstacle);
+            match self.driver.calls_for_pilot(self.t_s) {
+                Some(PilotCall::HiddenObstacle) => return Ok(EndReason::WaitingForHiddenObstacle),
+                Some(PilotCall::Blocked) => return Ok(EndReason::Blocked),
+                None => {}
             }
             let physics = Instant::now();
             self.move_obstacles();

@@ -613,7 +613,7 @@ impl Judge {
             ExpectedEnd::StoppedForGood => {
                 matches!(
                     end,
-                    EndReason::TimedOut | EndReason::WaitingForHiddenObstacle
+                    EndReason::TimedOut | EndReason::WaitingForHiddenObstacle | EndReason::Blocked
                 ) && self.stops.last().is_some_and(|s| s.end_s.is_none())
             }
         };

@@ -69,6 +69,9 @@ pub enum EndReason {
     /// Stopped for an obstacle the sensor could no longer see, the vehicle waited
     /// `pilot_call_after_s` and called for a pilot (the thesis' pilot intervention).
     WaitingForHiddenObstacle,
+    /// Stood for obstacles in its path (in view or hidden) for `blocked_call_after_s` (60 s),
+    /// the vehicle called for a pilot: its way is blocked (an aircraft never steers round).
+    Blocked,
 }
 
 /// One pass of the vehicle by an obstacle.

@@ -17,8 +17,8 @@ pub struct RunReport {
     pub seed: u64,
     /// True when every expectation held and every lap was completed.
     pub expectations_met: bool,
-    /// Why the run ended: `completed`, `timed_out`, `interrupted` or
-    /// `waiting_for_hidden_obstacle`.
+    /// Why the run ended: `completed`, `timed_out`, `interrupted`,
+    /// `waiting_for_hidden_obstacle` or `blocked` (the last two call for a pilot).
     pub end: EndReason,
     /// When the run ended waiting for a hidden obstacle: which, and since when.
     pub waiting_for: Option<HiddenObstacle>,

@@ -315,7 +315,7 @@ impl<'a> Rig<'a> {
         let contacts = self.world.contacts().to_vec();
         if matches!(
             end,
-            EndReason::TimedOut | EndReason::WaitingForHiddenObstacle
+            EndReason::TimedOut | EndReason::WaitingForHiddenObstacle | EndReason::Blocked
         ) {
             // The vehicle may stand before an obstacle: its pass closes as it stands.
             self.judge.close_open_passes(self.t_s, end);

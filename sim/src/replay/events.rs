@@ -80,6 +80,7 @@ pub(super) fn end_line(report: &RunReport) -> (String, &'static str) {
             EndReason::TimedOut => " (timed out)",
             EndReason::Interrupted => " (interrupted)",
             EndReason::WaitingForHiddenObstacle => " (waiting for a hidden obstacle: pilot called)",
+            EndReason::Blocked => " (blocked: pilot called)",
         }
     );
     let level = if report.expectations_met {

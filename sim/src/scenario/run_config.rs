@@ -355,6 +355,7 @@ impl RunConfig {
         non_negative("autonomy.avoider_safety_m", a.avoider_safety_m as f64)?;
         positive("autonomy.hidden_after_s", a.hidden_after_s)?;
         positive("autonomy.pilot_call_after_s", a.pilot_call_after_s)?;
+        positive("autonomy.blocked_call_after_s", a.blocked_call_after_s)?;
         if let Some(r) = a.detection_range_m {
             positive("autonomy.detection_range_m", r)?;
         }

@@ -78,7 +78,8 @@ pub struct ExpectationsSpec {
     /// How the run must end: `completed` (every lap driven; the default),
     /// `waiting_for_hidden_obstacle` (stopped for an obstacle the sensor can no longer see, the
     /// vehicle calls for a pilot rather than guess it has gone) or `stopped_for_good` (stopped
-    /// before an obstacle that never goes, timed out or calling for a pilot) or `any` (only
+    /// before an obstacle that never goes, timed out or calling for a pilot: waiting for a
+    /// hidden obstacle, or blocked) or `any` (only
     /// contacts and the obstacles' expectations count, and an obstacle never passed counts for
     /// nothing: a campaign's randomized obstacles, which may block the way or appear late).
     pub end: Option<ExpectedEnd>,
@@ -99,7 +100,7 @@ pub enum ExpectedEnd {
     /// Waiting for a hidden obstacle, calling for a pilot.
     WaitingForHiddenObstacle,
     /// Stopped for good before an obstacle that never goes: the run ends timed out or calling
-    /// for a pilot, the vehicle still standing.
+    /// for a pilot (waiting for a hidden obstacle, or blocked), the vehicle still standing.
     StoppedForGood,
     /// However it ends: only contacts and the obstacles' expectations count.
     Any,

@@ -145,8 +145,8 @@ fn a_person_at_the_standing_jets_body_holds_it_until_the_pilot_is_called() {
 /// Fixed: a fuel truck whose driver does not react strikes the standing jet's nose. Before, the
 /// truck's track seemed to stop as the nose hid its front and its side came into view, and the
 /// jet drove on into it (at fault). Now the truck halts where it struck and the jet is held
-/// while the box of the truck's hits is at its body: the run ends at its time limit, the truck
-/// in view. Found by the traffic campaign (variant 192).
+/// while the box of the truck's hits is at its body: after a minute standing for it, the jet
+/// calls a pilot (blocked), the truck in view. Found by the traffic campaign (variant 192).
 #[test]
 fn a_truck_that_struck_the_standing_nose_holds_the_jet() {
     let r = run_found_with(&found("fuel_truck_strikes_the_standing_nose"), |_| {});
@@ -155,7 +155,7 @@ fn a_truck_that_struck_the_standing_nose_holds_the_jet() {
     assert_eq!(c.len(), 1, "{c:?}");
     assert_eq!(c[0].contact.object, "fuel_truck_1");
     assert_eq!(c[0].vehicle_speed_m_s, 0.0, "{c:?}");
-    assert_eq!(r.end, sim::engine::EndReason::TimedOut);
+    assert_eq!(r.end, sim::engine::EndReason::Blocked);
 }
 
 /// Fixed: a 9 m fuel truck crossing at 1.3 m/s along its own length is offered for prediction
@@ -189,7 +189,7 @@ fn a_truck_lost_toward_the_standing_jet_is_waited_for() {
     let r = run_found_with(&found("fuel_truck_meets_the_stopping_jets_nacelle"), |_| {});
     assert_eq!(r.contacts_at_fault, 0, "{:?}", r.contacts_judged);
     assert_eq!(contact_parts(&r), [("fuel_truck_1", "wing_left")]);
-    assert_eq!(r.end, sim::engine::EndReason::TimedOut);
+    assert_eq!(r.end, sim::engine::EndReason::Blocked);
     let r = run_found_with(
         &found("fuel_truck_meets_the_stopping_jets_nacelle"),
         calibrated_sensor,
@@ -236,15 +236,15 @@ fn a_slow_fuel_truck_finds_the_jet_standing() {
 /// it read at 5 m/s stopped the jet with its nose in the truck's lane), moved off as the truck,
 /// now read at 0.65 m/s (its front hidden), fell under the floor of prediction, and met it with
 /// its left wing at 1.13 m/s. Now the known mover stays predicted: the jet stands and the truck
-/// strikes its fuselage (it stands there to the time limit, as a mover touching the vehicle
-/// does in the simulator). Stopping in the lane at all is the needless part (README, Known
+/// strikes its fuselage (it stands there, as a mover touching the vehicle does in the
+/// simulator, and after a minute the jet calls a pilot: blocked). Stopping in the lane at all is the needless part (README, Known
 /// problems).
 #[test]
 fn the_jet_does_not_move_off_into_a_slow_fuel_truck() {
     let r = run_found_with(&found("jet_moves_off_into_a_slow_fuel_truck"), |_| {});
     assert_eq!(contact_parts(&r), [("fuel_truck_1", "fuselage")]);
     assert_eq!(r.contacts_at_fault, 0, "{:?}", r.contacts_judged);
-    assert_eq!(r.end, sim::engine::EndReason::TimedOut);
+    assert_eq!(r.end, sim::engine::EndReason::Blocked);
 }
 
 /// FIXME (README, Known problems): found by the random traffic campaign on b324193 (variant 2):

@@ -71,6 +71,35 @@ fn a_fast_jet_stops_short_of_a_car_parked_across_the_taxiway() {
     assert!(r.lap_times_s.len() == 1);
 }
 
+/// Blocked: the same car parked across the taxiway for good. The jet stops short of it, stands
+/// with the car in plain view, and a minute after its plans first commanded speed 0
+/// (`blocked_call_after_s`; they slow it to a crawl first, so within half a second of coming to
+/// rest) calls for a pilot - an aircraft never steers round. Before, it stood to the run's time limit. With the setting at
+/// 20 s, it calls 40 s sooner.
+#[test]
+fn a_jet_blocked_by_a_car_parked_for_good_calls_a_pilot() {
+    let s = edited("traffic_parked_car_at_speed", "disappears_s = 60.0", "");
+    let dir = tempfile::tempdir().unwrap();
+    for after_s in [60.0, 20.0] {
+        let mut config = RunConfig::for_scenario(&s, None).unwrap();
+        config.pose_source = PoseSourceConfig::Truth;
+        config.autonomy.blocked_call_after_s = after_s;
+        let r = run_with(&s, dir.path(), config);
+        assert!(r.contacts.is_empty(), "{:?}", r.contacts);
+        assert_eq!(r.end, EndReason::Blocked, "{:?}", r.stops);
+        assert_eq!(r.stops.len(), 1, "{:?}", r.stops);
+        let stood_s = r.sim_time_s - r.stops[0].start_s;
+        assert!(
+            (after_s - 0.5..=after_s + 0.11).contains(&stood_s),
+            "stood {stood_s} s, blocked after {after_s} s"
+        );
+        assert_eq!(
+            mover(&r, "parked_car").passes[0].outcome.as_str(),
+            "stopped"
+        );
+    }
+}
+
 /// A baggage cart (1.0 m) driving past under the left wing's path (its level starts at 1.1 m)
 /// does not stop the jet; a fuel truck (3.2 m) on the same path does. Its driver does not react:
 /// it drives on into the standing jet's wing - struck, not the stack's fault (a jet cannot back

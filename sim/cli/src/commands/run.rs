@@ -332,6 +332,7 @@ pub fn table(r: &RunReport) -> String {
             EndReason::Interrupted => "  (interrupted)",
             EndReason::WaitingForHiddenObstacle =>
                 "  (waiting for a hidden obstacle: pilot called)",
+            EndReason::Blocked => "  (blocked: pilot called)",
         }
     );
     let f = &r.faults;
