@@ -226,6 +226,8 @@ struct Track {
     motion: Motion,
     /// The levels it was hit in (bit `l`: level `l`), over its life.
     levels: u32,
+    /// The lowest open top any revolution saw it with (`Cluster::open_top_m`), metres.
+    open_top_m: Option<f32>,
     moving: bool,
     /// Whether this revolution's step continued its motion (seen the revolution before, where
     /// its velocity said): only then may a moving track clear.
@@ -263,6 +265,11 @@ pub struct TrackState {
     pub extent_m: f64,
     /// The levels it was hit in (bit `l`: level `l`): the height span of the object.
     pub levels: u32,
+    /// How high above the ground it may reach where the sensor has not seen it, metres: the
+    /// lowest height at which a revolution's beams passed over all of it they hit (infinity:
+    /// never all; `None`: no revolution told, as with [`Tracker::update_with_levels`]). A
+    /// nose sensor 1.55 m up sees a 1.5 m van's side only below 1.1 m from 19 m out.
+    pub open_top_m: Option<f64>,
     /// Confirmed moving by the stricter rule that lets it clear what it left.
     pub confirmed: bool,
     /// How far its centre is from where it was first seen, metres: beyond its extent, it moved
@@ -314,6 +321,9 @@ struct Cluster {
     center: Point2<f64>,
     bbox: (WorldCell, WorldCell),
     levels: u32,
+    /// The highest open top of its cells (`MultiHeightMap::last_scan_open_tops`): where the
+    /// beam above each of its columns' top hits went (`None`: no cell told).
+    open_top_m: Option<f32>,
 }
 
 impl Tracker {
@@ -339,17 +349,20 @@ impl Tracker {
     /// confirmed moving and seen this revolution, whose centre is now farther from them than its
     /// largest extent plus the clear margin, and not hit by anything since.
     pub fn update_with_levels(&mut self, t_s: f64, hits: &[(WorldCell, u32)]) -> Vec<WorldCell> {
-        self.update_except(t_s, hits, |_| false)
+        self.update_except(t_s, hits, &[], |_| false)
     }
 
     /// [`Tracker::update_with_levels`], but the hits on cells `is_static` names (an offline
     /// map's obstacles) are only noted as hit: no object is clustered from them, so a static
     /// object never passes for a mover, and a mover passing one (a truck beside a lamp post)
-    /// is followed on its own hits.
+    /// is followed on its own hits. `open_tops` (sorted by cell, as
+    /// `MultiHeightMap::last_scan_open_tops` gives them) says how high the object hit in a cell
+    /// may reach unseen ([`TrackState::open_top_m`]).
     pub fn update_except(
         &mut self,
         t_s: f64,
         hits: &[(WorldCell, u32)],
+        open_tops: &[(WorldCell, f32)],
         is_static: impl Fn(WorldCell) -> bool,
     ) -> Vec<WorldCell> {
         for &(c, _) in hits {
@@ -369,7 +382,17 @@ impl Tracker {
             .copied()
             .filter(|&(c, _)| !is_static(c))
             .collect();
-        let clusters = self.clusters(&movable);
+        let mut clusters = self.clusters(&movable);
+        for cl in &mut clusters {
+            cl.open_top_m = cl
+                .cells
+                .iter()
+                .filter_map(|c| {
+                    let k = open_tops.binary_search_by(|(o, _)| o.cmp(c)).ok()?;
+                    Some(open_tops[k].1)
+                })
+                .reduce(f32::max);
+        }
         let assigned = self.associate(t_s, &clusters);
         for t in &mut self.tracks {
             t.bbox = None;
@@ -415,6 +438,7 @@ impl Tracker {
                 0.5 * cfg.max_speed_m_s,
             ),
             levels: 0,
+            open_top_m: None,
             moving: false,
             smooth: false,
             painted: Vec::new(),
@@ -462,6 +486,7 @@ impl Tracker {
                 track.moving = false;
                 track.predictable = false;
                 track.levels = 0;
+                track.open_top_m = None;
                 track.max_extent_m = 0.0;
                 track.seen = 0;
             }
@@ -498,6 +523,9 @@ impl Tracker {
         track.bbox = Some(cluster.bbox);
         track.last_bbox = cluster.bbox;
         track.levels |= cluster.levels;
+        if let Some(top) = cluster.open_top_m {
+            track.open_top_m = Some(track.open_top_m.map_or(top, |t| t.min(top)));
+        }
         track.max_extent_m = track.max_extent_m.max(extent);
         // What it hits on a step its motion does not explain (it took over another object's
         // hits) it owns, so no other track clears it, but never clears itself.
@@ -622,6 +650,7 @@ impl Tracker {
             covariance: t.motion.p,
             extent_m: t.max_extent_m,
             levels: t.levels,
+            open_top_m: t.open_top_m.map(f64::from),
             confirmed: t.moving,
             travel_m: (t.last - t.origin).norm(),
             peak_speed_m_s: t
@@ -702,6 +731,7 @@ impl Tracker {
                     center: Point2::origin(),
                     bbox: (c, c),
                     levels: 0,
+                    open_top_m: None,
                 });
             }
             let cl = &mut clusters[k];
@@ -874,6 +904,43 @@ mod tests {
             let cleared = t.update(k as f64 * 0.1, &block(k * 5, 0, 2, 2));
             assert!(cleared.iter().all(|c| !boxed.contains(c)), "{cleared:?}");
             k += 1;
+        }
+    }
+
+    /// A van's open top is the lowest of its revolutions' (each the highest of its cells'):
+    /// one cell whose beam above passed over at 1.55 m and one at 1.2 m make 1.55 m; a later
+    /// revolution bounding it at 1.3 m lowers it; one whose beams above were stopped nearer
+    /// (infinity), or that says nothing, leaves it; fed no open tops, a track has none.
+    #[test]
+    fn a_tracks_open_top_is_the_lowest_of_its_revolutions() {
+        let mut t = Tracker::new(TrackerConfig::default(), 0.2);
+        let mut plain = Tracker::new(TrackerConfig::default(), 0.2);
+        let mut tops_seen = Vec::new();
+        for k in 0..30 {
+            let x = (k as f64 * 0.3 / 0.2).round() as i64;
+            let cells = block(x, 0, 23, 9);
+            let van: Vec<(WorldCell, u32)> = cells.iter().map(|&c| (c, 1)).collect();
+            let tops: Vec<(WorldCell, f32)> = match k {
+                0..14 => vec![(cells[0], 1.2), (cells[5], 1.55)],
+                14..22 => vec![(cells[3], 1.3)],
+                22..26 => vec![(cells[3], f32::INFINITY)],
+                _ => Vec::new(),
+            };
+            t.update_except(k as f64 * 0.1, &van, &tops, |_| false);
+            plain.update_with_levels(k as f64 * 0.1, &van);
+            if let Some(m) = t.movers().first() {
+                tops_seen.push((k, m.open_top_m));
+            }
+            if let Some(m) = plain.movers().first() {
+                assert_eq!(m.open_top_m, None);
+            }
+        }
+        // Predicted from about a second on.
+        assert!(tops_seen.iter().any(|&(k, _)| k < 14), "{tops_seen:?}");
+        assert!(tops_seen.iter().any(|&(k, _)| k >= 26), "{tops_seen:?}");
+        for (k, top) in tops_seen {
+            let want = if k < 14 { 1.55 } else { 1.3 };
+            assert_eq!(top, Some(f64::from(want as f32)), "revolution {k}");
         }
     }
 

@@ -29,6 +29,7 @@ use rayon::prelude::*;
 use super::config::{FreeSpaceWalks, MapConfig};
 use super::distance::{TouchedCells, no_obstacle_at_or_below};
 use super::forget::{CLEAR_MARGIN_M, HitSpan, OccupiedCells, WalkStops};
+use super::open_top::{NO_CLAIM, beam_elevations, claim_open_tops};
 use super::walk::{Walk, walk_free};
 use super::{MultiHeightMap, WorldCell};
 use crate::collision::CollisionModel;
@@ -60,13 +61,16 @@ pub struct InsertStats {
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Classified {
     /// Cell index in the window, `u32::MAX` when dropped.
-    cell: u32,
+    pub(super) cell: u32,
     height_m: f32,
-    range_xy_m: f32,
-    obstacle: bool,
+    pub(super) range_xy_m: f32,
+    pub(super) obstacle: bool,
+    /// An obstacle return's open top: how high above the ground its object may reach where the
+    /// sensor cannot see, metres (`open_top.rs`; `NO_CLAIM` when the return above claims).
+    pub(super) open_top_m: f32,
 }
 
-const DROPPED: u32 = u32::MAX;
+pub(super) const DROPPED: u32 = u32::MAX;
 
 /// What one level needs to know of one column before walking it, from the classification pass:
 /// the farthest return it considers (not above it) and its nearest obstacle hit, as beam and
@@ -210,6 +214,7 @@ impl MultiHeightMap {
             })
             .collect();
         let n_levels = bands.len().max(1);
+        let elevations = beam_elevations(scan);
         self.column_levels
             .resize(scan.columns().len() * n_levels, ColumnLevel::default());
         let counts: (usize, usize, usize, usize) = self
@@ -274,6 +279,7 @@ impl MultiHeightMap {
                         height_m: height as f32,
                         range_xy_m: range_xy as f32,
                         obstacle,
+                        open_top_m: NO_CLAIM,
                     };
                     out[b] = c;
                     // Per level: the farthest return considered (the last of equals) and the
@@ -291,6 +297,7 @@ impl MultiHeightMap {
                         }
                     }
                 }
+                claim_open_tops(out, returns, column, &elevations, params.ground_height_m);
                 (n, self_hits, far, above)
             })
             .reduce(

@@ -34,6 +34,8 @@
 //! - `config`: [`MapConfig`] and the choices it names;
 //! - `window`: re-centring, blocks in from the stores and out to the live store;
 //! - `insert`: [`MultiHeightMap::insert_scan`] (classification, hits, the walks' schedule);
+//! - `open_top`: how high each hit object may reach unseen, from the beam above it
+//!   ([`MultiHeightMap::last_scan_open_tops`]);
 //! - `walk`: the Bresenham free-space walk;
 //! - `distance`: the distance maps brought up to date from the touched cells;
 //! - `forget`: forgetting on evidence, [`MultiHeightMap::clear_live`],
@@ -44,6 +46,7 @@ mod config;
 mod distance;
 mod forget;
 mod insert;
+mod open_top;
 mod query;
 mod walk;
 mod window;

@@ -1,8 +1,9 @@
 //! The mapper's integration tests, one binary: collision checks, exports, the map (by subject)
-//! and overhead structures.
+//! open tops and overhead structures.
 
 mod collision;
 mod export;
 mod map;
+mod open_top;
 mod overhead;
 mod representations;

@@ -153,7 +153,10 @@ impl OnlineMap {
                 (y - 1..=y + 1).any(|y| (0..levels).any(|l| map.is_prior_obstacle(l, (x, y))))
             })
         };
-        let clear = self.tracker.update_except(revolution.t_s, &hits, is_static);
+        let tops = self.map.last_scan_open_tops();
+        let clear = self
+            .tracker
+            .update_except(revolution.t_s, &hits, &tops, is_static);
         self.map.clear_live(&clear);
         self.revolutions += 1;
         if self.revolutions.is_multiple_of(50) {
@@ -181,15 +184,42 @@ impl OnlineMap {
     /// made of hits on or beside an obstacle of the offline map (of any level, [`Self::update`]):
     /// a static object the map holds, whose visible part slides as the vehicle drives by, never
     /// moved.
+    ///
+    /// A track's levels are those it was hit in and, once it is confirmed moving, those its
+    /// open top may reach unseen (the levels starting below it,
+    /// [`mapper::TrackState::open_top_m`]): a 1.5 m van seen only below 1.1 m from 19 m out
+    /// may reach the wing's level. Not before: static clutter far off, whose visible part
+    /// slides, makes short tracks whose tops nothing has bounded (on a stale map, the car
+    /// stopped for them until it called a pilot).
     pub fn movers(&self) -> Vec<mapper::TrackState> {
-        self.tracker.movers()
+        self.tracker
+            .movers()
+            .into_iter()
+            .map(|t| self.with_open_top(t))
+            .collect()
+    }
+
+    /// `t` with the levels its open top may reach added, if it is confirmed moving.
+    fn with_open_top(&self, mut t: mapper::TrackState) -> mapper::TrackState {
+        if let Some(top) = t.open_top_m.filter(|_| t.confirmed) {
+            for (k, &lower) in self.map.levels().heights_m().iter().enumerate() {
+                if lower < top {
+                    t.levels |= 1u32 << k.min(31);
+                }
+            }
+        }
+        t
     }
 
     /// The tracked objects that may be moving but are not yet predictable
     /// ([`mapper::Tracker::candidate_movers`]), as of the last revolution; none made of hits
     /// beside an offline-map obstacle either.
     pub fn candidate_movers(&self) -> Vec<mapper::TrackState> {
-        self.tracker.candidate_movers()
+        self.tracker
+            .candidate_movers()
+            .into_iter()
+            .map(|t| self.with_open_top(t))
+            .collect()
     }
 
     /// The multi-height map (occupancy and distance maps per level).

@@ -591,6 +591,7 @@ mod tests {
             covariance: Matrix4::from_diagonal(&nalgebra::Vector4::new(0.01, 0.01, 0.01, 0.01)),
             extent_m: 2.0,
             levels,
+            open_top_m: None,
             confirmed: true,
             travel_m: 10.0,
             // Its hits: the 1 m cell it stands in.

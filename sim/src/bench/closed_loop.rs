@@ -128,6 +128,7 @@ fn traffic_figures(samples: usize) -> Vec<Figure> {
                 covariance: Matrix4::from_diagonal(&Vector4::new(0.02, 0.02, 0.05, 0.05)),
                 extent_m: 4.9,
                 levels: 0b11,
+                open_top_m: None,
                 confirmed: true,
                 travel_m: 20.0,
                 bbox: ((0, 0), (22, 8)),

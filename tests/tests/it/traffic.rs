@@ -126,14 +126,21 @@ fn a_cart_passes_under_the_wing_a_fuel_truck_does_not() {
         truck.contacts
     );
     // FIXME (README, Known problems): the cart should not stop the jet at all; the jet holds
-    // short of it for about 6 s (the cart's predicted footprint, widened by what it may hide
-    // and its uncertainty, reaches the gear's path). Asserted as it is.
+    // short of it for about 9 s (the cart's predicted footprint, widened by what it may hide
+    // and its uncertainty, reaches the gear's path; and until the cart is within 24 m the
+    // sensor, 1.55 m up, cannot tell it from a 1.5 m van - its open top - and a fragment of it
+    // tracked apart is never bounded below the wing level). 7 s before the open top. Asserted
+    // as it is.
     let stood: f64 = cart
         .stops
         .iter()
         .map(|s| s.end_s.unwrap_or(cart.sim_time_s) - s.start_s)
         .sum();
-    assert!((4.0..9.0).contains(&stood), "FIXME fixed? {:?}", cart.stops);
+    assert!(
+        (7.0..11.0).contains(&stood),
+        "FIXME fixed? {:?}",
+        cart.stops
+    );
 }
 
 /// A van whose driver obeys the ramp rule stops for the jet; the jet, seeing it stand, drives on
