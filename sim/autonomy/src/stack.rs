@@ -364,7 +364,7 @@ impl Driver {
                 track_id: self.hold.map_or(u32::MAX, |h| h.0),
                 mover_at: conflict.map_or(here, |c| c.mover_at),
             },
-            _ => self.stopped_status(&p, map, estimate.t_s),
+            _ => self.stopped_status(&p, map, estimate.t_s, &config),
         };
         self.stopped_since_s = match self.status {
             DriverStatus::StoppedFor { .. } | DriverStatus::WaitingForHiddenObstacle { .. } => {
@@ -735,9 +735,16 @@ impl Driver {
     }
 
     /// Why the vehicle is stopped by the chosen candidate's first colliding pose: the obstacle
-    /// cells within each circle's radius plus the avoider's margin there, and when a revolution
-    /// last hit any of them.
-    fn stopped_status(&self, p: &Plan, map: &OnlineMap, now_s: f64) -> DriverStatus {
+    /// cells within each circle's radius plus the avoider's margin there (as `config`, the plan's,
+    /// widened for the estimate's uncertainty, has it; a metre more if none is), and when a
+    /// revolution last hit any of them.
+    fn stopped_status(
+        &self,
+        p: &Plan,
+        map: &OnlineMap,
+        now_s: f64,
+        config: &AutonomyConfig,
+    ) -> DriverStatus {
         let c = p.chosen();
         let Some(at_m) = c.collision_at_m else {
             return DriverStatus::Driving;
@@ -747,19 +754,25 @@ impl Driver {
             return DriverStatus::Driving;
         };
         let m = map.map();
-        let margin = f64::from(self.config.avoider_safety_m) + m.config().resolution_m;
+        let margin = f64::from(config.avoider_safety_m) + m.config().resolution_m;
         let (mut nearest, mut last_seen): (Option<(f64, Point2<f64>)>, Option<f64>) = (None, None);
-        for circle in self.vehicle.collision.circles() {
-            let center = pose * Point2::new(circle.x_m, circle.y_m);
-            for cell in m.obstacles_within(circle.level, &center, circle.radius_m + margin) {
-                let at = m.world_cell_center(cell);
-                let d = (at - center).norm();
-                if nearest.is_none_or(|(best, _)| d < best) {
-                    nearest = Some((d, at));
+        for extra in [0.0, 1.0] {
+            for circle in self.vehicle.collision.circles() {
+                let center = pose * Point2::new(circle.x_m, circle.y_m);
+                let r = circle.radius_m + margin + extra;
+                for cell in m.obstacles_within(circle.level, &center, r) {
+                    let at = m.world_cell_center(cell);
+                    let d = (at - center).norm();
+                    if nearest.is_none_or(|(best, _)| d < best) {
+                        nearest = Some((d, at));
+                    }
+                    if let Some(t) = map.last_hit_s(cell) {
+                        last_seen = Some(last_seen.map_or(t, |s: f64| s.max(t)));
+                    }
                 }
-                if let Some(t) = map.last_hit_s(cell) {
-                    last_seen = Some(last_seen.map_or(t, |s: f64| s.max(t)));
-                }
+            }
+            if nearest.is_some() {
+                break;
             }
         }
         let Some((_, obstacle)) = nearest else {
