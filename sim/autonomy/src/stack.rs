@@ -14,7 +14,7 @@ use crate::planner::{
 use crate::route::{RoutePath, wrap_angle};
 use crate::traffic::{
     Conflict, Prediction, SpeedProfile, TimedPath, at_body, first_conflict,
-    moved_beyond_its_extent, predict, predict_keeping,
+    moved_beyond_its_extent, passes_standing, predict, predict_keeping, surely_moving,
 };
 
 /// Half length of the stretch of route searched around the last progress when the estimate is
@@ -322,7 +322,8 @@ impl Driver {
         );
         // The tracker's movers, once a plan: the space-time check and the body hold read them.
         let movers = map.movers();
-        let wanted = self.caution(&p, &map.candidate_movers(), wanted, estimate.t_s, &config);
+        let candidates = map.candidate_movers();
+        let wanted = self.caution(&p, &candidates, &movers, wanted, estimate.t_s, &config);
         let mut conflict = self.traffic_conflict(&p, &movers, wanted, estimate.t_s, &config, false);
         let v0 = self.last_odometry.map_or(0.0, |o| o.speed_m_s.max(0.0));
         if conflict.is_some_and(|c| stopping_distance_m(v0, decel, &config) >= c.zone_m) {
@@ -343,7 +344,7 @@ impl Driver {
             // Stopping - for a mover or the map - never where another mover is predicted to
             // pass, when the vehicle can stop short of its path.
             chosen.collision_at_m =
-                Some(self.stand_clear(&p, at, v0, decel, estimate.t_s, &config));
+                Some(self.stand_clear(&p, &movers, at, v0, decel, estimate.t_s, &config));
         }
         let (mut v, _) = avoid(&chosen, wanted, decel, &config);
         let body = self.movers_at_body(
@@ -399,12 +400,15 @@ impl Driver {
 
     /// `wanted` capped at the caution speed while the motion so far of a candidate mover (one
     /// not yet predictable, [`mapper::Tracker::candidate_movers`]) would meet `p`'s chosen path,
-    /// and for `conflict_memory_s` after: by the time it is confirmed, the vehicle can stop
-    /// short of it; if it was a static object's parts coming into view, it only slowed.
+    /// or the path passes near a known mover standing ([`traffic::passes_standing`]), and for
+    /// `conflict_memory_s` after: by the time a candidate is confirmed, or the one standing has
+    /// walked on, the vehicle can stop short of it; if it was a static object's parts coming
+    /// into view, it only slowed.
     fn caution(
         &mut self,
         p: &Plan,
         candidates: &[TrackState],
+        movers: &[TrackState],
         wanted: f64,
         now_s: f64,
         config: &AutonomyConfig,
@@ -425,6 +429,19 @@ impl Driver {
             if first_conflict(&path, &self.vehicle.collision, &predictions, traffic).is_some() {
                 self.last_caution_s = Some(now_s);
             }
+        }
+        let standing: Vec<TrackState> = movers
+            .iter()
+            .filter(|t| !surely_moving(t, traffic))
+            .cloned()
+            .collect();
+        if passes_standing(
+            &self.vehicle.collision,
+            &p.chosen().poses,
+            &standing,
+            traffic,
+        ) {
+            self.last_caution_s = Some(now_s);
         }
         if self
             .last_caution_s
@@ -479,18 +496,26 @@ impl Driver {
         self.hold.map(|(_, line, _)| (line - s).max(0.0))
     }
 
-    /// Where to stop instead of `at_m` ahead so as not to stand in a predicted mover's path
+    /// Where to stop instead of `at_m` ahead so as not to stand in a predicted mover's path,
+    /// nor beside one of `movers` not predicted now - standing, or too slow to predict
     /// ([`traffic::stand_clear`]); `at_m` when it is clear or too late.
+    #[allow(clippy::too_many_arguments)]
     fn stand_clear(
         &self,
         p: &Plan,
+        movers: &[TrackState],
         at_m: f64,
         v0: f64,
         decel: f64,
         now_s: f64,
         config: &AutonomyConfig,
     ) -> f64 {
-        if !config.traffic.enabled || self.predictions.is_empty() {
+        let standing: Vec<TrackState> = movers
+            .iter()
+            .filter(|t| !self.predictions.iter().any(|q| q.track.id == t.id))
+            .cloned()
+            .collect();
+        if !config.traffic.enabled || (self.predictions.is_empty() && standing.is_empty()) {
             return at_m;
         }
         let path = TimedPath {
@@ -504,6 +529,7 @@ impl Driver {
             &path,
             &self.vehicle.collision,
             &self.predictions,
+            &standing,
             at_m,
             config.stop_buffer_m,
             stopping_distance_m(v0, decel, config),

@@ -92,6 +92,12 @@ pub struct TrafficConfig {
     /// it is confirmed, the vehicle can stop short of it. Default 3 (a long truck crossing at
     /// 1.3 m/s takes 4.4 s to confirm, 35 m at 8 m/s).
     pub caution_speed_m_s: f64,
+    /// A mover standing (a known mover not [`surely_moving`]) may walk or drive on without
+    /// warning: the vehicle passes within this much of it (beyond `margin_m` and its
+    /// footprint) no faster than `caution_speed_m_s` ([`passes_standing`]), and does not stop
+    /// within it when it can stop short ([`stand_clear`]), metres. Default 3 (two seconds of a
+    /// brisk walk; a van from rest at 1.5 m/s^2).
+    pub standing_reach_m: f64,
 }
 
 impl Default for TrafficConfig {
@@ -109,6 +115,7 @@ impl Default for TrafficConfig {
             min_speed_m_s: 0.8,
             at_body_m: 1.0,
             caution_speed_m_s: 3.0,
+            standing_reach_m: 3.0,
         }
     }
 }
@@ -128,6 +135,7 @@ impl TrafficConfig {
             ("min_speed_m_s", self.min_speed_m_s),
             ("at_body_m", self.at_body_m),
             ("caution_speed_m_s", self.caution_speed_m_s),
+            ("standing_reach_m", self.standing_reach_m),
         ];
         positive
             .into_iter()
@@ -230,14 +238,10 @@ pub fn predict_keeping(
     tracks
         .iter()
         .filter(|t| {
-            // Moving, and surely: faster than `sigmas` standard deviations of its speed.
-            let c = &t.covariance;
-            let speed_sigma = c[(2, 2)].max(c[(3, 3)]).max(0.0).sqrt();
-            let speed = t.velocity.norm();
             if kept.contains(&t.id) {
-                speed >= 0.5 * cfg.min_speed_m_s
+                t.velocity.norm() >= 0.5 * cfg.min_speed_m_s
             } else {
-                speed >= cfg.min_speed_m_s.max(cfg.sigmas * speed_sigma)
+                surely_moving(t, cfg)
             }
         })
         .map(|t| {
@@ -262,6 +266,40 @@ pub fn predict_keeping(
             }
         })
         .collect()
+}
+
+/// Whether the track `t` moves, and surely: faster than `cfg.min_speed_m_s` and than
+/// `cfg.sigmas` standard deviations of its speed.
+pub fn surely_moving(t: &TrackState, cfg: &TrafficConfig) -> bool {
+    let c = &t.covariance;
+    let speed_sigma = c[(2, 2)].max(c[(3, 3)]).max(0.0).sqrt();
+    t.velocity.norm() >= cfg.min_speed_m_s.max(cfg.sigmas * speed_sigma)
+}
+
+/// How near a known mover standing, `t`, the vehicle's circles may not come: its footprint's
+/// larger half, `cfg.standing_reach_m` (how far it may walk or drive on without warning) and
+/// `cfg.margin_m`, metres from its centre beyond a circle's radius.
+fn standing_reach(t: &TrackState, cfg: &TrafficConfig) -> f64 {
+    let f = Footprint::of(t, cfg);
+    f.half_length_m.max(f.half_width_m) + cfg.standing_reach_m + cfg.margin_m
+}
+
+/// Whether any of `poses` comes within [`standing_reach`] of a known mover standing in
+/// `standing`, on a level it occupies: the vehicle passes it slowly (the caution speed), as it
+/// may step into the path without warning (a person waiting beside the nose walked into the
+/// fuselage's side).
+pub fn passes_standing(
+    model: &CollisionModel,
+    poses: &[Isometry2<f64>],
+    standing: &[TrackState],
+    cfg: &TrafficConfig,
+) -> bool {
+    standing.iter().any(|t| {
+        let reach = standing_reach(t, cfg);
+        poses
+            .iter()
+            .any(|pose| touches(model, pose, t.levels, &t.position, &t.position, reach))
+    })
 }
 
 /// Whether the tracked mover `t` has moved beyond its own extent plus `cfg.hidden_m` since it
@@ -488,34 +526,48 @@ fn conflict_with(
 
 /// Where the vehicle about to stop `stop_at_m` along `path` (it stands `stand_back_m` before
 /// that) should stop instead, so that it does not stand where a mover is predicted to pass
-/// within the horizon: before the first pose such a mover's predicted positions touch, when
-/// that lies beyond `stopping_m` (the vehicle can still stop short of it). A stop for one mover,
-/// or for an obstacle in the map, must not leave the tail across another's path. `None`:
-/// standing there is clear of every mover, or it is too late to stop short.
+/// within the horizon, nor within `cfg.standing_reach_m` of a known mover standing
+/// (`standing`: it may walk on into the airframe, as a person waiting beside the nose did):
+/// before the first pose such a zone touches, when that lies beyond `stopping_m` (the vehicle
+/// can still stop short of it). A stop for one mover, or for an obstacle in the map, must not
+/// leave the tail across another's path. `None`: standing there is clear of every mover, or it
+/// is too late to stop short.
+#[allow(clippy::too_many_arguments)]
 pub fn stand_clear(
     path: &TimedPath<'_>,
     model: &CollisionModel,
     predictions: &[Prediction],
+    standing: &[TrackState],
     stop_at_m: f64,
     stand_back_m: f64,
     stopping_m: f64,
     cfg: &TrafficConfig,
 ) -> Option<f64> {
     let last = path.poses.len().checked_sub(1)?;
+    // Each zone: its capsule's axis, its reach beyond the circles' radii, its levels.
+    let zones: Vec<(Point2<f64>, Point2<f64>, f64, u32)> = predictions
+        .iter()
+        .map(|p| {
+            let (a, b, radius) = swept(&p.track, path.now_s, path.now_s + cfg.horizon_s, cfg);
+            (a, b, radius + cfg.margin_m, p.track.levels)
+        })
+        .chain(standing.iter().map(|t| {
+            let reach = standing_reach(t, cfg);
+            (t.position, t.position, reach, t.levels)
+        }))
+        .collect();
     let mut at_m = stop_at_m;
     let mut moved = false;
-    // Each earlier line may stand in a third mover's path: at most one step per mover.
-    for _ in 0..predictions.len() {
+    // Each earlier line may stand in a third mover's path: at most one step per zone.
+    for _ in 0..zones.len() {
         let stand = (((at_m - stand_back_m) / path.step_m).floor().max(0.0) as usize).min(last);
-        let earliest = predictions
+        let earliest = zones
             .iter()
-            .filter_map(|p| {
-                let (a, b, radius) = swept(&p.track, path.now_s, path.now_s + cfg.horizon_s, cfg);
-                let reach = radius + cfg.margin_m;
-                touches(model, &path.poses[stand], p.track.levels, &a, &b, reach).then(|| {
+            .filter_map(|(a, b, reach, levels)| {
+                touches(model, &path.poses[stand], *levels, a, b, *reach).then(|| {
                     path.poses[..=stand]
                         .iter()
-                        .position(|pose| touches(model, pose, p.track.levels, &a, &b, reach))
+                        .position(|pose| touches(model, pose, *levels, a, b, *reach))
                         .unwrap_or(stand) as f64
                         * path.step_m
                 })
@@ -644,7 +696,7 @@ mod tests {
         };
         let clear = |m: &TrackState, stopping_m: f64| {
             let p = predict(std::slice::from_ref(m), 0.0, &cfg);
-            stand_clear(&path, &model(), &p, 20.0, 3.0, stopping_m, &cfg)
+            stand_clear(&path, &model(), &p, &[], 20.0, 3.0, stopping_m, &cfg)
         };
         let truck = mover(22.0, -9.0, 0.0, 1.1, 0b11);
         let at = clear(&truck, 2.0).expect("moved short of the truck's path");
@@ -662,6 +714,45 @@ mod tests {
         assert_eq!(clear(&truck, at + 0.5), None);
         // A mover predicted to stay 30 m off: standing at the line is clear.
         assert_eq!(clear(&mover(22.0, -40.0, 0.0, 1.1, 0b11), 2.0), None);
+    }
+
+    /// A known mover standing - a person waiting by the taxiway - may walk on without warning:
+    /// the path passing within `standing_reach_m` (3 m) beyond its footprint (2 m from its
+    /// centre here) and the margin (0.5 m) of a circle on a level it occupies slows the vehicle,
+    /// and a stop is moved short of that reach while the vehicle can still stop short of it.
+    #[test]
+    fn a_mover_standing_is_kept_at_its_reach() {
+        let cfg = TrafficConfig::default();
+        let poses = straight(121);
+        let passes = |t: TrackState| passes_standing(&model(), &poses, &[t], &cfg);
+        // The body's circles (radius 1) along y = 0: 6.5 m from the centre reaches them.
+        assert!(passes(mover(30.0, -6.0, 0.0, 0.0, 0b01)));
+        assert!(!passes(mover(30.0, -7.0, 0.0, 0.0, 0b01)));
+        // 7.5 m left, under the wing tip's circle (y = 8, level 1): a cart on the ground level
+        // is clear of the body, a person (both levels) is not.
+        assert!(!passes(mover(30.0, 7.5, 0.0, 0.0, 0b01)));
+        assert!(passes(mover(30.0, 7.5, 0.0, 0.0, 0b11)));
+        // Walking, it is predicted instead.
+        assert!(surely_moving(&mover(30.0, -6.0, 0.0, 1.4, 0b11), &cfg));
+        assert!(!surely_moving(&mover(30.0, -6.0, 0.0, 0.1, 0b11), &cfg));
+
+        // About to stop 40 m ahead (standing 3 m back, its circles over 37-47 m) beside a
+        // person 5 m right at 44 m: the front circle (x + 10) first comes within 6.5 m of them
+        // at 44 - (6.5^2 - 5^2)^0.5 = 39.85 m, so the vehicle stops with its origin at 30 m.
+        let path = TimedPath {
+            poses: &poses,
+            step_m: 0.5,
+            profile: at_speed(2.0),
+            now_s: 0.0,
+            yielding: false,
+        };
+        let person = [mover(44.0, -5.0, 0.0, 0.0, 0b11)];
+        let clear = |stopping_m: f64| {
+            stand_clear(&path, &model(), &[], &person, 40.0, 3.0, stopping_m, &cfg)
+        };
+        assert_eq!(clear(5.0), Some(30.0));
+        // Too late to stop short of the reach: the line stays.
+        assert_eq!(clear(31.0), None);
     }
 
     #[test]

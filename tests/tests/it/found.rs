@@ -268,6 +268,36 @@ fn a_van_seen_only_low_is_waited_for_at_the_wing() {
     assert!(clearance > 5.0, "{van:?}");
 }
 
+/// Fixed: a person walking toward the taxiway stands 14 s 4.7 m left of the centreline, inside
+/// the wings' sweep, then walks on across. The jet (8 m/s) stopped for them at its wing, its
+/// nose and fuselage drawing up beside them, and the person walking on met the fuselage's side
+/// while the jet still braked (0.75 m/s, at fault). Now a known mover standing may walk on
+/// without warning: the jet passes within `standing_reach_m` (3 m) of one at the caution speed
+/// and stops short of that reach - here 7.8 m from them, and they cross first. Found by the
+/// falsifier on the traffic campaign with movers that stop (variant 13 on c4fdc01).
+#[test]
+fn a_person_standing_beside_the_nose_is_stopped_short_of() {
+    let r = run_found_with(&found("person_standing_beside_the_nose_walks_on"), |_| {});
+    assert!(r.contacts.is_empty(), "{:?}", r.contacts_judged);
+    assert_eq!(
+        r.end,
+        sim::engine::EndReason::Completed,
+        "{:?}",
+        r.waiting_for
+    );
+    let person = &r.obstacles[0];
+    assert_eq!(person.pet_mover_first, Some(true), "{person:?}");
+    // Stopped short of the 3 m reach beyond the person's footprint (1.25 m from its centre)
+    // and the margin (0.5 m), on every level: the circles 4.75 m from their centre, their body
+    // (0.25 m) 4.5 m from the circles, which cover the airframe.
+    let clearance = person.passes[0]
+        .min_clearance_m
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    assert!(clearance > 4.4, "{person:?}");
+}
+
 /// Not a case any stack can pass, kept as the evidence for the campaign's change: a follow-me car
 /// appeared (`appears_s` 29.6 s) 3.2 m left of the centreline ahead of the jet at 8 m/s - inside
 /// its stopping distance - and drove toward it. The stack braked at once (from the speed at the
