@@ -117,6 +117,10 @@ pub struct Driver {
     last_conflict_s: Option<f64>,
     /// When a plan last found a candidate mover's motion meeting the path, seconds.
     last_caution_s: Option<f64>,
+    /// Where, on the route, the nearest candidate mover's motion found lately meets the path
+    /// (the start of its zone, metres of route progress), and when it was last found, seconds:
+    /// a vehicle stopping anyway stops short of it.
+    caution_line: Option<(f64, f64)>,
     /// Since when the plans have stopped the vehicle for obstacles without a pause (`StoppedFor`
     /// or `WaitingForHiddenObstacle`), seconds.
     stopped_since_s: Option<f64>,
@@ -215,6 +219,7 @@ impl Driver {
             conflict: None,
             last_conflict_s: None,
             last_caution_s: None,
+            caution_line: None,
             stopped_since_s: None,
             hold: None,
             at_body: Vec::new(),
@@ -270,6 +275,7 @@ impl Driver {
         self.stopped_since_s = None;
         self.last_conflict_s = None;
         self.last_caution_s = None;
+        self.caution_line = None;
         self.at_body.clear();
         self.coasting.clear();
         self.streaks.clear();
@@ -323,7 +329,7 @@ impl Driver {
         // The tracker's movers, once a plan: the space-time check and the body hold read them.
         let movers = map.movers();
         let candidates = map.candidate_movers();
-        let wanted = self.caution(&p, &candidates, &movers, wanted, estimate.t_s, &config);
+        let wanted = self.caution(&p, s, &candidates, &movers, wanted, estimate.t_s, &config);
         let mut conflict = self.traffic_conflict(&p, &movers, wanted, estimate.t_s, &config, false);
         let v0 = self.last_odometry.map_or(0.0, |o| o.speed_m_s.max(0.0));
         if conflict.is_some_and(|c| stopping_distance_m(v0, decel, &config) >= c.zone_m) {
@@ -341,6 +347,9 @@ impl Driver {
             chosen.collision_at_m = Some(chosen.collision_at_m.map_or(stop_at, |c| c.min(stop_at)));
         }
         if let Some(at) = chosen.collision_at_m {
+            chosen.collision_at_m = Some(self.short_of_caution_line(at, s, v0, decel, &config));
+        }
+        if let Some(at) = chosen.collision_at_m {
             // Stopping - for a mover or the map - never where another mover is predicted to
             // pass, when the vehicle can stop short of its path.
             chosen.collision_at_m =
@@ -354,6 +363,15 @@ impl Driver {
             v0 < 0.05,
             &config,
         );
+        // Standing beside a known mover standing within its reach: it may walk or drive on
+        // into the airframe (or it touches it already): the vehicle does not move off.
+        let body = body.or_else(|| {
+            (v0 < 0.05)
+                .then(|| {
+                    self.standing_at(&movers, &estimate.world_from_vehicle, estimate.t_s, &config)
+                })
+                .flatten()
+        });
         if body.is_some() {
             v = 0.0;
         }
@@ -403,10 +421,13 @@ impl Driver {
     /// or the path passes near a known mover standing ([`traffic::passes_standing`]), and for
     /// `conflict_memory_s` after: by the time a candidate is confirmed, or the one standing has
     /// walked on, the vehicle can stop short of it; if it was a static object's parts coming
-    /// into view, it only slowed.
+    /// into view, it only slowed. Where the candidate's motion meets the path is kept as the
+    /// caution line ([`Self::short_of_caution_line`]).
+    #[allow(clippy::too_many_arguments)]
     fn caution(
         &mut self,
         p: &Plan,
+        s: f64,
         candidates: &[TrackState],
         movers: &[TrackState],
         wanted: f64,
@@ -426,8 +447,15 @@ impl Driver {
                 now_s,
                 yielding: false,
             };
-            if first_conflict(&path, &self.vehicle.collision, &predictions, traffic).is_some() {
+            if let Some(c) = first_conflict(&path, &self.vehicle.collision, &predictions, traffic) {
                 self.last_caution_s = Some(now_s);
+                let line = match self.caution_line {
+                    Some((held, t)) if now_s - t < traffic.conflict_memory_s => {
+                        held.min(s + c.zone_m)
+                    }
+                    _ => s + c.zone_m,
+                };
+                self.caution_line = Some((line, now_s));
             }
         }
         let standing: Vec<TrackState> = movers
@@ -450,6 +478,69 @@ impl Driver {
             wanted.min(traffic.caution_speed_m_s)
         } else {
             wanted
+        }
+    }
+
+    /// A known mover of `movers` arriving lately (seen predicted for a second within the last
+    /// six, beyond its own extent: not a static object's sliding parts) and standing now (not
+    /// [`surely_moving`]) within its reach of the vehicle at `pose` ([`passes_standing`]), as
+    /// what stops the vehicle; `None` with traffic off.
+    fn standing_at(
+        &self,
+        movers: &[TrackState],
+        pose: &Isometry2<f64>,
+        now_s: f64,
+        config: &AutonomyConfig,
+    ) -> Option<DriverStatus> {
+        let cfg = &config.traffic;
+        if !cfg.enabled {
+            return None;
+        }
+        movers
+            .iter()
+            .filter(|t| !surely_moving(t, cfg) && self.arriving(t, now_s, cfg))
+            .find(|t| {
+                passes_standing(
+                    &self.vehicle.collision,
+                    std::slice::from_ref(pose),
+                    std::slice::from_ref(*t),
+                    cfg,
+                )
+            })
+            .map(|t| DriverStatus::StoppedFor {
+                obstacle: t.position,
+                last_seen_s: t.t_s,
+            })
+    }
+
+    /// Where to stop instead of `at_m` ahead of route progress `s`: short of the caution line
+    /// while it holds (found within `conflict_memory_s`) and the vehicle can stop before it -
+    /// a vehicle stopping anyway (for a tug under its wing) must not stop with its nose across
+    /// the way a candidate mover is heading (the tug's train, not yet confirmed); `at_m` else.
+    fn short_of_caution_line(
+        &mut self,
+        at_m: f64,
+        s: f64,
+        v0: f64,
+        decel: f64,
+        config: &AutonomyConfig,
+    ) -> f64 {
+        let Some((line, t)) = self.caution_line else {
+            return at_m;
+        };
+        let now_s = self.estimate.map_or(t, |e| e.t_s);
+        if now_s - t >= config.traffic.conflict_memory_s || line - s < -1.0 {
+            self.caution_line = None;
+            return at_m;
+        }
+        // Short of the line itself, if not by the whole stop buffer: braking now, it stops
+        // before the mover's way.
+        let ahead = line - s;
+        let braking_m = stopping_distance_m(v0, decel, config) - config.stop_buffer_m;
+        if ahead > braking_m && ahead < at_m {
+            ahead
+        } else {
+            at_m
         }
     }
 

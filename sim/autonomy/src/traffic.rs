@@ -94,9 +94,10 @@ pub struct TrafficConfig {
     pub caution_speed_m_s: f64,
     /// A mover standing (a known mover not [`surely_moving`]) may walk or drive on without
     /// warning: the vehicle passes within this much of it (beyond `margin_m` and its
-    /// footprint) no faster than `caution_speed_m_s` ([`passes_standing`]), and does not stop
-    /// within it when it can stop short ([`stand_clear`]), metres. Default 3 (two seconds of a
-    /// brisk walk; a van from rest at 1.5 m/s^2).
+    /// footprint) no faster than `caution_speed_m_s` ([`passes_standing`]), does not stop
+    /// within it when it can stop short ([`stand_clear`]) and, standing within it, does not
+    /// move off, metres. Default 3 (two seconds of a brisk walk; a van from rest at 1.5
+    /// m/s^2).
     pub standing_reach_m: f64,
 }
 
@@ -563,14 +564,15 @@ pub fn stand_clear(
         let stand = (((at_m - stand_back_m) / path.step_m).floor().max(0.0) as usize).min(last);
         let earliest = zones
             .iter()
-            .filter_map(|(a, b, reach, levels)| {
-                touches(model, &path.poses[stand], *levels, a, b, *reach).then(|| {
-                    path.poses[..=stand]
-                        .iter()
-                        .position(|pose| touches(model, pose, *levels, a, b, *reach))
-                        .unwrap_or(stand) as f64
-                        * path.step_m
-                })
+            .filter(|(a, b, reach, levels)| {
+                touches(model, &path.poses[stand], *levels, a, b, *reach)
+            })
+            .map(|(a, b, reach, levels)| {
+                path.poses[..=stand]
+                    .iter()
+                    .position(|pose| touches(model, pose, *levels, a, b, *reach))
+                    .unwrap_or(stand) as f64
+                    * path.step_m
             })
             .reduce(f64::min);
         match earliest {

@@ -318,6 +318,7 @@ fn every_shipped_campaign_reads_and_its_first_variants_are_valid_scenarios() {
             "smoke",
             "traffic_airliner",
             "traffic_jet",
+            "traffic_jet_speed_profiles",
             "tune_a320",
             "tune_car",
             "tune_praetor",

@@ -413,8 +413,10 @@ fn the_watchdog_holds_the_car_through_lost_revolutions_and_it_drives_on() {
 /// on the other four. (Seed 7, this test's one seed before the sensor's calibration, waits for
 /// one as well now; with the old sensor seeds 1 and 3 did, so it is not the calibration's.) With
 /// the prediction of movers on (the default) the degraded returns make static objects seem to
-/// move and the car stops for them again and again: it does not finish within the time limit
-/// (it took 190.6 s with the old sensor, against 44 s without the prediction). Asserted as it is.
+/// move and the car stops for them again and again: it did not finish within the time limit
+/// (it took 190.6 s with the old sensor, against 44 s without the prediction); since the
+/// caution line and the rules for movers standing (2026-11-28) it finishes, after 24 stops (not
+/// read why). Asserted as it is.
 #[test]
 fn the_car_copes_with_dropout_dead_beams_noise_and_spurious_returns() {
     let s = scenario("straight_cone_under_wing");
@@ -460,12 +462,8 @@ fn the_car_copes_with_dropout_dead_beams_noise_and_spurious_returns() {
     assert_eq!(completed, [3, 4, 5, 6], "FIXME fixed?");
     let on = run_with(true, 3);
     assert!(on.contacts.is_empty(), "{:?}", on.contacts);
-    assert_eq!(
-        on.end,
-        sim::engine::EndReason::TimedOut,
-        "FIXME fixed? {:?}",
-        on.stops
-    );
+    assert_eq!(on.end, sim::engine::EndReason::Completed, "{:?}", on.stops);
+    assert!(on.stops.len() > 10, "FIXME fixed? {:?}", on.stops);
 }
 
 /// LiDAR latency: every revolution 0.2 s late (taken in the world as it was, mapped at the pose
