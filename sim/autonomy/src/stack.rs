@@ -13,7 +13,7 @@ use crate::planner::{
 };
 use crate::route::{RoutePath, wrap_angle};
 use crate::traffic::{
-    Conflict, Prediction, SpeedProfile, TimedPath, at_body, first_conflict,
+    Conflict, Prediction, SpeedProfile, TimedPath, at_body, first_conflict, may_have_walked_to,
     moved_beyond_its_extent, passes_standing, predict, predict_keeping, surely_moving,
 };
 
@@ -135,6 +135,11 @@ pub struct Driver {
     coasting: Vec<TrackState>,
     /// The tracks seen and predicted as movers lately.
     streaks: Vec<MoverStreak>,
+    /// Movers that went out of view standing, as last seen (see `lost_standing_at`), kept
+    /// for [`LOST_STANDING_FOR_S`] after.
+    lost_standing: Vec<TrackState>,
+    /// The tracks seen moving as movers for [`MOVER_FOR_S`] on end at some time.
+    walked: Vec<u32>,
 }
 
 /// A mover at the vehicle's body.
@@ -184,6 +189,13 @@ const MOVER_FOR_S: f64 = 1.0;
 /// part seems to move in bursts, not for a second on end (a row of parked cars a stale map
 /// does not hold, on the parking lot).
 const MOVER_LATELY_S: f64 = 6.0;
+/// A mover lost from view while standing may have walked on at this speed, m/s (a brisk walk)
+/// ...
+const LOST_STANDING_WALK_M_S: f64 = 1.5;
+/// ... for this long after it was last seen, seconds, if no larger than this, metres (a person;
+/// a parked car a stale map does not hold, whose visible part slides, is larger).
+const LOST_STANDING_FOR_S: f64 = 60.0;
+const LOST_STANDING_EXTENT_M: f64 = 2.0;
 
 impl Driver {
     /// A driver of `vehicle` along `route` at `wanted_speed_m_s`, keeping the distance maps up
@@ -225,6 +237,8 @@ impl Driver {
             at_body: Vec::new(),
             coasting: Vec::new(),
             streaks: Vec::new(),
+            lost_standing: Vec::new(),
+            walked: Vec::new(),
         }
     }
 
@@ -279,6 +293,8 @@ impl Driver {
         self.at_body.clear();
         self.coasting.clear();
         self.streaks.clear();
+        self.lost_standing.clear();
+        self.walked.clear();
         self.hold = None;
         self.route_s_m = None;
         self.estimate = None;
@@ -695,6 +711,7 @@ impl Driver {
         }
         let cfg = &config.traffic;
         self.note_streaks(now_s);
+        self.note_lost_standing(movers, now_s, cfg);
         // A mover arriving at the body, or one held there before and not seen away.
         let mut body: Vec<AtBody> = movers
             .iter()
@@ -746,6 +763,8 @@ impl Driver {
                 })
                 .collect::<Vec<_>>();
             body.extend(dropped);
+            let lost = self.lost_standing_at(pose, now_s, &body, cfg);
+            body.extend(lost);
         }
         // Movers predicted out of view now, confirmed, beyond what revealing a static object
         // explains, and seen predicted on a few revolutions on end: checked again if their
@@ -796,6 +815,77 @@ impl Driver {
             .iter()
             .any(|r| r.id == t.id && r.mover_s.is_some_and(|m| now_s - m <= MOVER_LATELY_S))
             && moved_beyond_its_extent(t, cfg)
+    }
+
+    /// Keeps the known movers out of view while standing (the tracker's confirmed movers, no
+    /// larger than [`LOST_STANDING_EXTENT_M`], that were seen moving for [`MOVER_FOR_S`] on end
+    /// and travelled more than twice their extent and 3 m: a person who walked up and stopped,
+    /// not a static object's sliding parts, which seem to move in bursts), as last seen, after their tracks drop; forgets one seen again,
+    /// or lost [`LOST_STANDING_FOR_S`] ago.
+    fn note_lost_standing(
+        &mut self,
+        movers: &[TrackState],
+        now_s: f64,
+        cfg: &crate::traffic::TrafficConfig,
+    ) {
+        for r in self.streaks.iter().filter(|r| r.mover_s.is_some()) {
+            if !self.walked.contains(&r.id) {
+                self.walked.push(r.id);
+            }
+        }
+        // Those neither tracked nor kept are forgotten.
+        let lost = &self.lost_standing;
+        self.walked
+            .retain(|id| movers.iter().any(|t| t.id == *id) || lost.iter().any(|l| l.id == *id));
+        self.lost_standing.retain(|l| {
+            now_s - l.t_s < LOST_STANDING_FOR_S
+                && !movers.iter().any(|t| t.id == l.id && now_s - t.t_s <= 0.25)
+        });
+        for t in movers.iter().filter(|t| {
+            now_s - t.t_s > 0.25
+                && t.confirmed
+                && self.walked.contains(&t.id)
+                && t.extent_m <= LOST_STANDING_EXTENT_M
+                && t.travel_m > 2.0 * t.extent_m + 3.0
+                && !surely_moving(t, cfg)
+        }) {
+            match self.lost_standing.iter_mut().find(|l| l.id == t.id) {
+                Some(l) => *l = t.clone(),
+                None => self.lost_standing.push(t.clone()),
+            }
+        }
+    }
+
+    /// The movers lost standing (see `note_lost_standing`) that may have walked to the body of
+    /// the standing vehicle at `pose` since they were last seen, as movers at its body (waited
+    /// for, the pilot called): a person the airframe hid may have walked on into the blind zone
+    /// at the tail. Not those already in `body`.
+    fn lost_standing_at(
+        &self,
+        pose: &Isometry2<f64>,
+        now_s: f64,
+        body: &[AtBody],
+        cfg: &crate::traffic::TrafficConfig,
+    ) -> Vec<AtBody> {
+        self.lost_standing
+            .iter()
+            .filter(|l| !body.iter().any(|r| r.id == l.id))
+            .filter(|l| {
+                may_have_walked_to(
+                    &self.vehicle.collision,
+                    pose,
+                    l,
+                    now_s,
+                    LOST_STANDING_WALK_M_S,
+                    cfg,
+                )
+            })
+            .map(|l| AtBody {
+                id: l.id,
+                at: l.position,
+                seen_s: l.t_s,
+            })
+            .collect()
     }
 
     /// Each track seen (this revolution or the last, 0.25 s) and predicted now continues its

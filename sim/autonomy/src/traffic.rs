@@ -303,6 +303,22 @@ pub fn passes_standing(
     })
 }
 
+/// Whether a known mover lost while standing, `t`, may have walked from where it was last seen
+/// to the body of the vehicle `model` at `pose` by `now_s`: within its footprint and
+/// `walk_m_s` times the time since, of a circle of a level it occupies.
+pub fn may_have_walked_to(
+    model: &CollisionModel,
+    pose: &Isometry2<f64>,
+    t: &TrackState,
+    now_s: f64,
+    walk_m_s: f64,
+    cfg: &TrafficConfig,
+) -> bool {
+    let f = Footprint::of(t, cfg);
+    let reach = f.half_length_m.max(f.half_width_m) + walk_m_s * (now_s - t.t_s).max(0.0);
+    touches(model, pose, t.levels, &t.position, &t.position, reach)
+}
+
 /// Whether the tracked mover `t` has moved beyond its own extent plus `cfg.hidden_m` since it
 /// was first seen: the centre of a static object's hits stays within its extent, however it is
 /// hidden or revealed (a row of parked cars merged into one track can still slide further).
