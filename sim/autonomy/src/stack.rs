@@ -140,6 +140,9 @@ pub struct Driver {
     lost_standing: Vec<TrackState>,
     /// The tracks seen moving as movers for [`MOVER_FOR_S`] on end at some time.
     walked: Vec<u32>,
+    /// The person standing the last plan stopped short of (see `short_of_walkers`): where, and
+    /// when last seen, seconds.
+    walker_stop: Option<(Point2<f64>, f64)>,
 }
 
 /// A mover at the vehicle's body.
@@ -239,6 +242,7 @@ impl Driver {
             streaks: Vec::new(),
             lost_standing: Vec::new(),
             walked: Vec::new(),
+            walker_stop: None,
         }
     }
 
@@ -371,6 +375,8 @@ impl Driver {
             chosen.collision_at_m =
                 Some(self.stand_clear(&p, &movers, at, v0, decel, estimate.t_s, &config));
         }
+        chosen.collision_at_m =
+            self.short_of_walkers(&p, &movers, chosen.collision_at_m, v0, decel, &config);
         let (mut v, _) = avoid(&chosen, wanted, decel, &config);
         let body = self.movers_at_body(
             &movers,
@@ -395,6 +401,10 @@ impl Driver {
         self.status = match conflict {
             _ if let Some(held) = body => held,
             _ if v > 0.0 => DriverStatus::Driving,
+            _ if let Some((obstacle, last_seen_s)) = self.walker_stop => DriverStatus::StoppedFor {
+                obstacle,
+                last_seen_s,
+            },
             _ if chosen.collision_at_m != p.chosen().collision_at_m => DriverStatus::Yielding {
                 track_id: self.hold.map_or(u32::MAX, |h| h.0),
                 mover_at: conflict.map_or(here, |c| c.mover_at),
@@ -514,7 +524,9 @@ impl Driver {
         }
         movers
             .iter()
-            .filter(|t| !surely_moving(t, cfg) && self.arriving(t, now_s, cfg))
+            .filter(|t| {
+                !surely_moving(t, cfg) && (self.arriving(t, now_s, cfg) || self.is_walker(t, cfg))
+            })
             .find(|t| {
                 passes_standing(
                     &self.vehicle.collision,
@@ -527,6 +539,59 @@ impl Driver {
                 obstacle: t.position,
                 last_seen_s: t.t_s,
             })
+    }
+
+    /// Whether `t` is a person standing: a small known mover (up to
+    /// [`LOST_STANDING_EXTENT_M`]) seen moving for [`MOVER_FOR_S`] on end at some time, not
+    /// moving now.
+    fn is_walker(&self, t: &TrackState, cfg: &crate::traffic::TrafficConfig) -> bool {
+        t.confirmed
+            && t.extent_m <= LOST_STANDING_EXTENT_M
+            && !surely_moving(t, cfg)
+            && self.walked.contains(&t.id)
+    }
+
+    /// Where to stop instead of `at_m` ahead (`None`: nothing stops the vehicle) so as not to
+    /// pass within reach ([`passes_standing`]) of a person standing (`is_walker`): walking on
+    /// from 2 m off the path, they reach it before the tracker sees them move and the vehicle
+    /// can stop - passing slowly is not enough. When the vehicle can stop before the reach;
+    /// already inside it, the caution speed applies. The person stopped for is kept as
+    /// `walker_stop` (what the stopped vehicle says it stands for).
+    fn short_of_walkers(
+        &mut self,
+        p: &Plan,
+        movers: &[TrackState],
+        at_m: Option<f64>,
+        v0: f64,
+        decel: f64,
+        config: &AutonomyConfig,
+    ) -> Option<f64> {
+        self.walker_stop = None;
+        let cfg = &config.traffic;
+        if !cfg.enabled {
+            return at_m;
+        }
+        let braking_m = stopping_distance_m(v0, decel, config) - config.stop_buffer_m;
+        let poses = &p.chosen().poses;
+        let mut at_m = at_m;
+        let walkers: Vec<&TrackState> = movers.iter().filter(|t| self.is_walker(t, cfg)).collect();
+        for t in walkers {
+            let reached = poses.iter().position(|pose| {
+                passes_standing(
+                    &self.vehicle.collision,
+                    std::slice::from_ref(pose),
+                    std::slice::from_ref(t),
+                    cfg,
+                )
+            });
+            let Some(k) = reached else { continue };
+            let zone_m = k as f64 * config.step_m;
+            if zone_m > braking_m && at_m.is_none_or(|a| zone_m < a) {
+                at_m = Some(zone_m);
+                self.walker_stop = Some((t.position, t.t_s));
+            }
+        }
+        at_m
     }
 
     /// Where to stop instead of `at_m` ahead of route progress `s`: short of the caution line
