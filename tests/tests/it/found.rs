@@ -390,6 +390,21 @@ fn a_person_walks_on_into_the_slowing_nose_as_it_is() {
     assert!(first.at_fault && first.vehicle_speed_m_s > 2.0, "{first:?}");
 }
 
+/// FIXME: the jet at 5 m/s; a tug towing four carts crosses at 1.66 m/s, 120 degrees to the
+/// route, and the slowing jet meets it with its nose (1.53 m/s, at fault): the caution line
+/// that mended a shorter train crossing square does not stop it short here. Not read further.
+/// Found by the speed-profile campaign (variant 87 on 308acd2). Asserted as it is.
+#[test]
+fn a_tug_train_meets_the_slowing_nose_as_it_is() {
+    let r = run_found_with(&found("tug_train_meets_the_slowing_nose"), |_| {});
+    let first = r.contacts_judged.first().expect("a contact");
+    assert_eq!(
+        (first.contact.object.as_str(), first.contact.part.as_str()),
+        ("tug_2", "nose")
+    );
+    assert!(first.at_fault && first.vehicle_speed_m_s > 1.0, "{first:?}");
+}
+
 /// Not a case any stack can pass, kept as the evidence for the campaign's change: a follow-me car
 /// appeared (`appears_s` 29.6 s) 3.2 m left of the centreline ahead of the jet at 8 m/s - inside
 /// its stopping distance - and drove toward it. The stack braked at once (from the speed at the
