@@ -13,8 +13,9 @@ use crate::planner::{
 };
 use crate::route::{RoutePath, wrap_angle};
 use crate::traffic::{
-    Conflict, Prediction, SpeedProfile, TimedPath, at_body, first_conflict, may_have_walked_to,
-    moved_beyond_its_extent, passes_standing, predict, predict_keeping, surely_moving,
+    Conflict, Prediction, SpeedProfile, TimedPath, at_body, first_conflict,
+    first_within_standing_reach, may_have_walked_to, moved_beyond_its_extent, predict,
+    predict_keeping, surely_moving,
 };
 
 /// Half length of the stretch of route searched around the last progress when the estimate is
@@ -484,17 +485,14 @@ impl Driver {
                 self.caution_line = Some((line, now_s));
             }
         }
-        let standing: Vec<TrackState> = movers
+        let poses = &p.chosen().poses;
+        if movers
             .iter()
             .filter(|t| !surely_moving(t, traffic))
-            .cloned()
-            .collect();
-        if passes_standing(
-            &self.vehicle.collision,
-            &p.chosen().poses,
-            &standing,
-            traffic,
-        ) {
+            .any(|t| {
+                first_within_standing_reach(&self.vehicle.collision, poses, t, traffic).is_some()
+            })
+        {
             self.last_caution_s = Some(now_s);
         }
         if self
@@ -509,8 +507,8 @@ impl Driver {
 
     /// A known mover of `movers` arriving lately (seen predicted for a second within the last
     /// six, beyond its own extent: not a static object's sliding parts) and standing now (not
-    /// [`surely_moving`]) within its reach of the vehicle at `pose` ([`passes_standing`]), as
-    /// what stops the vehicle; `None` with traffic off.
+    /// [`surely_moving`]) within its reach of the vehicle at `pose`
+    /// ([`first_within_standing_reach`]), as what stops the vehicle; `None` with traffic off.
     fn standing_at(
         &self,
         movers: &[TrackState],
@@ -528,12 +526,13 @@ impl Driver {
                 !surely_moving(t, cfg) && (self.arriving(t, now_s, cfg) || self.is_walker(t, cfg))
             })
             .find(|t| {
-                passes_standing(
+                first_within_standing_reach(
                     &self.vehicle.collision,
                     std::slice::from_ref(pose),
-                    std::slice::from_ref(*t),
+                    t,
                     cfg,
                 )
+                .is_some()
             })
             .map(|t| DriverStatus::StoppedFor {
                 obstacle: t.position,
@@ -552,9 +551,9 @@ impl Driver {
     }
 
     /// Where to stop instead of `at_m` ahead (`None`: nothing stops the vehicle) so as not to
-    /// pass within reach ([`passes_standing`]) of a person standing (`is_walker`): walking on
-    /// from 2 m off the path, they reach it before the tracker sees them move and the vehicle
-    /// can stop - passing slowly is not enough. When the vehicle can stop before the reach;
+    /// pass within reach ([`first_within_standing_reach`]) of a person standing (`is_walker`):
+    /// walking on from 2 m off the path, they reach it before the tracker sees them move and
+    /// the vehicle can stop - passing slowly is not enough. When the vehicle can stop before the reach;
     /// already inside it, the caution speed applies. The person stopped for is kept as
     /// `walker_stop` (what the stopped vehicle says it stands for).
     fn short_of_walkers(
@@ -576,14 +575,7 @@ impl Driver {
         let mut at_m = at_m;
         let walkers: Vec<&TrackState> = movers.iter().filter(|t| self.is_walker(t, cfg)).collect();
         for t in walkers {
-            let reached = poses.iter().position(|pose| {
-                passes_standing(
-                    &self.vehicle.collision,
-                    std::slice::from_ref(pose),
-                    std::slice::from_ref(t),
-                    cfg,
-                )
-            });
+            let reached = first_within_standing_reach(&self.vehicle.collision, poses, t, cfg);
             let Some(k) = reached else { continue };
             let zone_m = k as f64 * config.step_m;
             if zone_m > braking_m && at_m.is_none_or(|a| zone_m < a) {

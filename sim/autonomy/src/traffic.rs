@@ -295,12 +295,23 @@ pub fn passes_standing(
     standing: &[TrackState],
     cfg: &TrafficConfig,
 ) -> bool {
-    standing.iter().any(|t| {
-        let reach = standing_reach(t, cfg);
-        poses
-            .iter()
-            .any(|pose| touches(model, pose, t.levels, &t.position, &t.position, reach))
-    })
+    standing
+        .iter()
+        .any(|t| first_within_standing_reach(model, poses, t, cfg).is_some())
+}
+
+/// The first of `poses` that comes within [`standing_reach`] of the mover standing `t`, on a
+/// level it occupies.
+pub fn first_within_standing_reach(
+    model: &CollisionModel,
+    poses: &[Isometry2<f64>],
+    t: &TrackState,
+    cfg: &TrafficConfig,
+) -> Option<usize> {
+    let reach = standing_reach(t, cfg);
+    poses
+        .iter()
+        .position(|pose| touches(model, pose, t.levels, &t.position, &t.position, reach))
 }
 
 /// Whether a known mover lost while standing, `t`, may have walked from where it was last seen
@@ -674,6 +685,17 @@ mod tests {
         }
     }
 
+    /// `poses` driven at 2 m/s from now.
+    fn at_2_m_s(poses: &[Isometry2<f64>]) -> TimedPath<'_> {
+        TimedPath {
+            poses,
+            step_m: 0.5,
+            profile: at_speed(2.0),
+            now_s: 0.0,
+            yielding: false,
+        }
+    }
+
     fn at_speed(v: f64) -> SpeedProfile {
         SpeedProfile {
             speed_m_s: v,
@@ -705,13 +727,7 @@ mod tests {
     fn a_stop_is_moved_short_of_another_movers_path() {
         let cfg = TrafficConfig::default();
         let poses = straight(121);
-        let path = TimedPath {
-            poses: &poses,
-            step_m: 0.5,
-            profile: at_speed(2.0),
-            now_s: 0.0,
-            yielding: false,
-        };
+        let path = at_2_m_s(&poses);
         let clear = |m: &TrackState, stopping_m: f64| {
             let p = predict(std::slice::from_ref(m), 0.0, &cfg);
             stand_clear(&path, &model(), &p, &[], 20.0, 3.0, stopping_m, &cfg)
@@ -757,13 +773,7 @@ mod tests {
         // About to stop 40 m ahead (standing 3 m back, its circles over 37-47 m) beside a
         // person 5 m right at 44 m: the front circle (x + 10) first comes within 6.5 m of them
         // at 44 - (6.5^2 - 5^2)^0.5 = 39.85 m, so the vehicle stops with its origin at 30 m.
-        let path = TimedPath {
-            poses: &poses,
-            step_m: 0.5,
-            profile: at_speed(2.0),
-            now_s: 0.0,
-            yielding: false,
-        };
+        let path = at_2_m_s(&poses);
         let person = [mover(44.0, -5.0, 0.0, 0.0, 0b11)];
         let clear = |stopping_m: f64| {
             stand_clear(&path, &model(), &[], &person, 40.0, 3.0, stopping_m, &cfg)
