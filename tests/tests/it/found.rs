@@ -429,6 +429,48 @@ fn a_tug_train_meets_the_slowing_nose_as_it_is() {
     assert!(first.at_fault && first.vehicle_speed_m_s > 1.0, "{first:?}");
 }
 
+/// FIXME: the van of `van_strikes_the_tail_of_the_standing_jet` with the calibrated sensor and
+/// a follow-me car appearing earlier: lost behind the right wing, read at 4.2 m/s (it drives
+/// 6.3), it strikes the standing wing, its track drops with its prediction not yet at the body,
+/// and the jet moves off while it touches (at fault). Found by the random campaign (variant
+/// 963 of 1000 on 308acd2). Asserted as it is.
+#[test]
+fn a_van_lost_behind_the_wing_strikes_it_as_the_jet_moves_off_as_it_is() {
+    let r = run_found_with(
+        &found("van_lost_behind_the_wing_strikes_it_as_the_jet_moves_off"),
+        |_| {},
+    );
+    assert_eq!(
+        contact_parts(&r),
+        [("van_1", "wing_right"), ("van_1", "wing_right")]
+    );
+    assert_eq!((r.contacts_struck, r.contacts_at_fault), (1, 1));
+    assert!(r.contacts_judged[1].vehicle_speed_m_s > 0.0);
+}
+
+/// FIXME: a person walking toward the standing jet's right wing, confirmed, is lost under it
+/// while walking; they strike the standing wing, and once the van the jet stood for has passed
+/// it drives on into them (right main gear, at fault): nothing waits for a mover lost walking
+/// toward the vehicle once its track drops. Found by the falsifier (sample 757 of 1000 on
+/// 308acd2). Asserted as it is.
+#[test]
+fn a_person_lost_under_the_wing_walks_into_the_gear_as_it_is() {
+    let r = run_found_with(
+        &found("person_lost_under_the_wing_walks_into_the_gear"),
+        |_| {},
+    );
+    assert_eq!(
+        contact_parts(&r),
+        [
+            ("person_2", "wing_right"),
+            ("person_2", "wing_right"),
+            ("person_2", "main_gear_right")
+        ]
+    );
+    // Struck by the standing wing, then the wing and the gear moving into them.
+    assert_eq!((r.contacts_struck, r.contacts_at_fault), (1, 2));
+}
+
 /// Not a case any stack can pass, kept as the evidence for the campaign's change: a follow-me car
 /// appeared (`appears_s` 29.6 s) 3.2 m left of the centreline ahead of the jet at 8 m/s - inside
 /// its stopping distance - and drove toward it. The stack braked at once (from the speed at the
