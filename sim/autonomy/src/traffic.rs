@@ -396,17 +396,12 @@ pub fn may_reach_body(
     (now_s, until_s): (f64, f64),
     cfg: &TrafficConfig,
 ) -> bool {
-    let speed = t.velocity.norm();
-    if speed < 1e-9 {
-        return at_body(model, pose, t, now_s, cfg);
-    }
-    let along = t.velocity / speed;
-    let near_m = speed * (now_s - t.t_s).max(0.0);
-    let far_m = t.peak_speed_m_s.max(speed) * (until_s - t.t_s).max(0.0);
-    let steps = ((far_m - near_m) / SWEEP_STEP_M).ceil().max(1.0) as usize;
+    let (near, _, _) = reach(t, (now_s - t.t_s).max(0.0));
+    let (_, far, _) = reach(t, (until_s - t.t_s).max(0.0));
+    let steps = ((far - near).norm() / SWEEP_STEP_M).ceil().max(1.0) as usize;
     (0..=steps).any(|i| {
-        let d = near_m + (far_m - near_m) * i as f64 / steps as f64;
-        box_at_body(model, pose, t, &(along * d), cfg)
+        let at = near + (far - near) * (i as f64 / steps as f64);
+        box_at_body(model, pose, t, &(at - t.position), cfg)
     })
 }
 
