@@ -6,6 +6,8 @@ use std::path::PathBuf;
 use sim::engine::{RunSetup, run};
 use sim::scenario::{RunConfig, Scenario};
 
+use crate::common::nearest_m;
+
 /// Runs a found scenario after its mapping drive (with the configuration the campaign found it
 /// with: the true pose - every one was found before the particle filter became the default).
 fn run_found(s: &Scenario) -> sim::engine::RunReport {
@@ -266,11 +268,7 @@ fn a_van_seen_only_low_is_waited_for_at_the_wing() {
     assert!(r.contacts.is_empty(), "{:?}", r.contacts_judged);
     let van = r.obstacles.iter().find(|o| o.id == "van_2").unwrap();
     assert_eq!(van.pet_mover_first, Some(true), "{van:?}");
-    let clearance = van.passes[0]
-        .min_clearance_m
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
+    let clearance = nearest_m(&van.passes[0]);
     assert!(clearance > 5.0, "{van:?}");
 }
 
@@ -296,11 +294,7 @@ fn a_person_standing_beside_the_nose_is_stopped_short_of() {
     // Stopped short of the 3 m reach beyond the person's footprint (1.25 m from its centre)
     // and the margin (0.5 m), on every level: the circles 4.75 m from their centre, their body
     // (0.25 m) 4.5 m from the circles, which cover the airframe.
-    let clearance = person.passes[0]
-        .min_clearance_m
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
+    let clearance = nearest_m(&person.passes[0]);
     assert!(clearance > 4.4, "{person:?}");
 }
 
@@ -320,11 +314,7 @@ fn a_tug_train_crosses_before_the_jet_stopping_for_it() {
     assert_eq!(r.obstacles.len(), 4, "the tug and its three carts");
     for o in &r.obstacles {
         assert_eq!(o.pet_mover_first, Some(true), "{o:?}");
-        let clearance = o.passes[0]
-            .min_clearance_m
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min);
+        let clearance = nearest_m(&o.passes[0]);
         assert!(clearance > 3.0, "{o:?}");
     }
     // FIXME: a cart lost beyond the wing tip is waited for (a needless pilot call).
@@ -589,11 +579,7 @@ fn container_pass(r: &sim::engine::RunReport) -> (&sim::engine::Pass, f64) {
     let o = r.obstacles.iter().find(|o| o.id == "cone_path_1").unwrap();
     let p = &o.passes[0];
     assert_eq!(p.outcome, sim::engine::PassOutcome::Deviated);
-    let closest = p
-        .min_clearance_m
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
+    let closest = nearest_m(p);
     (p, closest)
 }
 

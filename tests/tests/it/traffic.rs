@@ -5,7 +5,7 @@
 use sim::engine::{EndReason, RunReport};
 use sim::scenario::{PoseSourceConfig, RunConfig, Scenario};
 
-use crate::common::{run_with, scenario};
+use crate::common::{nearest_m, run_with, scenario};
 
 fn run_default(s: &Scenario) -> RunReport {
     let dir = tempfile::tempdir().unwrap();
@@ -59,11 +59,7 @@ fn the_airliner_yields_to_a_van_timed_to_meet_its_nose() {
     let van = yielded_to(&r, "van");
     assert_eq!(r.stops.len(), 1, "{:?}", r.stops);
     assert!(van.min_ttc_s.is_some_and(|t| t > 3.0), "{van:?}");
-    let clearance = van.passes[0]
-        .min_clearance_m
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
+    let clearance = nearest_m(&van.passes[0]);
     assert!(clearance > 10.0, "{van:?}");
 }
 

@@ -24,3 +24,11 @@ pub fn run_with(s: &Scenario, map_dir: &Path, config: RunConfig) -> RunReport {
     };
     run(s, &setup).unwrap_or_else(|e| panic!("{}: {e:#}", s.name))
 }
+
+/// A pass's nearest approach over the levels, metres.
+pub fn nearest_m(pass: &sim::engine::Pass) -> f64 {
+    pass.min_clearance_m
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min)
+}
