@@ -10,7 +10,7 @@ import re
 import sys
 
 LAYERS = ["toml_file", "error", "chart", "world", "airports", "scenario", "offline_map", "engine", "replay",
-          "rosbag", "pcap", "studies", "campaign", "tune", "bench"]
+          "rosbag", "pcap", "studies", "campaign", "tune", "regress", "bench"]
 
 def strip_comments(text):
     return "\n".join(line.split("//", 1)[0] for line in text.splitlines())

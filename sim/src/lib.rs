@@ -20,6 +20,7 @@
 //! - [`studies`]: the mapping demo and the small-obstacle sweep;
 //! - [`campaign`]: scenario families sampled, run in parallel, searched for failures;
 //! - [`tune`]: collision-model tuning on the campaign engine;
+//! - [`regress`]: scenario files run against their own expectations, JUnit out (`taxi-sim regress`);
 //! - [`bench`]: the headline performance figures, measured without criterion.
 
 pub mod chart;
@@ -46,6 +47,8 @@ pub mod studies;
 pub mod campaign;
 
 pub mod tune;
+
+pub mod regress;
 
 pub mod bench;
 

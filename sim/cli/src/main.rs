@@ -47,6 +47,11 @@ enum Command {
     /// Sweep obstacle heights and speeds: the range each obstacle is first mapped at and whether
     /// the vehicle keeps off it.
     SmallObstacles(commands::small::SmallArgs),
+    /// Scenario regressions: every scenario file under the paths (default `scenarios`) run in
+    /// parallel against its own expectations, with JUnit XML, JSON lines and a Markdown summary.
+    /// Exit code 0 when every case passed or is a known problem failing as stated, 1 when one
+    /// failed, 2 when a file is not a valid scenario (the run goes on) or on bad input.
+    Regress(commands::regress::RegressArgs),
     /// Campaigns: scenario families sampled, run in parallel, searched for failures.
     #[command(subcommand)]
     Campaign(commands::campaign::CampaignCommand),
@@ -110,6 +115,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 ExitCode::from(1)
             }
         }),
+        Command::Regress(args) => commands::regress::run(&args).map(ExitCode::from),
         Command::Tune(args) => commands::tune::run(&args).map(|ok| {
             if ok {
                 ExitCode::SUCCESS
@@ -131,7 +137,7 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
         Command::CompareLidar(args) => commands::compare_lidar::run(&args),
         Command::Check(args) => commands::check::run(&args),
         Command::Map(args) => commands::map::run(&args),
-        Command::Run(_) | Command::Campaign(_) | Command::Tune(_) => {
+        Command::Run(_) | Command::Campaign(_) | Command::Tune(_) | Command::Regress(_) => {
             unreachable!("dispatched in run")
         }
         Command::Scan(args) => commands::scan::run(&args),

@@ -42,14 +42,14 @@ pub fn static_world_key(scenario: &Scenario, config: &RunConfig) -> Result<Strin
 type MapSlot = OnceLock<std::result::Result<PathBuf, String>>;
 
 /// The offline maps of a campaign directory, built once per static world.
-pub(super) struct MapCache {
+pub(crate) struct MapCache {
     dir: PathBuf,
     entries: Mutex<HashMap<String, Arc<MapSlot>>>,
 }
 
 impl MapCache {
     /// An empty cache over the map directories under `dir`.
-    pub(super) fn new(dir: PathBuf) -> Self {
+    pub(crate) fn new(dir: PathBuf) -> Self {
         MapCache {
             dir,
             entries: Mutex::default(),
@@ -64,6 +64,31 @@ impl MapCache {
         scenario_text: &str,
         scenario: &Scenario,
         config: &RunConfig,
+    ) -> Result<PathBuf> {
+        self.get_with(scenario, config, &|scratch| {
+            // The map holds the scenario it was driven in: `fingerprint` reads it.
+            let file = scratch.join("scenario.toml");
+            mapper::write_atomically(&file, scenario_text.as_bytes())?;
+            let s = Scenario::from_file(&file)?;
+            crate::offline_map::map_drive(&s, config, scratch, &mut |_, _| {}).map(|_| ())
+        })
+    }
+
+    /// The map of a scenario read from its own file (`taxi-sim regress`): driven as it is, its
+    /// relative paths (vehicle sidecar, airport, pose file) resolved where the file lives.
+    pub(crate) fn get_for_file(&self, scenario: &Scenario, config: &RunConfig) -> Result<PathBuf> {
+        self.get_with(scenario, config, &|scratch| {
+            crate::offline_map::map_drive(scenario, config, scratch, &mut |_, _| {}).map(|_| ())
+        })
+    }
+
+    /// The map keyed by [`static_world_key`], made by `drive` into a scratch directory on first
+    /// use and renamed into place.
+    fn get_with(
+        &self,
+        scenario: &Scenario,
+        config: &RunConfig,
+        drive: &(dyn Fn(&std::path::Path) -> Result<()> + Sync),
     ) -> Result<PathBuf> {
         let key = static_world_key(scenario, config)?;
         let cell = self
@@ -96,11 +121,7 @@ impl MapCache {
                     path: scratch.clone(),
                     source,
                 })?;
-                // The map holds the scenario it was driven in: `fingerprint` reads it.
-                let file = scratch.join("scenario.toml");
-                mapper::write_atomically(&file, scenario_text.as_bytes())?;
-                let s = Scenario::from_file(&file)?;
-                crate::offline_map::map_drive(&s, config, &scratch, &mut |_, _| {})?;
+                drive(&scratch)?;
                 match std::fs::rename(&scratch, &done) {
                     Ok(()) => Ok(()),
                     // Another process got there first: theirs is the same map.

@@ -182,12 +182,54 @@ fn contact_failures(scenario: &Scenario, r: &RunReport, failures: &mut Vec<Strin
     contacts_while_stopped
 }
 
+/// What failed in run `r` of `scenario`, one line each (a contact that counts, a pass that did
+/// not meet its obstacle's expectation with its clearance, the end against the expected one),
+/// and how many contacts began during a stop.
+pub fn failures_of(scenario: &Scenario, r: &RunReport) -> (Vec<String>, usize) {
+    let mut failures = Vec::new();
+    let contacts_while_stopped = contact_failures(scenario, r, &mut failures);
+    for o in &r.obstacles {
+        for p in o.passes.iter().filter(|p| !p.met) {
+            failures.push(format!(
+                "{} lap {}: {}, expected {} (clearance {:.2} m)",
+                o.id,
+                p.lap,
+                p.outcome,
+                o.expected,
+                p.min_clearance_m
+                    .iter()
+                    .copied()
+                    .fold(f64::INFINITY, f64::min)
+            ));
+        }
+        if o.passes.is_empty() && scenario.expected_end != ExpectedEnd::Any && !r.expectations_met {
+            failures.push(format!("{}: never passed, expected {}", o.id, o.expected));
+        }
+    }
+    let end_met = match scenario.expected_end {
+        ExpectedEnd::Completed => r.end == EndReason::Completed,
+        ExpectedEnd::WaitingForHiddenObstacle => r.end == EndReason::WaitingForHiddenObstacle,
+        ExpectedEnd::StoppedForGood => r.end != EndReason::Completed,
+        ExpectedEnd::Any => true,
+    };
+    if !end_met {
+        let end = serde_json::to_value(r.end)
+            .ok()
+            .and_then(|v| v.as_str().map(String::from))
+            .unwrap_or_default();
+        failures.push(format!("ended {end}, expected {:?}", scenario.expected_end).to_lowercase());
+    }
+    if !r.expectations_met && failures.is_empty() {
+        failures.push("an expectation was not met".into());
+    }
+    (failures, contacts_while_stopped)
+}
+
 /// The record of a run of variant `v`.
 pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunReport) -> RunRecord {
-    let mut failures = Vec::new();
+    let (failures, contacts_while_stopped) = failures_of(scenario, r);
     let mut contacts_with: Vec<String> = r.contacts.iter().map(|c| c.object.clone()).collect();
     contacts_with.dedup();
-    let contacts_while_stopped = contact_failures(scenario, r, &mut failures);
     let (mut false_stops, mut needless, mut deviations) = (0, 0, 0);
     let mut obstacles = Vec::new();
     let mut obstacle_clearance = f64::INFINITY;
@@ -199,19 +241,6 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
                 p.outcome == PassOutcome::Deviated && o.expected == Expectation::PassUnder,
             );
             deviations += usize::from(p.outcome == PassOutcome::Deviated);
-            if !p.met {
-                failures.push(format!(
-                    "{} lap {}: {}, expected {} (clearance {:.2} m)",
-                    o.id,
-                    p.lap,
-                    p.outcome,
-                    o.expected,
-                    p.min_clearance_m
-                        .iter()
-                        .copied()
-                        .fold(f64::INFINITY, f64::min)
-                ));
-            }
         }
         let levels = o.passes.first().map_or(0, |p| p.min_clearance_m.len());
         let per_level: Vec<f64> = (0..levels)
@@ -239,18 +268,6 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
         .ok()
         .and_then(|v| v.as_str().map(String::from))
         .unwrap_or_default();
-    let end_met = match scenario.expected_end {
-        ExpectedEnd::Completed => r.end == EndReason::Completed,
-        ExpectedEnd::WaitingForHiddenObstacle => r.end == EndReason::WaitingForHiddenObstacle,
-        ExpectedEnd::StoppedForGood => r.end != EndReason::Completed,
-        ExpectedEnd::Any => true,
-    };
-    if !end_met {
-        failures.push(format!("ended {end}, expected {:?}", scenario.expected_end).to_lowercase());
-    }
-    if !r.expectations_met && failures.is_empty() {
-        failures.push("an expectation was not met".into());
-    }
     let counted_contacts = if scenario.no_contact_at_fault {
         r.contacts_at_fault
     } else {

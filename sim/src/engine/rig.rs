@@ -42,6 +42,9 @@ pub struct RunSetup {
     pub seed: Option<u64>,
     /// The run configuration.
     pub config: RunConfig,
+    /// A bound on the simulated time, seconds, under the run's own (60 s plus four times the
+    /// route's length over its speed); `None`: the run's own.
+    pub time_limit_s: Option<f64>,
 }
 
 impl RunSetup {
@@ -52,6 +55,7 @@ impl RunSetup {
             laps: None,
             seed: None,
             config: RunConfig::default(),
+            time_limit_s: None,
         }
     }
 }
@@ -280,7 +284,8 @@ impl<'a> Rig<'a> {
             t_s: 0.0,
             step: 0,
             steps_per_scan: (config.physics_hz / config.scan_hz).round().max(1.0) as u64,
-            timeout_s: 60.0 + 4.0 * total_m / scenario.route.speed_m_s,
+            timeout_s: (60.0 + 4.0 * total_m / scenario.route.speed_m_s)
+                .min(setup.time_limit_s.unwrap_or(f64::INFINITY)),
             split: TimeSplit::default(),
             wall: Instant::now(),
             lost: crate::world::LostRevolutions::default(),

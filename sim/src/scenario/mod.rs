@@ -22,8 +22,8 @@ mod run_config;
 mod spec;
 
 pub use model::{
-    Ground, MotionStop, MoverState, Obstacle, ObstacleMotion, REACTIVE_ACCELERATION_M_S2, Route,
-    Scenario, ScenarioVehicle, TrainLink,
+    Ground, KnownProblem, MotionStop, MoverState, Obstacle, ObstacleMotion,
+    REACTIVE_ACCELERATION_M_S2, Route, Scenario, ScenarioVehicle, TrainLink,
 };
 pub use numbers::{Count, Finite, Laps, NonNegative, Positive, Remission};
 pub use overlap::start_overlap;
@@ -33,6 +33,6 @@ pub use run_config::{
 };
 pub use spec::{
     Expectation, ExpectationsSpec, ExpectedEnd, MAX_ROW_OBJECTS, MAX_TRAIN_CARS, ObjectSpec,
-    ObstacleSpec, PatchSpec, RouteSpec, RowLine, RowSpec, ScenarioFile, StartPose, StopSpec,
-    TrainSpec, VehicleEntry, WorldSpec,
+    ObstacleSpec, PatchSpec, RegressSpec, RouteSpec, RowLine, RowSpec, ScenarioFile, StartPose,
+    StopSpec, TodayEnd, TodaySpec, TrainSpec, VehicleEntry, WorldSpec,
 };

@@ -386,6 +386,23 @@ pub struct Scenario {
     pub no_contact_at_fault: bool,
     /// The `[config]` table (validated): the run configuration over the defaults.
     pub config: Option<toml::Table>,
+    /// `[expectations] known_problem` with its `today`: the run is known not to meet its
+    /// expectations, and ends today as stated.
+    pub known_problem: Option<KnownProblem>,
+    /// `[regress] quick_laps`: laps in `taxi-sim regress`'s quick tier, at most `laps` (`None`:
+    /// all).
+    pub quick_laps: Option<u32>,
+    /// `[regress] full_only`: run only in the full tier.
+    pub full_only: bool,
+}
+
+/// A scenario's known problem: why it fails today, and how it ends today.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KnownProblem {
+    /// The text: what goes wrong.
+    pub text: String,
+    /// The outcome as it is today.
+    pub today: super::spec::TodaySpec,
 }
 
 impl Scenario {

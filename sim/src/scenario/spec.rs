@@ -64,6 +64,9 @@ pub struct ScenarioFile {
     /// differs from the defaults). A campaign's failure file carries its setting here. Default
     /// none: the defaults.
     pub config: Option<Spanned<toml::Table>>,
+    /// How `taxi-sim regress` runs it (its quick tier). Default: as it is.
+    #[serde(default)]
+    pub regress: RegressSpec,
 }
 
 /// `[expectations]`: what must hold over the whole run, beside each obstacle's `expect`.
@@ -88,6 +91,70 @@ pub struct ExpectationsSpec {
     /// rule. Default false.
     #[serde(default)]
     pub no_contact_at_fault: bool,
+    /// A known problem: the run does not meet the expectations above today, and this text says
+    /// why. Given with `today` (the outcome as it is now), `taxi-sim regress` reports the case as
+    /// an expected failure while it still ends as `today` states, and as a failure once it meets
+    /// the expectations (the problem is fixed: remove the mark) or ends some other way. Default
+    /// none.
+    pub known_problem: Option<Spanned<String>>,
+    /// The outcome as it is today, for a `known_problem`: every field given must hold.
+    pub today: Option<Spanned<TodaySpec>>,
+}
+
+/// `[expectations.today]`: a known problem's outcome as it is now (each field optional; at
+/// least one given).
+#[derive(Debug, Default, Deserialize, serde::Serialize, Clone, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TodaySpec {
+    /// How the run ends today: `completed`, `timed_out`, `waiting_for_hidden_obstacle` or
+    /// `blocked`.
+    pub end: Option<TodayEnd>,
+    /// Contacts in all.
+    pub contacts: Option<usize>,
+    /// Contacts that began while the vehicle moved (at fault).
+    pub contacts_at_fault: Option<usize>,
+    /// Contacts that began while it stood (struck by a mover).
+    pub contacts_struck: Option<usize>,
+    /// The objects touched, in the order first touched.
+    pub contacts_with: Option<Vec<String>>,
+}
+
+/// How a run ends, as a known problem's `today.end` states it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TodayEnd {
+    /// Every lap driven.
+    Completed,
+    /// Out of simulated time.
+    TimedOut,
+    /// Waiting for a hidden obstacle: a pilot called.
+    WaitingForHiddenObstacle,
+    /// Blocked for good: a pilot called.
+    Blocked,
+}
+
+impl TodayEnd {
+    /// The name a run report gives this end.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            TodayEnd::Completed => "completed",
+            TodayEnd::TimedOut => "timed_out",
+            TodayEnd::WaitingForHiddenObstacle => "waiting_for_hidden_obstacle",
+            TodayEnd::Blocked => "blocked",
+        }
+    }
+}
+
+/// `[regress]`: how `taxi-sim regress` runs this file.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegressSpec {
+    /// Laps in the quick tier (without `--full`); a file with fewer `laps` (a campaign's
+    /// variant) runs them all. Default: all of them.
+    pub quick_laps: Option<Laps>,
+    /// Run only in the full tier (`--full`): a case too long to shorten. Default false.
+    #[serde(default)]
+    pub full_only: bool,
 }
 
 /// How a scenario's run must end (`[expectations] end`).

@@ -1,5 +1,7 @@
-//! The closed loop on the small scenarios of `scenarios/`: each run's report against the
-//! scenario's expectations, and a run repeated with the same seed.
+//! The closed loop on the small scenarios of `scenarios/` under run configurations their files do
+//! not carry (sequential sensing, no tracker, noisy poses, thread counts, faults, latency, a stale
+//! map), and a run repeated with the same seed. Each file's own expectations are `taxi-sim
+//! regress`'s to check (CI runs every shipped scenario).
 
 use std::path::{Path, PathBuf};
 
@@ -46,45 +48,6 @@ fn outcomes(r: &RunReport) -> Vec<(String, String)> {
         .collect()
 }
 
-#[test]
-fn a_short_cone_under_the_wing_is_passed_over_without_deviation() {
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_scenario("straight_cone_under_wing", dir.path());
-    assert!(r.expectations_met, "{r:#?}");
-    assert_eq!(
-        outcomes(&r),
-        vec![("cone_under_wing".into(), "passed".into())]
-    );
-    let pass = &r.obstacles[0].passes[0];
-    assert!(
-        pass.max_offset_m < 0.5,
-        "no deviation: {}",
-        pass.max_offset_m
-    );
-    // Level 1 is the wing (0.7 m): it passes over the 0.45 m cone with a little room.
-    assert!(
-        pass.min_clearance_m[1] > 0.1 && pass.min_clearance_m[1] < 0.4,
-        "{:?}",
-        pass.min_clearance_m
-    );
-    assert!(r.contacts.is_empty() && r.stops.is_empty());
-}
-
-#[test]
-fn the_car_deviates_around_a_cone_in_its_path() {
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_scenario("cone_in_path_car", dir.path());
-    assert!(r.expectations_met, "{r:#?}");
-    assert_eq!(
-        outcomes(&r),
-        vec![("cone_on_centreline".into(), "deviated".into())]
-    );
-    assert!(
-        r.obstacles[0].passes[0].min_clearance_m[0] > 0.2,
-        "never closer than the avoider's safety"
-    );
-}
-
 /// The same without the overlap of sensing and mapping: each revolution is mapped and planned
 /// the instant it is taken.
 #[test]
@@ -103,68 +66,10 @@ fn the_car_deviates_around_a_cone_in_its_path_with_sequential_sensing() {
     assert_eq!(config, r.config);
 }
 
-#[test]
-fn the_car_deviates_around_a_tall_container_in_its_wings_path() {
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_scenario("container_in_wing_path", dir.path());
-    assert!(r.expectations_met, "{r:#?}");
-    assert_eq!(
-        outcomes(&r),
-        vec![("container_in_wing_path".into(), "deviated".into())]
-    );
-    let clearance = &r.obstacles[0].passes[0].min_clearance_m;
-    assert!(
-        clearance[1] > 0.2,
-        "the wing keeps its distance: {clearance:?}"
-    );
-}
-
-#[test]
-fn the_jet_stops_for_a_cone_on_the_centreline_and_resumes_when_it_is_removed() {
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_scenario("cone_in_path_jet", dir.path());
-    assert!(r.expectations_met, "{r:#?}");
-    assert_eq!(
-        outcomes(&r),
-        vec![("cone_on_centreline".into(), "stopped".into())]
-    );
-    assert_eq!(r.stops.len(), 1);
-    let stop = &r.stops[0];
-    // The cone is removed at 60 s: the stop ends after that.
-    assert!(stop.end_s.is_some_and(|e| e > 60.0), "{stop:?}");
-    assert!(
-        r.obstacles[0].passes[0].min_clearance_m[0] > 2.0,
-        "stopped well short: {:?}",
-        r.obstacles[0].passes[0].min_clearance_m
-    );
-}
-
-/// The car crosses ahead of the jet and drives on. The jet stops for it, goes on when its beams
-/// see the road ahead of the nose clear, and stops again, briefly, before the cells the car
-/// left under the left wing's path (y = 8 m): the airframe hides them from the nose sensor, so
-/// no beam clears them; the tracker of moving objects does, having seen the car leave, and the
-/// jet goes on (seen: 14.4-16.6 s and 24.0-24.8 s).
-#[test]
-fn a_crossing_vehicle_stops_the_jet_which_resumes_once_it_has_gone() {
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_scenario("crossing_vehicle", dir.path());
-    assert!(r.expectations_met, "{r:#?}");
-    assert_eq!(
-        outcomes(&r),
-        vec![("crossing_car".into(), "stopped".into())]
-    );
-    assert!((1..=2).contains(&r.stops.len()), "{:?}", r.stops);
-    let mut waited = 0.0;
-    for stop in &r.stops {
-        waited += stop.end_s.expect("it resumes") - stop.start_s;
-    }
-    assert!((0.5..30.0).contains(&waited), "waited {waited:.1} s");
-    assert_eq!(r.laps_completed, 1);
-}
-
 /// Without the tracker, the trail stays and the jet waits for what it cannot see: it calls for
-/// a pilot, and says where (ahead of the wing, on the car's path at x = 50 m). What the
-/// crossing test above needs the tracker for.
+/// a pilot, and says where (ahead of the wing, on the car's path at x = 50 m). What
+/// `scenarios/crossing_vehicle.toml` (the jet stops for the car, then goes on) needs the
+/// tracker for.
 #[test]
 fn without_the_tracker_the_jet_waits_for_the_crossing_cars_hidden_trail() {
     let dir = tempfile::tempdir().unwrap();
@@ -181,28 +86,6 @@ fn without_the_tracker_the_jet_waits_for_the_crossing_cars_hidden_trail() {
     // On the car's path, under the wing's span (10.75 m).
     assert!((w.x_m - 50.0).abs() < 2.0 && w.y_m.abs() < 11.0, "{w:?}");
     assert!(w.last_seen_s.is_some_and(|t| t < w.since_s), "{w:?}");
-}
-
-/// Debris 0.15 m tall appears on the far side of the loop at 20 s: the car must see it at
-/// wheel level and not touch it on either lap. It ran over it on both laps (4 wheel contacts)
-/// while no test ran this shipped scenario: the consecutive-beam test alone mapped it only
-/// 12.7 m ahead, too late to go round; the car stopped against it, forgot it once its cabin hid
-/// it and drove over it. Mapped from its height (`sim::scenario::OBSTACLE_HEIGHT_M`), it is gone
-/// round on both laps.
-#[test]
-fn the_car_goes_round_short_debris_on_both_laps_of_the_pose_file_loop() {
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_scenario("closed_loop_pose_file", dir.path());
-    assert!(r.contacts.is_empty(), "{:?}", r.contacts);
-    assert!(r.expectations_met, "{r:#?}");
-    assert_eq!(r.laps_completed, 2);
-    assert_eq!(
-        outcomes(&r),
-        vec![("debris_far_side".into(), "deviated".into()); 2]
-    );
-    for pass in &r.obstacles[0].passes {
-        assert!(pass.min_clearance_m[0] > 0.2, "{pass:?}");
-    }
 }
 
 #[test]
@@ -222,41 +105,6 @@ fn a_run_is_identical_for_the_same_seed() {
         v
     };
     assert_eq!(strip(&a), strip(&b));
-}
-
-/// Every scenario shipped in `scenarios/` is run in closed loop by a test of this crate (this
-/// file, `experiments.rs`, `overhead.rs` or `permanence.rs`, found by its name in quotes), so a new scenario that nobody runs
-/// fails here (one that failed its expectations once shipped untested).
-#[test]
-fn every_shipped_scenario_is_run_by_a_test() {
-    let here = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let sources: String = [
-        "airports.rs",
-        "closed_loop.rs",
-        "experiments.rs",
-        "overhead.rs",
-        "permanence.rs",
-        "traffic.rs",
-    ]
-    .iter()
-    .map(|f| std::fs::read_to_string(here.join("tests/it").join(f)).unwrap())
-    .collect();
-    let mut shipped = Vec::new();
-    for entry in std::fs::read_dir(here.join("../scenarios")).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_some_and(|e| e == "toml") {
-            shipped.push(path.file_stem().unwrap().to_string_lossy().into_owned());
-        }
-    }
-    assert!(shipped.len() >= 8, "{shipped:?}");
-    let untested: Vec<_> = shipped
-        .iter()
-        .filter(|name| !sources.contains(&format!("scenario(\"{name}\"")))
-        .collect();
-    assert!(
-        untested.is_empty(),
-        "shipped but run by no test: {untested:?}"
-    );
 }
 
 /// A noisy pose source (drift and jitter at 20 Hz, dead reckoning between) is part of the run's

@@ -13,4 +13,5 @@ mod found;
 mod localization;
 mod overhead;
 mod permanence;
+mod regress;
 mod traffic;

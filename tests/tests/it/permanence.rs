@@ -9,6 +9,13 @@ use sim::scenario::RunConfig;
 
 use crate::common::{run_with, scenario};
 
+/// The A320-like airliner and the cart towed away from its engine's path (a known problem).
+fn towed_cart() -> sim::scenario::Scenario {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("found/a320_cart_towed_from_under_the_fuselage.toml");
+    sim::scenario::Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// Stopped for a unit its airframe then hides, the jet waits and calls for a pilot: no contact,
 /// the pass closes as a stop, and the report names where the hidden obstacle is.
 fn assert_waits_for_hidden(name: &str, id: &str, at: (f64, f64)) -> RunReport {
@@ -64,18 +71,19 @@ fn with_time_based_forgetting_the_jet_strikes_the_unit_it_stopped_for() {
 /// left engine's path, which its nose pod still sees under the fuselage; it waits while it sees
 /// the cart and drives on only once it has seen it towed away (60 s), without contact - with the
 /// sensor as it was before its calibration on a real HDL-32E (2 cm of range noise, no drop-off).
-/// FIXME (README, Known problems): with the calibrated sensor (4 mm, 1.3 %) the cart's top near
-/// its front corner, at (99.7, 5.5), is last hit 1.5 s before the stop and hidden from then on;
-/// when the cart vanishes at 60 s (the scenario's tow, `disappears_s`) the rest of it is seen
-/// gone, but no beam can pass through that cell (unseen is not gone), and the airliner waits for
-/// it until the pilot is called. Asserted as it is.
+/// With the calibrated sensor (4 mm, 1.3 %) the cart's top near its front corner, at (99.7,
+/// 5.5), is last hit 1.5 s before the stop and hidden from then on; when the cart vanishes at
+/// 60 s (the scenario's tow, `disappears_s`) the rest of it is seen gone, but no beam can pass
+/// through that cell (unseen is not gone), and the airliner waits for it until the pilot is
+/// called: a known problem, in its file (`tests/found/a320_cart_towed_from_under_the_fuselage`,
+/// which `taxi-sim regress` holds to it); here, where it waits.
 #[test]
 fn the_airliner_waits_for_a_cart_in_its_engines_path_until_it_sees_it_towed_away() {
     let dir = tempfile::tempdir().unwrap();
     let mut config = RunConfig::default();
     config.lidar.noise_stddev_m = 0.02;
     config.lidar.dropoff_general_rate = 0.0;
-    let r = run_with(&scenario("unit_in_engine_path_a320"), dir.path(), config);
+    let r = run_with(&towed_cart(), dir.path(), config);
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     assert!(r.expectations_met, "{r:#?}");
     assert_eq!(r.end, EndReason::Completed);
@@ -98,11 +106,7 @@ fn the_airliner_waits_for_a_cart_in_its_engines_path_until_it_sees_it_towed_away
 
     // The calibrated sensor: stopped without contact, then waiting for the hidden corner.
     let dir = tempfile::tempdir().unwrap();
-    let r = run_with(
-        &scenario("unit_in_engine_path_a320"),
-        dir.path(),
-        RunConfig::default(),
-    );
+    let r = run_with(&towed_cart(), dir.path(), RunConfig::default());
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     assert_eq!(
         r.end,

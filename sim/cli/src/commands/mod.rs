@@ -10,6 +10,7 @@ pub mod demo;
 pub mod figures;
 pub mod map;
 pub mod model;
+pub mod regress;
 pub mod representations;
 pub mod run;
 pub mod scan;

@@ -25,6 +25,7 @@ mod cli;
 mod figures;
 mod hostile;
 mod pcap;
+mod regress;
 mod replay;
 #[path = "../../../tests/it/smoke_campaign.rs"]
 mod smoke_campaign;

@@ -18,9 +18,9 @@ use std::path::Path;
 use nalgebra::Point2;
 use toml::Spanned;
 
-use super::model::{Ground, Scenario, ScenarioVehicle};
+use super::model::{Ground, KnownProblem, Scenario, ScenarioVehicle};
 use super::overlap::start_overlap;
-use super::spec::{ScenarioFile, WorldSpec};
+use super::spec::{ScenarioFile, TodaySpec, WorldSpec};
 use crate::toml_file::LocatedError;
 use crate::world::Solid;
 
@@ -38,7 +38,7 @@ impl Resolver<'_> {
 
     pub(super) fn resolve(
         &self,
-        spec: ScenarioFile,
+        mut spec: ScenarioFile,
         path: &Path,
     ) -> Result<Scenario, LocatedError> {
         let airport = spec
@@ -83,6 +83,7 @@ impl Resolver<'_> {
         self.rows(&spec.rows, &world, &route, &vehicle, &mut ids, &mut objects)?;
         patches.extend(self.patches(&spec.patches, &world, &mut ids)?);
         let obstacles = self.obstacles(&spec.obstacles, &world, &vehicle, &mut ids)?;
+        let known_problem = self.known_problem(&mut spec.expectations)?;
         if let Some(c) = &spec.config {
             crate::scenario::RunConfig::from_table(c.get_ref().clone())
                 .map_err(|m| LocatedError::at(self.file, self.text, c.span(), "config", m))?;
@@ -103,7 +104,47 @@ impl Resolver<'_> {
             expected_end: spec.expectations.end.unwrap_or_default(),
             no_contact_at_fault: spec.expectations.no_contact_at_fault,
             config: spec.config.map(Spanned::into_inner),
+            known_problem,
+            quick_laps: spec.regress.quick_laps.map(|q| q.0),
+            full_only: spec.regress.full_only,
         })
+    }
+
+    /// `[expectations] known_problem` and `today`: both or neither; `today` states something.
+    fn known_problem(
+        &self,
+        e: &mut crate::scenario::ExpectationsSpec,
+    ) -> Result<Option<KnownProblem>, LocatedError> {
+        let field = "expectations.known_problem";
+        match (e.known_problem.take(), e.today.take()) {
+            (None, None) => Ok(None),
+            (None, Some(today)) => Err(self.err(
+                today.span(),
+                "expectations.today",
+                "states a known problem's outcome, but `known_problem` (the text saying what goes wrong) is missing",
+            )),
+            (Some(text), None) => Err(self.err(
+                text.span(),
+                field,
+                "a known problem needs `[expectations.today]`: how the run ends today (end, contacts, contacts_at_fault, contacts_struck or contacts_with)",
+            )),
+            (Some(text), Some(today)) => {
+                if *today.get_ref() == TodaySpec::default() {
+                    return Err(self.err(
+                        today.span(),
+                        "expectations.today",
+                        "states nothing: give end, contacts, contacts_at_fault, contacts_struck or contacts_with",
+                    ));
+                }
+                if text.get_ref().trim().is_empty() {
+                    return Err(self.err(text.span(), field, "empty: say what goes wrong"));
+                }
+                Ok(Some(KnownProblem {
+                    text: text.into_inner(),
+                    today: today.into_inner(),
+                }))
+            }
+        }
     }
 
     /// Claims `id` in `ids` for `owner` (as error messages name it): an empty id or one

@@ -1,0 +1,144 @@
+//! `taxi-sim regress` end to end on one short scenario written five ways: a case that passes, a
+//! known problem that still fails as stated (expected failure), one that was fixed and one that
+//! changed (both failures, as pytest's strict xfail), a file that is not a scenario (an error,
+//! the run going on), and a campaign file beside them (skipped). The four runs share one map.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use sim::regress::results::{Counts, junit};
+use sim::regress::{CaseResult, Options, Status, Tier, discover, run_cases};
+
+fn shipped(name: &str) -> String {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../scenarios/{name}.toml"));
+    std::fs::read_to_string(p).unwrap()
+}
+
+/// The straight road with the cone expected to be gone round: the car passes under it, so the
+/// run fails that expectation (the cone `passed`, expected `deviate`).
+fn expecting_deviation(text: &str) -> String {
+    assert!(text.contains("expect = \"pass_under\""));
+    text.replace("expect = \"pass_under\"", "expect = \"deviate\"")
+}
+
+fn mark(text: &str, today: &str) -> String {
+    // `[expectations]` goes before the first table: after `laps = 1`.
+    text.replacen(
+        "laps = 1\n",
+        &format!("laps = 1\n\n[expectations]\nknown_problem = \"the car passes under the cone it should go round\"\n\n[expectations.today]\n{today}\n"),
+        1,
+    )
+}
+
+fn run_dir(dir: &Path, tier: Tier) -> Vec<CaseResult> {
+    let cases = discover(&[dir.to_path_buf()], None).unwrap();
+    let maps = tempfile::tempdir().unwrap();
+    let stop = AtomicBool::new(false);
+    run_cases(
+        &cases,
+        &Options {
+            jobs: 2,
+            tier,
+            maps_dir: maps.path().to_path_buf(),
+            shard: None,
+            time_limit_s: None,
+            stop: &stop,
+            progress: &|_| {},
+            started: &|_| {},
+        },
+    )
+    .unwrap()
+}
+
+#[test]
+fn regress_reports_passes_known_problems_fixed_and_changed_ones_and_bad_files() {
+    let base = shipped("straight_cone_under_wing");
+    let d = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: &str| std::fs::write(d.path().join(name), text).unwrap();
+    write("a_pass.toml", &base);
+    write(
+        "b_known.toml",
+        &mark(
+            &expecting_deviation(&base),
+            "end = \"completed\"\ncontacts = 0",
+        ),
+    );
+    write("c_fixed.toml", &mark(&base, "end = \"completed\""));
+    write(
+        "d_changed.toml",
+        &mark(&expecting_deviation(&base), "end = \"blocked\""),
+    );
+    write("e_broken.toml", "name = \"broken\"\nlaps = \"many\"\n");
+    std::fs::create_dir(d.path().join("campaigns")).unwrap();
+    std::fs::write(
+        d.path().join("campaigns/family.toml"),
+        "name = \"f\"\nbase = \"../a_pass.toml\"\nruns = 2\n",
+    )
+    .unwrap();
+
+    let rs = run_dir(d.path(), Tier::Quick);
+    let got: Vec<(&str, Status)> = rs.iter().map(|r| (r.name.as_str(), r.status)).collect();
+    assert_eq!(
+        got,
+        [
+            ("a_pass", Status::Passed),
+            ("b_known", Status::KnownProblem),
+            ("c_fixed", Status::Failed),
+            ("d_changed", Status::Failed),
+            ("e_broken", Status::Error),
+        ],
+        "{rs:#?}"
+    );
+    let by = |n: &str| rs.iter().find(|r| r.name == n).unwrap();
+    // The known problem's verdict says how it fails today, with the numbers.
+    let known = by("b_known");
+    assert_eq!(
+        known.messages,
+        ["cone_under_wing lap 1: passed, expected deviate (clearance 0.25 m)"],
+        "{known:?}"
+    );
+    assert!(by("c_fixed").messages[0].starts_with("known problem fixed"));
+    assert_eq!(
+        by("d_changed").messages[0],
+        "known problem changed: ended completed, today's end is blocked"
+    );
+    let broken = &by("e_broken").messages[0];
+    assert!(
+        broken.contains("e_broken.toml:2") && broken.contains("laps"),
+        "{broken}"
+    );
+    let pass = by("a_pass");
+    assert_eq!(pass.end.as_deref(), Some("completed"));
+    assert!(
+        pass.sim_time_s > 30.0 && pass.real_time_factor > 1.0,
+        "{pass:?}"
+    );
+    assert_eq!(
+        pass.rerun,
+        format!("taxi-sim run {}/a_pass.toml --seed 7", d.path().display())
+    );
+    // The same run twice gives the same verdicts and numbers (wall time aside).
+    assert_eq!(
+        (known.sim_time_s, known.obstacle_clearance_m),
+        (pass.sim_time_s, pass.obstacle_clearance_m)
+    );
+    let c = Counts::of(&rs);
+    assert_eq!(
+        (
+            c.passed,
+            c.known_problems,
+            c.failed,
+            c.errors,
+            c.exit_code()
+        ),
+        (1, 1, 2, 1, 2)
+    );
+    // JUnit: one suite (the folder), the known problem skipped with its text.
+    let xml = junit("r", &rs).to_string().unwrap();
+    assert!(
+        xml.contains(
+            "<skipped message=\"known problem: the car passes under the cone it should go round\""
+        ),
+        "{xml}"
+    );
+}
