@@ -41,15 +41,16 @@ pub fn static_world_key(scenario: &Scenario, config: &RunConfig) -> Result<Strin
 /// One static world's map directory, once built (or why it could not be).
 type MapSlot = OnceLock<std::result::Result<PathBuf, String>>;
 
-/// The offline maps of a campaign directory, built once per static world.
-pub(crate) struct MapCache {
+/// The offline maps of a campaign directory (or of `taxi-sim regress`, or a test binary), built
+/// once per static world.
+pub struct MapCache {
     dir: PathBuf,
     entries: Mutex<HashMap<String, Arc<MapSlot>>>,
 }
 
 impl MapCache {
     /// An empty cache over the map directories under `dir`.
-    pub(crate) fn new(dir: PathBuf) -> Self {
+    pub fn new(dir: PathBuf) -> Self {
         MapCache {
             dir,
             entries: Mutex::default(),
@@ -76,7 +77,7 @@ impl MapCache {
 
     /// The map of a scenario read from its own file (`taxi-sim regress`): driven as it is, its
     /// relative paths (vehicle sidecar, airport, pose file) resolved where the file lives.
-    pub(crate) fn get_for_file(&self, scenario: &Scenario, config: &RunConfig) -> Result<PathBuf> {
+    pub fn get_for_file(&self, scenario: &Scenario, config: &RunConfig) -> Result<PathBuf> {
         self.get_with(scenario, config, &|scratch| {
             crate::offline_map::map_drive(scenario, config, scratch, &mut |_, _| {}).map(|_| ())
         })

@@ -19,8 +19,7 @@ mod shard;
 pub mod summary;
 
 pub use execute::{Outcome, RunOptions, proposals_for, run_campaign, total_runs, variant};
-pub(crate) use map_cache::MapCache;
-pub use map_cache::static_world_key;
+pub use map_cache::{MapCache, static_world_key};
 pub use record::{INVALID, ObstacleOutcome, RunRecord, failures_of, read_results, record};
 pub use shard::Shard;
 

@@ -8,8 +8,7 @@ use crate::common::{run_with, scenario};
 #[test]
 fn the_jet_taxis_from_a_stand_to_the_runway_by_b_and_a() {
     let s = scenario("xtsm_stand_to_runway");
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_with(&s, dir.path(), RunConfig::for_scenario(&s, None).unwrap());
+    let r = run_with(&s, RunConfig::for_scenario(&s, None).unwrap());
     assert!(r.expectations_met && r.contacts.is_empty(), "{r:#?}");
     let outcome = |id: &str| {
         r.obstacles
@@ -52,8 +51,7 @@ fn the_jet_taxis_from_a_stand_to_the_runway_by_b_and_a() {
 #[ignore = "reads ../shared/data"]
 fn shared_data_the_jet_taxis_ksyr_from_gate_4_to_runway_28() {
     let s = scenario("airports/ksyr_gate_to_runway_28");
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_with(&s, dir.path(), RunConfig::for_scenario(&s, None).unwrap());
+    let r = run_with(&s, RunConfig::for_scenario(&s, None).unwrap());
     assert!(r.expectations_met && r.contacts.is_empty(), "{r:#?}");
     assert_eq!(r.obstacles[0].passes[0].outcome.as_str(), "passed");
 }

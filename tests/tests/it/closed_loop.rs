@@ -3,7 +3,7 @@
 //! map), and a run repeated with the same seed. Each file's own expectations are `taxi-sim
 //! regress`'s to check (CI runs every shipped scenario).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use sim::engine::{EndReason, RunReport, RunSetup, run};
 use sim::scenario::{NoisyTruthConfig, PoseSourceConfig, RunConfig, Scenario, Schedule};
@@ -15,24 +15,19 @@ fn scenario(name: &str) -> Scenario {
     Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Builds the offline map (mapping drive) in a scratch directory, then runs the closed loop.
-fn run_scenario(name: &str, map_dir: &Path) -> RunReport {
-    run_scenario_with(name, map_dir, |o| o)
+/// Runs the closed loop over the scenario's offline map (`common::map_for`: one mapping drive
+/// per static world for the whole test binary).
+fn run_scenario(name: &str) -> RunReport {
+    run_scenario_with(name, |o| o)
 }
 
 /// Like [`run_scenario`], with the run's configuration changed by `adjust`.
-fn run_scenario_with(
-    name: &str,
-    map_dir: &Path,
-    adjust: impl FnOnce(RunConfig) -> RunConfig,
-) -> RunReport {
+fn run_scenario_with(name: &str, adjust: impl FnOnce(RunConfig) -> RunConfig) -> RunReport {
     let s = scenario(name);
     let config = adjust(RunConfig::default());
-    sim::offline_map::map_drive(&s, &config, map_dir, &mut |_, _| {})
-        .unwrap_or_else(|e| panic!("{name}: mapping drive: {e:#}"));
     let setup = RunSetup {
-        config,
-        ..RunSetup::new(map_dir.to_path_buf())
+        config: config.clone(),
+        ..RunSetup::new(crate::common::map_for(&s, &config))
     };
     run(&s, &setup).unwrap_or_else(|e| panic!("{name}: {e:#}"))
 }
@@ -52,8 +47,7 @@ fn outcomes(r: &RunReport) -> Vec<(String, String)> {
 /// the instant it is taken.
 #[test]
 fn the_car_deviates_around_a_cone_in_its_path_with_sequential_sensing() {
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_scenario_with("cone_in_path_car", dir.path(), |c| RunConfig {
+    let r = run_scenario_with("cone_in_path_car", |c| RunConfig {
         schedule: Schedule::Sequential,
         ..c
     });
@@ -72,8 +66,7 @@ fn the_car_deviates_around_a_cone_in_its_path_with_sequential_sensing() {
 /// tracker for.
 #[test]
 fn without_the_tracker_the_jet_waits_for_the_crossing_cars_hidden_trail() {
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_scenario_with("crossing_vehicle", dir.path(), |mut c| {
+    let r = run_scenario_with("crossing_vehicle", |mut c| {
         c.mapping.forgetting.tracking.enabled = false;
         c
     });
@@ -90,11 +83,11 @@ fn without_the_tracker_the_jet_waits_for_the_crossing_cars_hidden_trail() {
 
 #[test]
 fn a_run_is_identical_for_the_same_seed() {
-    let dir = tempfile::tempdir().unwrap();
-    let a = run_scenario("cone_in_path_car", dir.path());
+    let a = run_scenario("cone_in_path_car");
+    let s = scenario("cone_in_path_car");
     let b = run(
-        &scenario("cone_in_path_car"),
-        &RunSetup::new(dir.path().to_path_buf()),
+        &s,
+        &RunSetup::new(crate::common::map_for(&s, &RunConfig::default())),
     )
     .unwrap();
     let strip = |r: &RunReport| {
@@ -112,7 +105,6 @@ fn a_run_is_identical_for_the_same_seed() {
 /// drift does not stop the car from going round the cone.
 #[test]
 fn a_run_with_a_noisy_pose_source_is_reproducible_from_its_seed() {
-    let dir = tempfile::tempdir().unwrap();
     let noisy = |mut c: RunConfig| {
         c.pose_source = PoseSourceConfig::NoisyTruth(NoisyTruthConfig {
             drift_sigma_m: 0.05,
@@ -122,13 +114,14 @@ fn a_run_with_a_noisy_pose_source_is_reproducible_from_its_seed() {
         });
         c
     };
-    let a = run_scenario_with("cone_in_path_car", dir.path(), noisy);
+    let a = run_scenario_with("cone_in_path_car", noisy);
+    let s = scenario("cone_in_path_car");
+    let map = crate::common::map_for(&s, &noisy(RunConfig::default()));
     let setup = |seed| RunSetup {
         seed,
         config: noisy(RunConfig::default()),
-        ..RunSetup::new(dir.path().to_path_buf())
+        ..RunSetup::new(map.clone())
     };
-    let s = scenario("cone_in_path_car");
     let b = run(&s, &setup(None)).unwrap();
     let c = run(&s, &setup(Some(s.seed + 1))).unwrap();
     let strip = |r: &RunReport| {
@@ -149,9 +142,7 @@ fn a_run_with_a_noisy_pose_source_is_reproducible_from_its_seed() {
 /// Each run has two minutes (it takes seconds) before the test fails instead of hanging.
 #[test]
 fn a_run_is_the_same_whatever_the_thread_count() {
-    let dir = tempfile::tempdir().unwrap();
-    let s = scenario("cone_in_path_car");
-    sim::offline_map::map_drive(&s, &RunConfig::default(), dir.path(), &mut |_, _| {}).unwrap();
+    let map = crate::common::map_for(&scenario("cone_in_path_car"), &RunConfig::default());
     let strip = |r: &RunReport| {
         let mut v = serde_json::to_value(r).unwrap();
         for k in ["wall_time_s", "real_time_factor", "time_split_s"] {
@@ -162,7 +153,7 @@ fn a_run_is_the_same_whatever_the_thread_count() {
     let mut reports = Vec::new();
     for threads in [1, 2, 4, 8] {
         let (tx, rx) = std::sync::mpsc::channel();
-        let (s, map_dir) = (scenario("cone_in_path_car"), dir.path().to_path_buf());
+        let (s, map_dir) = (scenario("cone_in_path_car"), map.clone());
         std::thread::spawn(move || {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -228,15 +219,14 @@ fn the_offline_map_is_the_same_whatever_the_thread_count() {
 #[test]
 fn the_watchdog_holds_the_car_through_lost_revolutions_and_it_drives_on() {
     let s = scenario("straight_cone_under_wing");
-    let dir = tempfile::tempdir().unwrap();
-    sim::offline_map::map_drive(&s, &RunConfig::default(), dir.path(), &mut |_, _| {}).unwrap();
+    let map = crate::common::map_for(&s, &RunConfig::default());
     let mut config = RunConfig::default();
     config.faults.lost_revolution_probability = 0.02;
     config.faults.lost_burst_revolutions = 5;
     let go = |config: &RunConfig| {
         let setup = RunSetup {
             config: config.clone(),
-            ..RunSetup::new(dir.path().to_path_buf())
+            ..RunSetup::new(map.clone())
         };
         run(&s, &setup).unwrap()
     };
@@ -268,8 +258,7 @@ fn the_watchdog_holds_the_car_through_lost_revolutions_and_it_drives_on() {
 #[test]
 fn the_car_copes_with_dropout_dead_beams_noise_and_spurious_returns() {
     let s = scenario("straight_cone_under_wing");
-    let dir = tempfile::tempdir().unwrap();
-    sim::offline_map::map_drive(&s, &RunConfig::default(), dir.path(), &mut |_, _| {}).unwrap();
+    let map = crate::common::map_for(&s, &RunConfig::default());
     let mut config = RunConfig::default();
     config.faults.beam_dropout_probability = 0.3;
     config.faults.dead_beams = vec![0, 1, 2];
@@ -281,7 +270,7 @@ fn the_car_copes_with_dropout_dead_beams_noise_and_spurious_returns() {
         let setup = RunSetup {
             config,
             seed: Some(seed),
-            ..RunSetup::new(dir.path().to_path_buf())
+            ..RunSetup::new(map.clone())
         };
         run(&s, &setup).unwrap()
     };
@@ -322,8 +311,7 @@ fn the_car_copes_with_dropout_dead_beams_noise_and_spurious_returns() {
 #[test]
 fn the_stack_meets_its_expectations_with_revolutions_two_tenths_late() {
     for name in ["straight_cone_under_wing", "cone_in_path_jet"] {
-        let dir = tempfile::tempdir().unwrap();
-        let r = run_scenario_with(name, dir.path(), |mut c| {
+        let r = run_scenario_with(name, |mut c| {
             c.faults.lidar_latency_s = 0.2;
             c
         });
@@ -348,8 +336,7 @@ fn the_stack_meets_its_expectations_with_revolutions_two_tenths_late() {
 /// and it touches nothing: it stops rather than drives on stale scans.
 #[test]
 fn revolutions_older_than_the_watchdog_allows_hold_the_car() {
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_scenario_with("straight_cone_under_wing", dir.path(), |mut c| {
+    let r = run_scenario_with("straight_cone_under_wing", |mut c| {
         c.faults.lidar_latency_s = 0.25;
         c.faults.lidar_jitter_s = 0.1;
         c

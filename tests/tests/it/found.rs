@@ -12,13 +12,11 @@ use sim::scenario::{RunConfig, Scenario};
 /// Runs a found scenario after its mapping drive, with its own configuration changed by
 /// `change`.
 fn run_found_with(s: &Scenario, change: impl FnOnce(&mut RunConfig)) -> sim::engine::RunReport {
-    let dir = tempfile::tempdir().unwrap();
     let mut config = RunConfig::for_scenario(s, None).unwrap();
     change(&mut config);
-    sim::offline_map::map_drive(s, &config, dir.path(), &mut |_, _| {}).unwrap();
     let setup = RunSetup {
-        config,
-        ..RunSetup::new(dir.path().to_path_buf())
+        config: config.clone(),
+        ..RunSetup::new(crate::common::map_for(s, &config))
     };
     run(s, &setup).unwrap()
 }

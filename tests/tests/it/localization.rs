@@ -32,8 +32,7 @@ fn localization(r: &RunReport) -> &sim::engine::LocalizationReport {
 fn the_parking_lot_is_localized_within_a_decimetre_and_every_expectation_holds() {
     let mut s = scenario("parking_lot");
     one_lap(&mut s);
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_with(&s, dir.path(), particle_filter(MeasurementModel::Both));
+    let r = run_with(&s, particle_filter(MeasurementModel::Both));
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     assert!(r.expectations_met, "{:?}", r.obstacles);
     let l = &localization(&r).run;
@@ -60,8 +59,7 @@ fn on_a_featureless_lot_the_covariance_grows_and_the_vehicle_slows_or_stops() {
     one_lap(&mut s);
     s.patches.clear();
     s.world.pavement_texture = 0.0;
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_with(&s, dir.path(), particle_filter(MeasurementModel::Remission));
+    let r = run_with(&s, particle_filter(MeasurementModel::Remission));
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     let l = &localization(&r).run;
     let slow_m = RunConfig::default().autonomy.uncertainty_slow_m;
@@ -89,7 +87,6 @@ fn on_a_featureless_lot_the_covariance_grows_and_the_vehicle_slows_or_stops() {
 fn with_the_odometry_bias_doubled_nothing_is_touched() {
     let mut s = scenario("parking_lot");
     one_lap(&mut s);
-    let dir = tempfile::tempdir().unwrap();
     let base = particle_filter(MeasurementModel::Both);
     let doubled = RunConfig {
         odometry: sim::world::OdometryConfig {
@@ -99,7 +96,7 @@ fn with_the_odometry_bias_doubled_nothing_is_touched() {
         },
         ..base
     };
-    let r = run_with(&s, dir.path(), doubled);
+    let r = run_with(&s, doubled);
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     assert!(r.expectations_met, "{:?}", r.obstacles);
     let l = &localization(&r).run;

@@ -10,8 +10,7 @@ use crate::common::{run_with, scenario};
 /// A run-time structure the vehicle must drive under: passed, no stop anywhere, no contact.
 fn assert_passes_under(s: Scenario, id: &str) -> RunReport {
     let name = s.name.clone();
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_with(&s, dir.path(), RunConfig::default());
+    let r = run_with(&s, RunConfig::default());
     assert!(r.expectations_met, "{name}: {r:#?}");
     assert_eq!(r.obstacles.len(), 1);
     let o = &r.obstacles[0];
@@ -62,9 +61,8 @@ fn the_jet_passes_under_a_footbridge_9_m_up() {
 
 #[test]
 fn the_car_stops_short_of_a_bar_whose_underside_is_1_9_m_up() {
-    let dir = tempfile::tempdir().unwrap();
     let s = scenario("low_bar_car");
-    let r = run_with(&s, dir.path(), RunConfig::default());
+    let r = run_with(&s, RunConfig::default());
     assert!(r.expectations_met, "{r:#?}");
     let pass = &r.obstacles[0].passes[0];
     assert_eq!(pass.outcome.as_str(), "stopped", "{r:#?}");
@@ -84,8 +82,7 @@ fn the_car_stops_short_of_a_bar_whose_underside_is_1_9_m_up() {
 #[test]
 fn the_jet_stops_short_of_a_bridge_6_m_up_and_stays_stopped() {
     let s = scenario("low_bridge_jet");
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_with(&s, dir.path(), RunConfig::default());
+    let r = run_with(&s, RunConfig::default());
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     assert!(r.expectations_met, "{r:#?}");
     assert_eq!(r.stops.len(), 1, "{:?}", r.stops);
@@ -101,8 +98,7 @@ fn the_jet_stops_short_of_a_bridge_6_m_up_and_stays_stopped() {
 #[test]
 fn the_airliner_s_wing_passes_over_a_parked_jet_s_wing() {
     let s = scenario("airliner_wing_over_parked_jet");
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_with(&s, dir.path(), RunConfig::for_scenario(&s, None).unwrap());
+    let r = run_with(&s, RunConfig::for_scenario(&s, None).unwrap());
     assert!(r.expectations_met && r.contacts.is_empty(), "{r:#?}");
     // Ground truth, level 2 (the airliner's wing and what is above 2.1 m): 1.24 m to the parked
     // jet's parts; the gear and engines (levels 0 and 1) stay 3.4 and 1.5 m away.

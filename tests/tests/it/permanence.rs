@@ -19,8 +19,7 @@ fn towed_cart() -> sim::scenario::Scenario {
 /// Stopped for a unit its airframe then hides, the jet waits and calls for a pilot: no contact,
 /// the pass closes as a stop, and the report names where the hidden obstacle is.
 fn assert_waits_for_hidden(name: &str, id: &str, at: (f64, f64)) -> RunReport {
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_with(&scenario(name), dir.path(), RunConfig::default());
+    let r = run_with(&scenario(name), RunConfig::default());
     assert!(r.contacts.is_empty(), "{name}: {:?}", r.contacts);
     assert!(r.expectations_met, "{name}: {r:#?}");
     assert_eq!(r.end, EndReason::WaitingForHiddenObstacle);
@@ -50,10 +49,9 @@ fn the_jet_waits_for_a_unit_its_wing_would_strike_once_its_airframe_hides_it() {
 /// jet forgets the hidden unit after its stop, drives on and strikes it with the left wing.
 #[test]
 fn with_time_based_forgetting_the_jet_strikes_the_unit_it_stopped_for() {
-    let dir = tempfile::tempdir().unwrap();
     let mut config = RunConfig::default();
     config.mapping.forgetting.rule = ForgettingRule::TimeDecay;
-    let r = run_with(&scenario("unit_in_wing_path_jet"), dir.path(), config);
+    let r = run_with(&scenario("unit_in_wing_path_jet"), config);
     assert_eq!(r.stops.len(), 1, "{:?}", r.stops);
     let stop = &r.stops[0];
     assert!(stop.end_s.is_some(), "it went on: {stop:?}");
@@ -79,11 +77,10 @@ fn with_time_based_forgetting_the_jet_strikes_the_unit_it_stopped_for() {
 /// which `taxi-sim regress` holds to it); here, where it waits.
 #[test]
 fn the_airliner_waits_for_a_cart_in_its_engines_path_until_it_sees_it_towed_away() {
-    let dir = tempfile::tempdir().unwrap();
     let mut config = RunConfig::default();
     config.lidar.noise_stddev_m = 0.02;
     config.lidar.dropoff_general_rate = 0.0;
-    let r = run_with(&towed_cart(), dir.path(), config);
+    let r = run_with(&towed_cart(), config);
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     assert!(r.expectations_met, "{r:#?}");
     assert_eq!(r.end, EndReason::Completed);
@@ -105,8 +102,7 @@ fn the_airliner_waits_for_a_cart_in_its_engines_path_until_it_sees_it_towed_away
     assert!(pass.min_clearance_m[1] > 1.0, "{pass:?}");
 
     // The calibrated sensor: stopped without contact, then waiting for the hidden corner.
-    let dir = tempfile::tempdir().unwrap();
-    let r = run_with(&towed_cart(), dir.path(), RunConfig::default());
+    let r = run_with(&towed_cart(), RunConfig::default());
     assert!(r.contacts.is_empty(), "{:?}", r.contacts);
     assert_eq!(
         r.end,

@@ -1,7 +1,11 @@
-//! Helpers shared by the closed-loop test files: a shipped scenario by name, and a run after its
-//! mapping drive.
+//! Helpers shared by the closed-loop test files: a shipped scenario by name, its offline map
+//! (one mapping drive per static world for the whole test binary), and a run over it.
 
 use std::path::{Path, PathBuf};
+use std::sync::LazyLock;
+use std::time::UNIX_EPOCH;
+
+use sim::campaign::MapCache;
 
 use sim::engine::{RunReport, RunSetup, run};
 use sim::scenario::{RunConfig, Scenario};
@@ -14,21 +18,36 @@ pub fn scenario(name: &str) -> Scenario {
     Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Builds the offline map (mapping drive) in `map_dir` with `config`, then runs the closed loop.
-pub fn run_with(s: &Scenario, map_dir: &Path, config: RunConfig) -> RunReport {
-    sim::offline_map::map_drive(s, &config, map_dir, &mut |_, _| {})
-        .unwrap_or_else(|e| panic!("{}: mapping drive: {e:#}", s.name));
-    let setup = RunSetup {
-        config,
-        ..RunSetup::new(map_dir.to_path_buf())
-    };
-    run(s, &setup).unwrap_or_else(|e| panic!("{}: {e:#}", s.name))
+/// The maps of this test binary: one mapping drive per static world (the campaigns' cache, keyed
+/// by what the drive depends on), in `CARGO_TARGET_TMPDIR` under this binary's build stamp so a
+/// later run of the same binary reuses them and a rebuilt one (the mapper changed) does not.
+static MAPS: LazyLock<MapCache> = LazyLock::new(|| {
+    let root = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let exe = std::fs::metadata(std::env::current_exe().unwrap()).unwrap();
+    let built = exe.modified().unwrap().duration_since(UNIX_EPOCH).unwrap();
+    let stamp = format!("it-maps-{}-{}", exe.len(), built.as_nanos());
+    // Older builds' maps go.
+    for entry in std::fs::read_dir(root).into_iter().flatten().flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if name.starts_with("it-maps-") && name != stamp {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+    MapCache::new(root.join(stamp))
+});
+
+/// The offline map of `s` under `config`: built by its mapping drive on first use, shared by every
+/// test whose static world and map settings are the same.
+pub fn map_for(s: &Scenario, config: &RunConfig) -> PathBuf {
+    MAPS.get_for_file(s, config)
+        .unwrap_or_else(|e| panic!("{}: mapping drive: {e:#}", s.name))
 }
 
-/// A pass's nearest approach over the levels, metres.
-pub fn nearest_m(pass: &sim::engine::Pass) -> f64 {
-    pass.min_clearance_m
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min)
+/// Runs the closed loop over the offline map of `s` under `config` ([`map_for`]).
+pub fn run_with(s: &Scenario, config: RunConfig) -> RunReport {
+    let setup = RunSetup {
+        config: config.clone(),
+        ..RunSetup::new(map_for(s, &config))
+    };
+    run(s, &setup).unwrap_or_else(|e| panic!("{}: {e:#}", s.name))
 }
