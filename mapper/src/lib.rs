@@ -13,7 +13,8 @@
 //! - [`map`]: `MultiHeightMap`, the local window: insertion, offline/online merge, re-centring.
 //! - [`blocks`]: the map block file format and the directory store.
 //! - [`remission`]: per-cell intensity statistics.
-//! - [`export`]: ROS map_server PGM/YAML, PNG and NumPy `.npy` files.
+//! - [`export`]: ROS map_server PGM/YAML, PNG and NumPy `.npy` files; [`ros_occupancy`]: a
+//!   square of a map or a distance map in ROS `OccupancyGrid` values.
 //! - [`synthetic`]: analytic scenes and a synthetic HDL-32E for tests and benchmarks.
 //! - [`tracking`]: moving objects, so what they leave can be cleared on evidence.
 //! - [`workloads`]: the inputs of the headline benchmarks.
@@ -33,6 +34,7 @@ pub mod occupancy;
 pub mod odm;
 pub mod organise;
 pub mod remission;
+pub mod ros_occupancy;
 pub mod scan;
 pub mod self_hits;
 pub mod synthetic;
@@ -48,13 +50,13 @@ pub use error::{MapError, Result};
 pub use grid::{Cell, Grid, GridGeometry};
 pub use levels::{HeightClass, LevelMode, Levels};
 pub use map::{
-    FreeSpaceStop, FreeSpaceWalks, InsertStats, MapConfig, MergeMode, MultiHeightMap, RosOccupancy,
-    WorldCell,
+    FreeSpaceStop, FreeSpaceWalks, InsertStats, MapConfig, MergeMode, MultiHeightMap, WorldCell,
 };
 pub use occupancy::{ObstacleTestParams, OccupancyParams};
 pub use odm::{DistanceMap, DistanceMaps};
 pub use organise::{ColumnLayout, SensorPoint, organise};
 pub use remission::RemissionCell;
+pub use ros_occupancy::RosOccupancy;
 pub use scan::{Return, Scan, ScanColumn};
 pub use self_hits::SelfHitFilter;
 pub use tracking::{MovingObject, TrackState, Tracker, TrackerConfig};

@@ -12,6 +12,7 @@ use nalgebra::Point2;
 use crate::edt::{EdtScratch, exact_edt};
 use crate::grid::{Grid, GridGeometry};
 use crate::levels::LevelMode;
+use crate::ros_occupancy::RosOccupancy;
 
 /// Distance to the nearest obstacle, in metres, for every cell of one level.
 #[derive(Clone, Debug)]
@@ -148,11 +149,7 @@ impl DistanceMap {
     /// The distances within `half_m` of `center` (clamped to the grid) in ROS `OccupancyGrid`
     /// values, as costmaps are shown: the distance in percent of the cap (0 at an obstacle, 100
     /// at the cap or beyond); row 0 at the lowest y. `None` when nothing is left.
-    pub fn ros_distance_around(
-        &self,
-        center: &Point2<f64>,
-        half_m: f64,
-    ) -> Option<crate::map::RosOccupancy> {
+    pub fn ros_distance_around(&self, center: &Point2<f64>, half_m: f64) -> Option<RosOccupancy> {
         let g = self.grid.geometry();
         let (xs, ys) = g.cells_around(center, half_m)?;
         let cap = self.max_distance_m().max(f32::MIN_POSITIVE);
@@ -165,7 +162,7 @@ impl DistanceMap {
             );
         }
         let res = g.resolution_m();
-        Some(crate::map::RosOccupancy {
+        Some(RosOccupancy {
             corner: g.origin_m()
                 + nalgebra::Vector2::new(xs.start as f64 * res, ys.start as f64 * res),
             width: xs.len(),

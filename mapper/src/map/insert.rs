@@ -26,6 +26,7 @@ use foldhash::HashMap;
 use nalgebra::{Point2, Point3};
 use rayon::prelude::*;
 
+use super::classified::{Classified, DROPPED};
 use super::config::{FreeSpaceWalks, MapConfig};
 use super::distance::{TouchedCells, no_obstacle_at_or_below};
 use super::forget::{CLEAR_MARGIN_M, HitSpan, OccupiedCells, WalkStops};
@@ -56,21 +57,6 @@ pub struct InsertStats {
     /// Cells updated as free per level.
     pub free_cells: Vec<usize>,
 }
-
-/// One return, classified once for every level.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Classified {
-    /// Cell index in the window, `u32::MAX` when dropped.
-    pub(super) cell: u32,
-    height_m: f32,
-    pub(super) range_xy_m: f32,
-    pub(super) obstacle: bool,
-    /// An obstacle return's open top: how high above the ground its object may reach where the
-    /// sensor cannot see, metres (`open_top.rs`; `NO_CLAIM` when the return above claims).
-    pub(super) open_top_m: f32,
-}
-
-pub(super) const DROPPED: u32 = u32::MAX;
 
 /// What one level needs to know of one column before walking it, from the classification pass:
 /// the farthest return it considers (not above it) and its nearest obstacle hit, as beam and

@@ -33,6 +33,8 @@
 //! what they make public is re-exported here:
 //! - `config`: [`MapConfig`] and the choices it names;
 //! - `window`: re-centring, blocks in from the stores and out to the live store;
+//! - `classified`: one return as the classification pass leaves it, what `insert` writes and
+//!   `open_top` reads;
 //! - `insert`: [`MultiHeightMap::insert_scan`] (classification, hits, the walks' schedule);
 //! - `open_top`: how high each hit object may reach unseen, from the beam above it
 //!   ([`MultiHeightMap::last_scan_open_tops`]);
@@ -42,6 +44,7 @@
 //!   [`MultiHeightMap::forget_unseen`];
 //! - `query`: accessors, world-lattice cells, obstacle and probability queries.
 
+mod classified;
 mod config;
 mod distance;
 mod forget;
@@ -51,9 +54,10 @@ mod query;
 mod walk;
 mod window;
 
+pub use crate::ros_occupancy::RosOccupancy;
 pub use config::{FreeSpaceStop, FreeSpaceWalks, MapConfig, MergeMode};
 pub use insert::InsertStats;
-pub use query::{RosOccupancy, merge_log_odds};
+pub use query::merge_log_odds;
 
 use foldhash::HashMap;
 use nalgebra::Point2;
@@ -66,9 +70,10 @@ use crate::levels::Levels;
 use crate::odm::{DistanceMap, DistanceMaps};
 use crate::remission::RemissionCell;
 use crate::self_hits::SelfHitFilter;
+use classified::Classified;
 use distance::TouchedCells;
 use forget::{HitSpan, OccupiedCells};
-use insert::{Classified, ColumnLevel};
+use insert::ColumnLevel;
 
 /// The local window of a quantized multi-height occupancy grid map.
 #[derive(Debug)]

@@ -12,7 +12,7 @@ use nalgebra::Vector3;
 
 use super::MultiHeightMap;
 use super::WorldCell;
-use super::insert::{Classified, DROPPED};
+use super::classified::{Classified, DROPPED};
 use crate::scan::{Return, Scan, ScanColumn};
 
 /// A return the beam above says nothing of (it is not the top of its column's hits on the

@@ -11,6 +11,7 @@ use crate::grid::{Grid, GridGeometry};
 use crate::levels::Levels;
 use crate::occupancy::probability;
 use crate::remission::RemissionCell;
+use crate::ros_occupancy::RosOccupancy;
 
 impl MultiHeightMap {
     /// The map's configuration.
@@ -270,20 +271,4 @@ pub fn merge_log_odds(live: f32, prior: f32, mode: MergeMode) -> Option<f32> {
             }
         },
     }
-}
-
-/// A square of a level's merged occupancy in ROS `OccupancyGrid` values
-/// ([`MultiHeightMap::ros_occupancy_around`]).
-#[derive(Clone, Debug, PartialEq)]
-pub struct RosOccupancy {
-    /// The lower-left corner of its first cell, metres.
-    pub corner: Point2<f64>,
-    /// Cells across.
-    pub width: usize,
-    /// Rows.
-    pub height: usize,
-    /// Metres per cell.
-    pub resolution_m: f64,
-    /// Row-major from the lowest row: probability in percent, -1 unknown.
-    pub cells: Vec<i8>,
 }

@@ -1,5 +1,6 @@
 //! The taxi routing network (`1201` nodes, `1202` edges with their `1204` runway zones) as a graph
-//! in metres.
+//! in metres, and a route on it ([`NetworkRoute`]: what `route` finds, `paint` moves and `path`
+//! smooths, so each of them names it here).
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
@@ -220,4 +221,29 @@ impl Network {
     pub fn node_by_id(&self, id: u32) -> Option<usize> {
         self.nodes.iter().position(|n| n.id == id)
     }
+}
+
+/// A route on the network (moved onto the paint by [`crate::route::find`]), before smoothing.
+#[derive(Debug, Clone)]
+pub struct NetworkRoute {
+    /// Where it starts, as asked.
+    pub from: String,
+    /// Where it ends, as asked.
+    pub to: String,
+    /// Its corner points: start, the nodes passed, end (a stand: the point on the taxilane
+    /// abeam it, then the stand); following the paint, the points between where it leaves and
+    /// rejoins a network edge's line.
+    pub points: Vec<Vector2<f64>>,
+    /// The network node of each point, if it is one (where the paint moved it, a node is no
+    /// longer exactly at the network's position).
+    pub nodes: Vec<Option<usize>>,
+    /// The network edge each leg (`points[i]` to `points[i + 1]`) runs along; `None` for the
+    /// lead-in to a stand.
+    pub edges: Vec<Option<usize>>,
+    /// Taxiway names in the order driven (each run once).
+    pub taxiways: Vec<String>,
+    /// Runway ends whose zones it enters on the way (runway crossings).
+    pub crossings: Vec<String>,
+    /// Length (m).
+    pub length_m: f64,
 }

@@ -51,7 +51,7 @@ mod profile;
 use nalgebra::Vector2;
 
 use crate::model::{Airport, line_type};
-use crate::route::NetworkRoute;
+use crate::network::NetworkRoute;
 use centreline::Paint;
 use legs::{Leg, legs};
 use nodes::{place_nodes, settle};

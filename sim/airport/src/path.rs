@@ -7,7 +7,7 @@
 use nalgebra::Vector2;
 
 use crate::error::AirportError;
-use crate::route::NetworkRoute;
+use crate::network::NetworkRoute;
 
 /// How a route is rounded and how fast it is driven.
 #[derive(Debug, Clone, Copy)]

@@ -13,6 +13,7 @@ use nalgebra::Vector2;
 
 use crate::error::AirportError;
 use crate::model::Airport;
+pub use crate::network::NetworkRoute;
 use crate::network::{EdgeClass, Network};
 use crate::size::SizeClass;
 
@@ -70,31 +71,6 @@ pub struct RouteRequest {
     pub via: Vec<String>,
     /// The aircraft's code letter.
     pub code: SizeClass,
-}
-
-/// A route on the network (moved onto the paint by [`find`]), before smoothing.
-#[derive(Debug, Clone)]
-pub struct NetworkRoute {
-    /// Where it starts, as asked.
-    pub from: String,
-    /// Where it ends, as asked.
-    pub to: String,
-    /// Its corner points: start, the nodes passed, end (a stand: the point on the taxilane
-    /// abeam it, then the stand); following the paint, the points between where it leaves and
-    /// rejoins a network edge's line.
-    pub points: Vec<Vector2<f64>>,
-    /// The network node of each point, if it is one (where the paint moved it, a node is no
-    /// longer exactly at the network's position).
-    pub nodes: Vec<Option<usize>>,
-    /// The network edge each leg (`points[i]` to `points[i + 1]`) runs along; `None` for the
-    /// lead-in to a stand.
-    pub edges: Vec<Option<usize>>,
-    /// Taxiway names in the order driven (each run once).
-    pub taxiways: Vec<String>,
-    /// Runway ends whose zones it enters on the way (runway crossings).
-    pub crossings: Vec<String>,
-    /// Length (m).
-    pub length_m: f64,
 }
 
 /// A directed arc of the search graph: a network edge (or part of one) in one direction.

@@ -9,7 +9,8 @@
 //! - `spec`: the file as written ([`ScenarioFile`] and the `*Spec` structs, serde);
 //! - `numbers`: the validating numbers the file is read with ([`Finite`], [`Positive`]...);
 //! - `resolve`: the resolver, the file turned into the model with the cross-field checks (the
-//!   route and the vehicle, objects, patches and obstacles, rows);
+//!   route and the vehicle, objects, patches and obstacles, rows), and the entries that read a
+//!   file ([`Scenario::from_file`], [`Scenario::from_str`]);
 //! - `overlap`: the start overlap of a solid and the vehicle ([`start_overlap`]);
 //! - `model`: the resolved scenario ([`Scenario`], [`Route`], [`Obstacle`]...) and its scenes;
 //! - `run_config`: the run configuration ([`RunConfig`]).

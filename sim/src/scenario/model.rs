@@ -2,16 +2,15 @@
 //! [`ScenarioVehicle`] at its start pose, the [`Route`], static objects, patches and run-time
 //! [`Obstacle`]s with their expectations), read by [`Scenario::from_str`] (which loads the files
 //! the text names, a vehicle sidecar or a pose file, relative to the scenario's directory) or
-//! [`Scenario::from_file`], and turned into the worlds a run drives in ([`Scenario::full_scene`],
-//! [`Scenario::static_scene`]). World frame: x east, y north, z up, metres, radians.
+//! [`Scenario::from_file`] (both beside the resolver, in `resolve/`), and turned into the worlds
+//! a run drives in ([`Scenario::full_scene`], [`Scenario::static_scene`]). World frame: x east,
+//! y north, z up, metres, radians.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use nalgebra::{Isometry2, Point2};
 
-use super::resolve::Resolver;
-use super::spec::{Expectation, ExpectedEnd, ScenarioFile};
-use crate::toml_file::LocatedError;
+use super::spec::{Expectation, ExpectedEnd};
 use crate::world::{Patch, Scene, Solid};
 
 /// The ground.
@@ -406,29 +405,6 @@ pub struct KnownProblem {
 }
 
 impl Scenario {
-    /// Reads and validates a scenario file.
-    pub fn from_file(path: &Path) -> Result<Self, LocatedError> {
-        let text = std::fs::read_to_string(path).map_err(|error| LocatedError::Io {
-            path: path.to_path_buf(),
-            error,
-        })?;
-        Scenario::from_str(&text, path)
-    }
-
-    /// Validates a scenario text; `path` labels errors and anchors the relative paths of the
-    /// files it names (vehicle sidecar, pose file), which are read here.
-    pub fn from_str(text: &str, path: &Path) -> Result<Self, LocatedError> {
-        let file = path.display().to_string();
-        let spec: ScenarioFile =
-            toml::from_str(text).map_err(|e| LocatedError::toml(&file, text, &e))?;
-        Resolver {
-            text,
-            file: &file,
-            dir: path.parent().unwrap_or_else(|| Path::new("")),
-        }
-        .resolve(spec, path)
-    }
-
     /// The world as a [`Scene`]: ground, static objects, patches and the run-time obstacles at
     /// their initial poses (`Solid::runtime` true): the closed loop's world.
     pub fn full_scene(&self) -> Scene {

@@ -7,8 +7,7 @@ use super::centreline::Paint;
 use super::geometry::{Frame, Line};
 use super::{FOLLOW_DEG, MAX_OFFSET_M, MIN_LINE_M, ON_NETWORK_M, PARALLEL_DEG, V2, node_reach_m};
 use crate::model::Airport;
-use crate::network::EdgeClass;
-use crate::route::NetworkRoute;
+use crate::network::{EdgeClass, NetworkRoute};
 
 /// How far along the route a candidate line's paint is followed to judge how far it goes with
 /// the route (m).

@@ -7,7 +7,7 @@ use super::geometry::{Frame, Line};
 use super::legs::Leg;
 use super::{MAX_OFFSET_M, PARALLEL_DEG, V2, finite};
 use crate::model::Airport;
-use crate::route::NetworkRoute;
+use crate::network::NetworkRoute;
 
 /// How far from where two legs' paint lines meet the paint's curve round the turn is looked
 /// for (m): the middle of a 30 m fillet in a 90-degree turn lies 12 m inside its tangents' corner.

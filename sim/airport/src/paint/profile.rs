@@ -3,8 +3,8 @@
 //! taxi-sim's rounding would turn them too tight.
 
 use super::{DRIVABLE_RADIUS_M, TAPER_DEG, V2};
+use crate::network::NetworkRoute;
 use crate::path::{PathOptions, STRAIGHT_RAD, corners};
-use crate::route::NetworkRoute;
 
 /// The tightest turns an aircraft may be limited to at which a route on the paint must round
 /// wherever the network's route does (m). A route that rounds for an aircraft turning no

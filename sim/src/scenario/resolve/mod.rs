@@ -2,8 +2,9 @@
 //! the cross-field checks (one route source, ids unique across objects, rows, patches and
 //! obstacles, everything inside the world, nothing over the vehicle at its start) on the spans
 //! toml keeps. Every mistake becomes a [`LocatedError`] naming the file, the line, the column and
-//! the field, with the offending line quoted. This file holds the entry ([`Resolver::resolve`])
-//! and the helpers the parts share: ids, the world and its bounds, polylines, the start overlap.
+//! the field, with the offending line quoted. This file holds the entries ([`Scenario::from_file`],
+//! [`Scenario::from_str`] and [`Resolver::resolve`]) and the helpers the parts share: ids, the
+//! world and its bounds, polylines, the start overlap.
 
 mod airport;
 mod motion;
@@ -23,6 +24,31 @@ use super::overlap::start_overlap;
 use super::spec::{ScenarioFile, TodaySpec, WorldSpec};
 use crate::toml_file::LocatedError;
 use crate::world::Solid;
+
+impl Scenario {
+    /// Reads and validates a scenario file.
+    pub fn from_file(path: &Path) -> Result<Self, LocatedError> {
+        let text = std::fs::read_to_string(path).map_err(|error| LocatedError::Io {
+            path: path.to_path_buf(),
+            error,
+        })?;
+        Scenario::from_str(&text, path)
+    }
+
+    /// Validates a scenario text; `path` labels errors and anchors the relative paths of the
+    /// files it names (vehicle sidecar, pose file), which are read here.
+    pub fn from_str(text: &str, path: &Path) -> Result<Self, LocatedError> {
+        let file = path.display().to_string();
+        let spec: ScenarioFile =
+            toml::from_str(text).map_err(|e| LocatedError::toml(&file, text, &e))?;
+        Resolver {
+            text,
+            file: &file,
+            dir: path.parent().unwrap_or_else(|| Path::new("")),
+        }
+        .resolve(spec, path)
+    }
+}
 
 /// Turns the file as written into a [`Scenario`], with the cross-field checks.
 pub(super) struct Resolver<'a> {
