@@ -12,7 +12,9 @@
 //! - [`online_map`]: the offline map merged with live LiDAR data around the estimate.
 //! - [`planner`]: candidates, the avoider, the behaviour, pure pursuit.
 //! - [`route`]: route geometry and Frenet projection.
-//! - [`traffic`]: movers predicted over the horizon, the space-time check of the path.
+//! - [`traffic`]: movers predicted over the horizon, the space-time check of the path, and the
+//!   rules about movers with their memory ([`TrafficRules`]: one plan's inputs in, the speed cap
+//!   and where to stop out).
 //! - [`stack`]: the [`Driver`], which ties them together and tracks its own route progress.
 
 pub mod localizer;
@@ -28,7 +30,7 @@ pub use online_map::{ForgettingConfig, ForgettingRule, OnlineMap, trusted_range_
 pub use planner::{AutonomyConfig, Behaviour, Candidate, Plan, avoid, plan, pure_pursuit};
 pub use route::{RoutePath, wrap_angle};
 pub use stack::{Driver, DriverStatus, PilotCall, PlanTimes, VehicleModel};
-pub use traffic::{Conflict, Prediction, TrafficConfig};
+pub use traffic::{Conflict, MoverDecision, MoverInputs, Prediction, TrafficConfig, TrafficRules};
 
 impl Behaviour {
     /// The behaviour the thesis gives a vehicle by how it steers: a car (front wheels) deviates,

@@ -10,16 +10,32 @@
 //! blocks, re-centred on the estimate like the online map, from which a [`LocalizationMap`]
 //! (per cell: the remission mean and weight, the likelihood field's log-likelihood) is built when
 //! the window moves. A pure function of the seed.
+//!
+//! The files, by job: `map` (the window's tables the measurement update reads),
+//! `observation` (a revolution reduced to what the filter weighs), `motion` (the odometry's
+//! arc and each particle's own errors), `measurement` (weighing the particles against the
+//! map), `resample` (diffusion, the low-variance sampler, the weighted estimate); the filter
+//! ([`ParticleFilter`]) and its configuration are here.
 
-use mapper::{CollisionModel, GridGeometry, MultiHeightMap, RemissionCell};
-use nalgebra::{Isometry2, Matrix3, Point2, Vector2};
-use rand::{RngExt, SeedableRng};
-use rand_distr::StandardNormal;
-use rayon::prelude::*;
+mod map;
+mod measurement;
+mod motion;
+mod observation;
+mod resample;
+
+use mapper::{CollisionModel, MultiHeightMap};
+use nalgebra::{Isometry2, Matrix3, Point2};
+use rand::SeedableRng;
 use serde::{Deserialize, Serialize};
 
 use crate::messages::{LidarRevolution, Odometry};
 use crate::route::wrap_angle;
+
+pub use map::{LocalizationMap, level0_distance};
+pub use measurement::{weigh, weigh_parallel, weigh_straightforward};
+pub use observation::Observation;
+pub use resample::{effective_size, estimate_of};
+use resample::{normal, normalise};
 
 /// What a revolution is compared with.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -215,175 +231,6 @@ impl LocalizerConfig {
     }
 }
 
-/// The map as the measurement update reads it, one window: per cell the remission mean and the
-/// weight `-0.5 / (variance + floor^2)` (NaN mean: no sample), and the likelihood field's
-/// log-likelihood of an obstacle return there.
-#[derive(Clone, Debug)]
-pub struct LocalizationMap {
-    geometry: GridGeometry,
-    /// Mean, weight per cell.
-    remission: Vec<[f32; 2]>,
-    field: Vec<f32>,
-}
-
-impl LocalizationMap {
-    /// Built from `map`'s window: its remission layer, and the distance to the nearest level-0
-    /// obstacle cell of its offline (prior) occupancy, capped at `outlier_sigmas` field sigmas
-    /// (an exact EDT of level 0 only; the map's own distance maps would cover every level).
-    pub fn from_map(map: &MultiHeightMap, config: &LocalizerConfig) -> Self {
-        let floor2 = (config.remission_sigma_floor * config.remission_sigma_floor) as f32;
-        let remission = map
-            .remission_grid()
-            .data()
-            .iter()
-            .map(|c| remission_entry(c, floor2))
-            .collect();
-        let sigma = config.field_sigma_m as f32;
-        let floor = config.floor();
-        let field = match level0_distance(map, config) {
-            Some(distance) => distance
-                .grid()
-                .data()
-                .iter()
-                .map(|d| (-0.5 * (d / sigma) * (d / sigma)).max(floor))
-                .collect(),
-            None => vec![floor; map.geometry().len()],
-        };
-        LocalizationMap {
-            geometry: *map.geometry(),
-            remission,
-            field,
-        }
-    }
-
-    /// The window's geometry.
-    pub fn geometry(&self) -> &GridGeometry {
-        &self.geometry
-    }
-}
-
-/// The distance from each cell of `map`'s window to the nearest level-0 obstacle cell (the
-/// filter's map holds the offline occupancy only), capped at `outlier_sigmas` field sigmas: an exact EDT of level 0
-/// only (the map's own distance maps would cover every level). `None` without levels.
-pub fn level0_distance(
-    map: &MultiHeightMap,
-    config: &LocalizerConfig,
-) -> Option<mapper::DistanceMap> {
-    let (prior, live) = (map.prior_log_odds(0)?.data(), map.live_log_odds(0)?.data());
-    let t = map.config().obstacle_threshold;
-    let l_obstacle = (t / (1.0 - t)).ln();
-    let cap = (config.outlier_sigmas * config.field_sigma_m) as f32;
-    let merge = map.config().merge;
-    Some(mapper::DistanceMap::compute(
-        *map.geometry(),
-        cap.max(map.config().resolution_m as f32),
-        |i| mapper::map::merge_log_odds(live[i], prior[i], merge).is_some_and(|l| l > l_obstacle),
-        &mut mapper::edt::EdtScratch::default(),
-    ))
-}
-
-#[inline]
-fn remission_entry(c: &RemissionCell, floor2: f32) -> [f32; 2] {
-    match (c.mean(), c.variance()) {
-        (Some(mean), Some(var)) => [mean, -0.5 / (var + floor2)],
-        _ => [f32::NAN, 0.0],
-    }
-}
-
-/// One revolution as the filter uses it, in the vehicle frame: ground returns (x, y, intensity)
-/// and obstacle returns (x, y), decimated to the configured counts.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Observation {
-    /// Ground returns: x, y (metres, vehicle frame), intensity.
-    pub ground: Vec<[f64; 3]>,
-    /// Obstacle returns: x, y (metres, vehicle frame).
-    pub obstacles: Vec<[f64; 2]>,
-}
-
-impl Observation {
-    /// The returns of `revolution` in the vehicle frame (each column's points taken back through
-    /// the pose the column was placed at), the vehicle's own body left out (`self_filter`, with
-    /// `self_margin_m`), spread evenly over the revolution down to the configured counts.
-    pub fn from_revolution(
-        revolution: &LidarRevolution,
-        config: &LocalizerConfig,
-        self_filter: Option<&CollisionModel>,
-        self_margin_m: f64,
-    ) -> Self {
-        let scan = &revolution.scan;
-        let beams = scan.beams().max(1);
-        // Classified by height first (the world point's z is the vehicle frame's), decimated,
-        // and only then taken to the vehicle frame: a revolution has ~70,000 returns, the filter
-        // uses a few hundred.
-        let (mut ground, mut obstacles) = (Vec::new(), Vec::new());
-        let max_range = config.max_ground_range_m as f32;
-        let heights = config.obstacle_min_height_m..config.obstacle_max_height_m;
-        for (i, r) in scan.returns().iter().enumerate() {
-            let Some(r) = r else { continue };
-            let z = r.point_in_world.z;
-            if z < config.ground_height_m {
-                if r.range_m <= max_range {
-                    ground.push(i);
-                }
-            } else if heights.contains(&z) {
-                obstacles.push(i);
-            }
-        }
-        let in_vehicle = |i: usize| -> Option<(Point2<f64>, &mapper::Return)> {
-            let r = scan.returns()[i].as_ref()?;
-            let column = scan.columns().get(i / beams)?;
-            let p = r.point_in_world;
-            Some((
-                column.world_from_vehicle.inverse() * Point2::new(p.x, p.y),
-                r,
-            ))
-        };
-        let ground = decimate(ground, config.remission_points)
-            .into_iter()
-            .filter_map(in_vehicle)
-            .map(|(v, r)| [v.x, v.y, f64::from(r.intensity)])
-            .collect();
-        // Four times as many obstacle returns as wanted, then the vehicle's own body left out.
-        let obstacles = decimate(obstacles, 4 * config.field_points)
-            .into_iter()
-            .filter_map(in_vehicle)
-            .filter(|(v, r)| {
-                !self_filter.is_some_and(|m| m.is_self_hit(v, r.point_in_world.z, self_margin_m))
-            })
-            .map(|(v, _)| [v.x, v.y])
-            .collect();
-        Observation {
-            ground,
-            obstacles: decimate(obstacles, config.field_points),
-        }
-    }
-}
-
-impl Observation {
-    /// The returns taken into another frame of the vehicle (`new_from_old`).
-    pub fn transform(&mut self, new_from_old: &Isometry2<f64>) {
-        for g in &mut self.ground {
-            let p = new_from_old * Point2::new(g[0], g[1]);
-            (g[0], g[1]) = (p.x, p.y);
-        }
-        for o in &mut self.obstacles {
-            let p = new_from_old * Point2::new(o[0], o[1]);
-            *o = [p.x, p.y];
-        }
-    }
-}
-
-/// How long the odometry trail is kept, seconds (a revolution later than this is not used).
-const TRAIL_S: f64 = 2.0;
-
-/// At most `n` of `v`, evenly spaced.
-fn decimate<T: Copy>(v: Vec<T>, n: usize) -> Vec<T> {
-    if v.len() <= n {
-        return v;
-    }
-    (0..n).map(|k| v[k * v.len() / n]).collect()
-}
-
 /// A particle's pose and its own odometry errors.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Particle {
@@ -543,77 +390,9 @@ impl ParticleFilter {
         &self.particles
     }
 
-    /// The odometry's reading since the last: the nominal pose is integrated along its arc (the
-    /// particles follow it at the next update or estimate - a hundred readings a second, ten
-    /// updates).
-    pub fn on_odometry(&mut self, odometry: &Odometry) {
-        if let Some(last) = self.last_odometry {
-            let dt = odometry.t_s - last.t_s;
-            if dt > 0.0 {
-                let (v, delta, l) = (last.speed_m_s, last.steering_rad, self.wheelbase_m);
-                self.travelled_m += (v * dt).abs();
-                let ds = v * dt;
-                let dtheta = ds * delta.tan() / l;
-                let step = Isometry2::new(
-                    Vector2::new(ds * (0.5 * dtheta).cos(), ds * (0.5 * dtheta).sin()),
-                    dtheta,
-                );
-                self.odometry_pose *= step;
-            }
-        }
-        self.last_odometry = Some(*odometry);
-        self.trail.push_back((odometry.t_s, self.odometry_pose));
-        while self
-            .trail
-            .front()
-            .is_some_and(|(t, _)| *t < odometry.t_s - TRAIL_S)
-        {
-            self.trail.pop_front();
-        }
-    }
-
-    /// Motion update: every particle moves by the odometry's displacement since the last
-    /// propagation, read with its own errors - its distance times `1 + speed_scale`, its turn
-    /// plus the distance times `tan(steering error) / wheelbase`.
-    fn propagate(&mut self) {
-        let delta = self.propagated_at.inverse() * self.odometry_pose;
-        if delta == Isometry2::identity() {
-            return;
-        }
-        let (t, turn) = (delta.translation.vector, delta.rotation.angle());
-        let d = t.norm().copysign(t.x);
-        for p in &mut self.particles {
-            let (s, c) = p.theta.sin_cos();
-            let k = 1.0 + p.speed_scale;
-            let (dx, dy) = (k * t.x, k * t.y);
-            p.x += c * dx - s * dy;
-            p.y += s * dx + c * dy;
-            p.theta = wrap_angle(p.theta + turn + d * p.steering_rad.tan() / self.wheelbase_m);
-        }
-        self.propagated_at = self.odometry_pose;
-        self.refresh();
-    }
-
     /// The estimate of the particles as they stand, kept for the estimates between updates.
     fn refresh(&mut self) {
         self.at_propagation = estimate_of(&self.particles, &self.log_w);
-    }
-
-    /// Where the vehicle was at `t_s` in its frame now, by the odometry (`None`: before the
-    /// trail, or no odometry yet).
-    pub fn now_from_then(&self, t_s: f64) -> Option<Isometry2<f64>> {
-        let (t_last, now) = *self.trail.back()?;
-        if t_s >= t_last {
-            return Some(Isometry2::identity());
-        }
-        let k = self.trail.partition_point(|(t, _)| *t <= t_s + 1e-9);
-        let (_, then) = if k == 0 {
-            // Older than the trail: only at the start, when the trail is shorter than its span.
-            (t_last - self.trail.front()?.0 < TRAIL_S - 0.05).then(|| self.trail.front())??
-        } else {
-            self.trail.get(k - 1)?
-        };
-        Some(now.inverse() * then)
     }
 
     /// Measurement update from a revolution already reduced to an [`Observation`]: (once the
@@ -707,246 +486,4 @@ impl ParticleFilter {
         }
         Ok(())
     }
-
-    /// The per-update diffusion, and each particle's odometry errors until the next update.
-    fn diffuse(&mut self) {
-        let c = &self.config;
-        let d = self.travelled_m;
-        let sp = c.diffusion_m + c.diffusion_per_m * d;
-        let sh = c.diffusion_rad + 0.01 * d;
-        let (ss, sst) = (c.speed_scale_sigma, c.steering_sigma_rad);
-        let rng = &mut self.rng;
-        for p in &mut self.particles {
-            p.x += sp * normal(rng);
-            p.y += sp * normal(rng);
-            p.theta = wrap_angle(p.theta + sh * normal(rng));
-            p.speed_scale = ss * normal(rng);
-            p.steering_rad = sst * normal(rng);
-        }
-    }
-
-    /// Low-variance (systematic) resampling: one uniform draw, particles taken at equal steps
-    /// of the cumulative weight; the weights start equal again.
-    fn resample(&mut self) {
-        let n = self.particles.len();
-        let w: Vec<f64> = self.log_w.iter().map(|l| l.exp()).collect();
-        let step = w.iter().sum::<f64>() / n as f64;
-        let mut u = self.rng.random::<f64>() * step;
-        let (mut i, mut cumulative) = (0, w[0]);
-        let mut next = Vec::with_capacity(n);
-        for _ in 0..n {
-            while u > cumulative && i + 1 < n {
-                i += 1;
-                cumulative += w[i];
-            }
-            next.push(self.particles[i]);
-            u += step;
-        }
-        self.particles = next;
-        self.log_w.iter_mut().for_each(|l| *l = 0.0);
-    }
-}
-
-fn normal(rng: &mut rand::rngs::Xoshiro256PlusPlus) -> f64 {
-    rng.sample(StandardNormal)
-}
-
-/// Log-weights shifted so the largest is 0.
-fn normalise(log_w: &mut [f64]) {
-    let max = log_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if max.is_finite() {
-        log_w.iter_mut().for_each(|l| *l -= max);
-    }
-}
-
-/// Effective sample size of log-weights: `(sum w)^2 / sum w^2`.
-pub fn effective_size(log_w: &[f64]) -> f64 {
-    let max = log_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let (s, s2) = log_w.iter().fold((0.0, 0.0), |(s, s2), l| {
-        let w = (l - max).exp();
-        (s + w, s2 + w * w)
-    });
-    if s2 > 0.0 { s * s / s2 } else { 0.0 }
-}
-
-/// The weighted mean and covariance of particles with log-weights `log_w`.
-pub fn estimate_of(particles: &[Particle], log_w: &[f64]) -> Estimate {
-    let max = log_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let w: Vec<f64> = log_w.iter().map(|l| (l - max).exp()).collect();
-    let total: f64 = w.iter().sum();
-    if particles.is_empty() || total.is_nan() || total <= 0.0 {
-        return Estimate {
-            world_from_vehicle: Isometry2::identity(),
-            covariance: Matrix3::from_diagonal_element(f64::INFINITY),
-        };
-    }
-    let (mut mx, mut my, mut sc, mut ss) = (0.0, 0.0, 0.0, 0.0);
-    for (p, w) in particles.iter().zip(&w) {
-        mx += w * p.x;
-        my += w * p.y;
-        sc += w * p.theta.cos();
-        ss += w * p.theta.sin();
-    }
-    let (mx, my, mt) = (mx / total, my / total, ss.atan2(sc));
-    let mut cov = Matrix3::zeros();
-    for (p, w) in particles.iter().zip(&w) {
-        let e = nalgebra::Vector3::new(p.x - mx, p.y - my, wrap_angle(p.theta - mt));
-        cov += (w / total) * e * e.transpose();
-    }
-    Estimate {
-        world_from_vehicle: Isometry2::new(Vector2::new(mx, my), mt),
-        covariance: cov,
-    }
-}
-
-/// Each particle's log-likelihood of `obs` over `lmap`. Point-major over blocks of particles:
-/// the particles of a block stand within a few cells of each other, so one return placed from
-/// each of them reads the same few cache lines of the tables (particle-major, each particle
-/// would sweep the whole window on its own). One thread: in the closed loop the other cores
-/// are mapping, so the blocks run one after the other; [`weigh_parallel`] is the parallel form
-/// `taxi-sim bench localization` measures against it. Equal to [`weigh_straightforward`] to
-/// rounding (`the_tables_weigh_like_the_straightforward_way`).
-pub fn weigh(
-    particles: &[Particle],
-    obs: &Observation,
-    lmap: &LocalizationMap,
-    config: &LocalizerConfig,
-) -> Vec<f64> {
-    let mut out = vec![0.0; particles.len()];
-    for (out, block) in out
-        .chunks_mut(PARTICLE_BLOCK)
-        .zip(particles.chunks(PARTICLE_BLOCK))
-    {
-        weigh_block(block, obs, lmap, config, out);
-    }
-    out
-}
-
-/// [`weigh`] with the blocks in parallel (measured against it by `taxi-sim bench
-/// localization`).
-pub fn weigh_parallel(
-    particles: &[Particle],
-    obs: &Observation,
-    lmap: &LocalizationMap,
-    config: &LocalizerConfig,
-) -> Vec<f64> {
-    let mut out = vec![0.0; particles.len()];
-    out.par_chunks_mut(PARTICLE_BLOCK)
-        .zip(particles.par_chunks(PARTICLE_BLOCK))
-        .for_each(|(out, block)| weigh_block(block, obs, lmap, config, out));
-    out
-}
-
-/// Particles weighed together, point by point.
-const PARTICLE_BLOCK: usize = 32;
-
-/// [`weigh`] of one block of particles into `out`.
-fn weigh_block(
-    block: &[Particle],
-    obs: &Observation,
-    lmap: &LocalizationMap,
-    config: &LocalizerConfig,
-    out: &mut [f64],
-) {
-    let g = &lmap.geometry;
-    let (w, h) = (g.width(), g.height());
-    let (wf, hf) = (w as f64, h as f64);
-    let origin = g.origin_m();
-    let inv = 1.0 / g.resolution_m();
-    let floor = config.floor();
-    let unknown = (-0.5 * config.remission_unknown_sigmas * config.remission_unknown_sigmas) as f32;
-    let poses: Vec<(f64, f64, f64, f64)> = block
-        .iter()
-        .map(|p| {
-            let (s, c) = p.theta.sin_cos();
-            (c, s, p.x, p.y)
-        })
-        .collect();
-    // The cell `GridGeometry::cell_coords` gives, without its NaN and sign handling: a
-    // coordinate in [0, w) truncates to its floor, and NaN fails the comparisons.
-    let index = |&(c, s, x, y): &(f64, f64, f64, f64), px: f64, py: f64| -> Option<usize> {
-        let fx = ((c * px - s * py + x) - origin.x) * inv;
-        let fy = ((s * px + c * py + y) - origin.y) * inv;
-        (fx >= 0.0 && fy >= 0.0 && fx < wf && fy < hf).then(|| fy as usize * w + fx as usize)
-    };
-    let mut sums = vec![0.0f32; block.len()];
-    if config.measurement != MeasurementModel::LikelihoodField {
-        for &[px, py, intensity] in &obs.ground {
-            for (sum, pose) in sums.iter_mut().zip(&poses) {
-                *sum += match index(pose, px, py) {
-                    Some(i) => {
-                        let [mean, weight] = lmap.remission[i];
-                        if mean.is_nan() {
-                            unknown
-                        } else {
-                            let d = intensity as f32 - mean;
-                            (weight * d * d).max(floor)
-                        }
-                    }
-                    None => unknown,
-                };
-            }
-        }
-    }
-    if config.measurement != MeasurementModel::Remission {
-        for &[px, py] in &obs.obstacles {
-            for (sum, pose) in sums.iter_mut().zip(&poses) {
-                *sum += index(pose, px, py).map_or(floor, |i| lmap.field[i]);
-            }
-        }
-    }
-    for (o, s) in out.iter_mut().zip(sums) {
-        *o = f64::from(s) * config.likelihood_weight;
-    }
-}
-
-/// The straightforward measurement update, for comparison: one particle at a time, each return
-/// through the particle's `Isometry2`, the map's `Option` lookups, the cell's mean and variance
-/// computed from its sums and the likelihood field's Gaussian evaluated at each lookup.
-pub fn weigh_straightforward(
-    particles: &[Particle],
-    obs: &Observation,
-    remission: &mapper::Grid<RemissionCell>,
-    field: Option<&mapper::DistanceMap>,
-    config: &LocalizerConfig,
-) -> Vec<f64> {
-    let floor = f64::from(config.floor());
-    let unknown = -0.5 * config.remission_unknown_sigmas * config.remission_unknown_sigmas;
-    let floor2 = config.remission_sigma_floor * config.remission_sigma_floor;
-
-    particles
-        .iter()
-        .map(|p| {
-            let pose = Isometry2::new(Vector2::new(p.x, p.y), p.theta);
-            let mut sum = 0.0;
-            if config.measurement != MeasurementModel::LikelihoodField {
-                for &[px, py, intensity] in &obs.ground {
-                    let at = pose * Point2::new(px, py);
-                    sum += match remission
-                        .at(&at)
-                        .and_then(|c| Some((c.mean()?, c.variance()?)))
-                    {
-                        Some((mean, var)) => {
-                            let d = intensity - f64::from(mean);
-                            (-0.5 * d * d / (f64::from(var) + floor2)).max(floor)
-                        }
-                        None => unknown,
-                    };
-                }
-            }
-            if config.measurement != MeasurementModel::Remission {
-                for &[px, py] in &obs.obstacles {
-                    let at = pose * Point2::new(px, py);
-                    sum += match (field, remission.geometry().contains(&at)) {
-                        (Some(f), true) => {
-                            let d = f64::from(f.distance_at(&at)) / config.field_sigma_m;
-                            (-0.5 * d * d).max(floor)
-                        }
-                        _ => floor,
-                    };
-                }
-            }
-            sum * config.likelihood_weight
-        })
-        .collect()
 }

@@ -1,0 +1,251 @@
+//! The driver's unit tests: an empty map, a straight route.
+
+use super::*;
+use crate::online_map::ForgettingConfig;
+use mapper::{Circle, Levels, MapConfig, MultiHeightMap};
+
+fn driver() -> Driver {
+    let route = RoutePath::new(&[Point2::new(0.0, 0.0), Point2::new(200.0, 0.0)], false);
+    let circle = |x_m| Circle {
+        x_m,
+        y_m: 0.0,
+        radius_m: 1.0,
+        level: 0,
+    };
+    let collision = CollisionModel::new(vec![circle(0.0), circle(2.0)], vec![0.0]).unwrap();
+    Driver::new(
+        route,
+        VehicleModel {
+            collision,
+            wheelbase_m: 2.5,
+            deceleration_m_s2: 3.0,
+            acceleration_m_s2: 1.0,
+            behaviour: Behaviour::Deviate,
+        },
+        AutonomyConfig::default(),
+        5.0,
+        40.0,
+    )
+}
+
+fn empty_map() -> OnlineMap {
+    started(unstarted_map(), 20.0)
+}
+
+/// An empty map centred at (20, 0) that no revolution has reached.
+fn unstarted_map() -> OnlineMap {
+    let config = MapConfig {
+        block_cells: 100,
+        max_distance_m: 5.0,
+        ..MapConfig::default()
+    };
+    let levels = Levels::cumulative(vec![0.0]).unwrap();
+    let map = MultiHeightMap::new(config, levels, Point2::new(20.0, 0.0)).unwrap();
+    let self_filter = CollisionModel::new(
+        vec![mapper::Circle {
+            x_m: 1.0,
+            y_m: 0.0,
+            radius_m: 1.5,
+            level: 0,
+        }],
+        vec![0.0],
+    )
+    .unwrap();
+    OnlineMap::new(map, self_filter, ForgettingConfig::default(), 0.1, 1.0)
+}
+
+/// `map` after an empty revolution at an exact pose at `x_m` (where it is centred):
+/// mapping has started.
+fn started(mut map: OnlineMap, x_m: f64) -> OnlineMap {
+    assert!(!map.mapping_started());
+    map.update(&crate::LidarRevolution {
+        t_s: 0.0,
+        scan: mapper::Scan::new(1, Vec::new(), Vec::new()).unwrap(),
+        world_from_vehicle_estimate: nalgebra::Isometry2::translation(x_m, 0.0),
+        estimate_covariance: nalgebra::Matrix3::zeros(),
+    })
+    .unwrap();
+    assert!(map.mapping_started());
+    map
+}
+
+/// Until mapping has started (no revolution yet, or none taken at an estimate trusted out
+/// to the obstacle test's range), the vehicle is held, whatever the estimate.
+#[test]
+fn the_vehicle_is_held_until_mapping_has_started() {
+    let mut map = unstarted_map();
+    let mut d = driver();
+    d.on_pose(at(0.0, 10.0, 0.0, 0.0));
+    let revolution = |t_s: f64, sigma_rad: f64| crate::LidarRevolution {
+        t_s,
+        scan: mapper::Scan::new(1, Vec::new(), Vec::new()).unwrap(),
+        world_from_vehicle_estimate: nalgebra::Isometry2::translation(10.0, 0.0),
+        estimate_covariance: nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(
+            0.0025,
+            0.0025,
+            sigma_rad * sigma_rad,
+        )),
+    };
+    d.plan(&mut map).unwrap();
+    assert_eq!(d.speed_command_m_s(), 0.0);
+    // 2 x 0.01 rad x 70 m = 1.4 m: not yet.
+    map.update(&revolution(0.0, 0.01)).unwrap();
+    d.plan(&mut map).unwrap();
+    assert!(!map.mapping_started());
+    assert_eq!(d.speed_command_m_s(), 0.0);
+    // 2 x 0.004 rad x 70 m = 0.56 m (with 0.1 m of position): mapping starts, the vehicle goes.
+    map.update(&revolution(0.1, 0.004)).unwrap();
+    d.plan(&mut map).unwrap();
+    assert!(map.mapping_started());
+    assert!(d.speed_command_m_s() > 0.0);
+}
+
+fn at(t_s: f64, x: f64, y: f64, yaw: f64) -> PoseEstimate {
+    PoseEstimate {
+        covariance: nalgebra::Matrix3::zeros(),
+        t_s,
+        world_from_vehicle: Isometry2::new(Vector2::new(x, y), yaw),
+    }
+}
+
+#[test]
+fn without_an_estimate_the_vehicle_is_held() {
+    let mut d = driver();
+    let mut map = empty_map();
+    d.plan(&mut map).unwrap();
+    assert!(d.last_plan().is_none());
+    assert_eq!(d.command(), Command::default());
+}
+
+/// The plan starts where the estimate is, and the route progress is the estimate's: the
+/// driver has nothing else to go by (before, progress came from the true pose every step).
+#[test]
+fn plans_and_tracks_route_progress_from_its_estimate() {
+    let mut d = driver();
+    let mut map = empty_map();
+    d.on_pose(at(0.0, 10.0, 1.0, 0.0));
+    d.plan(&mut map).unwrap();
+    assert!((d.route_s_m().unwrap() - 10.0).abs() < 1e-9);
+    let first = d.last_plan().unwrap().chosen().poses[0];
+    assert!(
+        (first.translation.y - 1.0).abs() < 1e-9,
+        "starts at the estimate's offset: {first}"
+    );
+    assert_eq!(d.speed_command_m_s(), 5.0, "nothing in the way");
+    d.on_pose(at(0.1, 12.5, -0.5, 0.0));
+    d.plan(&mut map).unwrap();
+    assert!((d.route_s_m().unwrap() - 12.5).abs() < 1e-9);
+    // Steering back towards the route from the left: to the right (negative).
+    d.on_pose(at(0.2, 13.0, 1.0, 0.0));
+    d.plan(&mut map).unwrap();
+    d.on_odometry(Odometry {
+        t_s: 0.2,
+        speed_m_s: 5.0,
+        steering_rad: 0.0,
+    });
+    let c = d.command();
+    assert!(c.speed_m_s == 5.0 && c.steering_rad < 0.0, "{c:?}");
+}
+
+/// A route faster than the vehicle can stop from within its longest horizon (60 m at
+/// 3 m/s^2: 17.5 m/s) is lowered, and the driver says so; one within it is not.
+#[test]
+fn a_route_too_fast_to_stop_within_the_horizon_is_lowered() {
+    assert_eq!(driver().route_speed_lowered(), None, "5 m/s is allowed");
+    let mut fast = driver();
+    fast.wanted_speed_m_s = 20.0;
+    let (cap, why) = fast.route_speed_lowered().expect("lowered");
+    assert_eq!(why, SpeedLimit::Horizon);
+    let stopping = cap * 0.5 + cap * cap / 6.0 + 3.0;
+    assert!(
+        (stopping - 60.0).abs() < 1e-9,
+        "{cap} m/s stops in {stopping} m"
+    );
+    // Maps wide enough for the 60 m horizon the speed needs (blocks of 60 m).
+    fast.distance_map_half_size_m = 80.0;
+    let config = MapConfig {
+        block_cells: 300,
+        max_distance_m: 5.0,
+        ..MapConfig::default()
+    };
+    let levels = Levels::cumulative(vec![0.0]).unwrap();
+    let wide = MultiHeightMap::new(config, levels, Point2::new(40.0, 0.0)).unwrap();
+    let self_filter = fast.vehicle.collision.clone();
+    let mut map = started(
+        OnlineMap::new(wide, self_filter, ForgettingConfig::default(), 0.1, 1.0),
+        40.0,
+    );
+    fast.on_pose(at(0.0, 10.0, 0.0, 0.0));
+    fast.plan(&mut map).unwrap();
+    let v = fast.speed_command_m_s();
+    assert!((v - cap).abs() < 1e-9, "{v} against {cap}");
+}
+
+/// An estimate with a lateral standard deviation `sigma_m` (position only).
+fn uncertain(sigma_m: f64) -> PoseEstimate {
+    PoseEstimate {
+        covariance: nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(
+            sigma_m * sigma_m,
+            sigma_m * sigma_m,
+            0.0,
+        )),
+        ..at(0.0, 10.0, 0.0, 0.0)
+    }
+}
+
+/// A less certain estimate means a slower vehicle, then a stopped one: full speed up to
+/// 0.15 m, falling linearly to 0 at 0.5 m (the defaults).
+#[test]
+fn an_uncertain_estimate_slows_then_stops_the_vehicle() {
+    let speed = |sigma_m| {
+        let mut d = driver();
+        let mut map = empty_map();
+        d.on_pose(uncertain(sigma_m));
+        d.plan(&mut map).unwrap();
+        d.speed_command_m_s()
+    };
+    assert_eq!(speed(0.0), 5.0);
+    assert_eq!(speed(0.1), 5.0);
+    assert!((speed(0.325) - 2.5).abs() < 1e-9, "{}", speed(0.325));
+    assert_eq!(speed(0.5), 0.0);
+    assert_eq!(
+        speed(f64::NAN),
+        0.0,
+        "an estimate that knows nothing holds the vehicle"
+    );
+}
+
+/// The margins widen by two standard deviations: an obstacle the certain estimate passes
+/// 0.3 m from (beyond the avoider's 0.2 m) is inside the uncertain estimate's 0.2 + 2 x 0.1.
+#[test]
+fn an_uncertain_estimate_widens_the_safety_distances() {
+    let c = AutonomyConfig::default();
+    let (w, factor) = c.under_uncertainty(0.1);
+    assert!((w.avoider_safety_m - 0.4).abs() < 1e-6 && (w.planner_safety_m - 0.8).abs() < 1e-6);
+    assert_eq!(factor, 1.0);
+    let (w0, _) = c.under_uncertainty(0.0);
+    assert_eq!(w0, c);
+}
+
+/// Between estimates the driver carries its estimate forward on odometry (a localizer slower
+/// than the control loop); a new estimate replaces it.
+#[test]
+fn between_estimates_the_pose_is_dead_reckoned_on_odometry() {
+    let mut d = driver();
+    d.on_pose(at(0.0, 0.0, 0.0, 0.0));
+    let odo = |t_s, steering_rad| Odometry {
+        t_s,
+        speed_m_s: 2.0,
+        steering_rad,
+    };
+    d.on_odometry(odo(0.0, 0.0));
+    d.on_odometry(odo(0.5, 0.2));
+    let e = d.estimate().unwrap();
+    assert!((e.world_from_vehicle.translation.x - 1.0).abs() < 1e-12 && e.t_s == 0.5);
+    // 0.5 s more on the arc of steering 0.2: yaw grows by v t tan(0.2) / wheelbase.
+    d.on_odometry(odo(1.0, 0.2));
+    let yaw = d.estimate().unwrap().world_from_vehicle.rotation.angle();
+    assert!((yaw - 1.0 * 0.2f64.tan() / 2.5).abs() < 1e-12, "{yaw}");
+    d.on_pose(at(1.0, 7.0, 0.0, 0.0));
+    assert_eq!(d.estimate().unwrap().world_from_vehicle.translation.x, 7.0);
+}

@@ -1,0 +1,264 @@
+//! What the rules remember of movers from plan to plan: the streaks of tracks seen moving
+//! (which make a track a mover), the movers at the vehicle's body, those that coasted out of
+//! view towards it, and those lost from view while standing.
+
+use mapper::TrackState;
+use nalgebra::Isometry2;
+
+use super::rules::{AtBody, BodyHold, MoverStreak, TrafficRules};
+use super::{
+    TrafficConfig, at_body, may_have_walked_to, may_reach_body, moved_beyond_its_extent,
+    surely_moving,
+};
+
+/// A mover predicted out of view whose track drops while it may reach the standing vehicle's
+/// body within this many seconds, at any speed up to its peak ([`may_reach_body`]), is waited
+/// for as one lost there. Short: a static object's parts sliding out of view (a stale map,
+/// heavy dropout) seem to move too, and over the whole horizon their predictions would reach
+/// the body and call the pilot.
+const DROPPED_AT_BODY_S: f64 = 2.0;
+
+/// ... and only once it had been out of view this long, seconds: it coasted out of view. Under
+/// heavy faults spurious returns make one-cell tracks that jump at 5-14 m/s and are dropped
+/// within a second; a person lost under the wing was dropped 1.9 s after last seen (sample 757
+/// of the falsifier on 308acd2), so 2 s let them go.
+const COASTED_S: f64 = 1.5;
+
+/// ... and only one seen and predicted on consecutive plans for at least this long, seconds
+/// (three revolutions): one revolution's jump of a one-cell track is no evidence of a mover (a
+/// parked car a stale map does not hold).
+const SEEN_MOVING_S: f64 = 0.15;
+
+/// A track seen and predicted as a mover without a break for this long, seconds ...
+const MOVER_FOR_S: f64 = 1.0;
+/// ... this lately, seconds, may arrive at the body (`arriving`): one that slowed as it
+/// reached it, or walked out of view into it, is still one. A static object's sliding visible
+/// part seems to move in bursts, not for a second on end (a row of parked cars a stale map
+/// does not hold, on the parking lot).
+const MOVER_LATELY_S: f64 = 6.0;
+/// A mover lost from view while standing may have walked on at this speed, m/s (a brisk walk)
+/// ...
+const LOST_STANDING_WALK_M_S: f64 = 1.5;
+/// ... for this long after it was last seen, seconds, if no larger than this, metres (a person;
+/// a parked car a stale map does not hold, whose visible part slides, is larger).
+const LOST_STANDING_FOR_S: f64 = 60.0;
+pub(super) const LOST_STANDING_EXTENT_M: f64 = 2.0;
+
+impl TrafficRules {
+    /// The movers at the body now ([`at_body`]) joined to those lost there before; what holds
+    /// the vehicle for them (`None`: nothing at the body): stopped for the one seen last, if
+    /// seen within `hidden_after_s`, else waiting for one lost there, as for a hidden obstacle.
+    pub(super) fn movers_at_body(
+        &mut self,
+        movers: &[TrackState],
+        pose: &Isometry2<f64>,
+        now_s: f64,
+        stopped: bool,
+        cfg: &TrafficConfig,
+        hidden_after_s: f64,
+    ) -> Option<BodyHold> {
+        if !cfg.enabled {
+            self.at_body.clear();
+            self.coasting.clear();
+            return None;
+        }
+        self.note_streaks(now_s);
+        self.note_lost_standing(movers, now_s, cfg);
+        // A mover arriving at the body, or one held there before and not seen away.
+        let mut body: Vec<AtBody> = movers
+            .iter()
+            .filter(|t| {
+                let at = || at_body(&self.model, pose, t, now_s, cfg);
+                if self.at_body.iter().any(|r| r.id == t.id) {
+                    // Held: released only once seen away (a prediction carrying it on through
+                    // the airframe is no evidence that it left).
+                    let seen_now = now_s - t.t_s <= 0.25;
+                    return !seen_now || at();
+                }
+                self.arriving(t, now_s, cfg) && at()
+            })
+            .map(|t| AtBody {
+                id: t.id,
+                at: t.position,
+                seen_s: t.t_s,
+            })
+            .collect();
+        // One lost (its track gone, or renumbered: seen again beyond its own extent from where
+        // it was lost) is waited for for good, as a hidden obstacle: the pilot is called. Its
+        // cells reading free would prove nothing - within the map's self-hit margin of the
+        // body nothing is ever mapped.
+        let lost = self
+            .at_body
+            .iter()
+            .filter(|r| !movers.iter().any(|t| t.id == r.id));
+        body.extend(lost);
+        // A mover that coasted out of view toward a standing vehicle and whose track was then
+        // dropped: if it may reach the body within `DROPPED_AT_BODY_S`, it is waited for as
+        // one lost there (a van that drove into the blind zone behind the wing has not gone).
+        if stopped {
+            let dropped = self
+                .coasting
+                .iter()
+                .filter(|t| !movers.iter().any(|m| m.id == t.id))
+                .filter(|t| !body.iter().any(|r| r.id == t.id) && now_s - t.t_s >= COASTED_S)
+                .filter(|t| {
+                    let window = (now_s, now_s + DROPPED_AT_BODY_S);
+                    may_reach_body(&self.model, pose, t, window, cfg)
+                })
+                .map(|t| AtBody {
+                    id: t.id,
+                    at: t.position,
+                    seen_s: t.t_s,
+                })
+                .collect::<Vec<_>>();
+            body.extend(dropped);
+            let lost = self.lost_standing_at(pose, now_s, &body, cfg);
+            body.extend(lost);
+        }
+        // Movers predicted out of view now, confirmed, beyond what revealing a static object
+        // explains, and seen predicted on a few revolutions on end: checked again if their
+        // track drops (seen too briefly for a streak, maybe: a van seen in fragments for under
+        // a second each). Others are not: a one-cell track jumping at 7 m/s at the edge of
+        // view, lost for 6 s, would be predicted onto the body from 50 m away (one seen longer
+        // still is: docs/known-problems.md).
+        self.coasting = movers
+            .iter()
+            .filter(|t| {
+                now_s - t.t_s > 0.25
+                    && t.confirmed
+                    && moved_beyond_its_extent(t, cfg)
+                    && self.predictions.iter().any(|p| p.track.id == t.id)
+                    && self
+                        .streaks
+                        .iter()
+                        .any(|r| r.id == t.id && r.last_s - r.since_s >= SEEN_MOVING_S)
+            })
+            .cloned()
+            .collect();
+        self.at_body = body;
+        let seen = self
+            .at_body
+            .iter()
+            .filter(|r| now_s - r.seen_s <= hidden_after_s);
+        if let Some(r) = seen.max_by(|a, b| a.seen_s.total_cmp(&b.seen_s)) {
+            return Some(BodyHold::Seen {
+                at: r.at,
+                last_seen_s: r.seen_s,
+            });
+        }
+        let r = self.at_body.first()?;
+        Some(BodyHold::Lost {
+            at: r.at,
+            last_seen_s: r.seen_s,
+        })
+    }
+
+    /// Whether track `t` is a mover that may arrive at the body: one predicted on a streak
+    /// lately that has moved beyond its own extent.
+    pub(super) fn arriving(&self, t: &TrackState, now_s: f64, cfg: &TrafficConfig) -> bool {
+        self.streaks
+            .iter()
+            .any(|r| r.id == t.id && r.mover_s.is_some_and(|m| now_s - m <= MOVER_LATELY_S))
+            && moved_beyond_its_extent(t, cfg)
+    }
+
+    /// Keeps the known movers out of view while standing (the tracker's confirmed movers, no
+    /// larger than [`LOST_STANDING_EXTENT_M`], that were seen moving for [`MOVER_FOR_S`] on end
+    /// and travelled more than twice their extent and 3 m: a person who walked up and stopped,
+    /// not a static object's sliding parts, which seem to move in bursts), as last seen, after their tracks drop; forgets one seen again,
+    /// or lost [`LOST_STANDING_FOR_S`] ago.
+    pub(super) fn note_lost_standing(
+        &mut self,
+        movers: &[TrackState],
+        now_s: f64,
+        cfg: &TrafficConfig,
+    ) {
+        for r in self.streaks.iter().filter(|r| r.mover_s.is_some()) {
+            if !self.walked.contains(&r.id) {
+                self.walked.push(r.id);
+            }
+        }
+        // Those neither tracked nor kept are forgotten.
+        let lost = &self.lost_standing;
+        self.walked
+            .retain(|id| movers.iter().any(|t| t.id == *id) || lost.iter().any(|l| l.id == *id));
+        self.lost_standing.retain(|l| {
+            now_s - l.t_s < LOST_STANDING_FOR_S
+                && !movers.iter().any(|t| t.id == l.id && now_s - t.t_s <= 0.25)
+        });
+        for t in movers.iter().filter(|t| {
+            now_s - t.t_s > 0.25
+                && t.confirmed
+                && self.walked.contains(&t.id)
+                && t.extent_m <= LOST_STANDING_EXTENT_M
+                && t.travel_m > 2.0 * t.extent_m + 3.0
+                && !surely_moving(t, cfg)
+        }) {
+            match self.lost_standing.iter_mut().find(|l| l.id == t.id) {
+                Some(l) => *l = t.clone(),
+                None => self.lost_standing.push(t.clone()),
+            }
+        }
+    }
+
+    /// The movers lost standing (see `note_lost_standing`) that may have walked to the body of
+    /// the standing vehicle at `pose` since they were last seen, as movers at its body (waited
+    /// for, the pilot called): a person the airframe hid may have walked on into the blind zone
+    /// at the tail. Not those already in `body`.
+    pub(super) fn lost_standing_at(
+        &self,
+        pose: &Isometry2<f64>,
+        now_s: f64,
+        body: &[AtBody],
+        cfg: &TrafficConfig,
+    ) -> Vec<AtBody> {
+        self.lost_standing
+            .iter()
+            .filter(|l| !body.iter().any(|r| r.id == l.id))
+            .filter(|l| {
+                may_have_walked_to(&self.model, pose, l, now_s, LOST_STANDING_WALK_M_S, cfg)
+            })
+            .map(|l| AtBody {
+                id: l.id,
+                at: l.position,
+                seen_s: l.t_s,
+            })
+            .collect()
+    }
+
+    /// Each track seen (this revolution or the last, 0.25 s) and predicted now continues its
+    /// streak, or starts one; its last streak, once it lasted [`MOVER_FOR_S`], makes it a mover
+    /// as of the streak's last plan. Streaks not continued are kept for [`MOVER_LATELY_S`].
+    pub(super) fn note_streaks(&mut self, now_s: f64) {
+        for p in self
+            .predictions
+            .iter()
+            .filter(|p| now_s - p.track.t_s <= 0.25)
+        {
+            let id = p.track.id;
+            let r = match self.streaks.iter_mut().find(|r| r.id == id) {
+                Some(r) => r,
+                None => {
+                    self.streaks.push(MoverStreak {
+                        id,
+                        last_s: now_s,
+                        since_s: now_s,
+                        mover_s: None,
+                    });
+                    self.streaks.last_mut().expect("just pushed")
+                }
+            };
+            if now_s - r.last_s > 0.25 {
+                // A new streak: an earlier one does not count (a row of parked cars the map
+                // does not hold, merged into one track, seems to move in bursts).
+                r.since_s = now_s;
+                r.mover_s = None;
+            }
+            r.last_s = now_s;
+            if now_s - r.since_s >= MOVER_FOR_S {
+                r.mover_s = Some(now_s);
+            }
+        }
+        self.streaks.retain(|r| now_s - r.last_s <= MOVER_LATELY_S);
+    }
+}
