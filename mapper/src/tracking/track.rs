@@ -1,0 +1,191 @@
+//! One object being followed ([`Track`]), and how a revolution's cluster moves it on: a new
+//! track, or an old one followed - its motion, what it paints, whether it moves.
+
+use nalgebra::{Point2, Vector2};
+
+use super::clustering::Cluster;
+use super::motion::Motion;
+use super::{PEAK_SPEED_S, Tracker};
+use crate::map::WorldCell;
+
+/// One object being followed.
+#[derive(Clone, Debug)]
+pub(super) struct Track {
+    /// Its id (a new one when it takes over another object's hits beyond its extent).
+    pub(super) id: u32,
+    /// Where it was first seen (kept when it is seen anew within its extent: it is the same
+    /// object).
+    pub(super) origin: Point2<f64>,
+    /// Where its current motion started (set anew when it starts over).
+    pub(super) first: Point2<f64>,
+    /// The centre of its hits when last seen.
+    pub(super) last: Point2<f64>,
+    /// When it was last seen, seconds.
+    pub(super) last_t_s: f64,
+    /// Sum of the centre's steps, metres.
+    pub(super) path_m: f64,
+    /// Its speed on each revolution of the last [`PEAK_SPEED_S`] it was seen moving steadily, as
+    /// (time, m/s), oldest first.
+    pub(super) recent_speeds: std::collections::VecDeque<(f64, f64)>,
+    /// Largest extent (bounding-box diagonal) it was seen with, metres.
+    pub(super) max_extent_m: f64,
+    /// Its cells this revolution: bounding box (world cells), when seen.
+    pub(super) bbox: Option<(WorldCell, WorldCell)>,
+    /// The bounding box it was last seen with.
+    pub(super) last_bbox: (WorldCell, WorldCell),
+    /// Whether it has been offered for prediction (it then coasts when out of view).
+    pub(super) predictable: bool,
+    /// Revolutions it was seen in since it was created or started over.
+    pub(super) seen: u32,
+    /// Revolutions in a row whose step its motion explained.
+    pub(super) steady: u32,
+    /// Where its motion says it is, and its velocity, with their covariance.
+    pub(super) motion: Motion,
+    /// The levels it was hit in (bit `l`: level `l`), over its life.
+    pub(super) levels: u32,
+    /// The lowest open top any revolution saw it with (`Cluster::open_top_m`), metres.
+    pub(super) open_top_m: Option<f32>,
+    /// Confirmed moving: it may clear what it left.
+    pub(super) moving: bool,
+    /// Whether this revolution's step continued its motion (seen the revolution before, where
+    /// its velocity said): only then may a moving track clear.
+    pub(super) smooth: bool,
+    /// Cells it painted (some may since belong to another track).
+    pub(super) painted: Vec<WorldCell>,
+}
+
+impl Tracker {
+    /// A new track at a cluster nobody follows; its index.
+    pub(super) fn new_track(&mut self, t_s: f64, cluster: &Cluster) -> usize {
+        let cfg = &self.config;
+        self.tracks.push(Track {
+            id: self.next_id,
+            origin: cluster.center,
+            first: cluster.center,
+            last: cluster.center,
+            last_t_s: t_s,
+            path_m: 0.0,
+            recent_speeds: std::collections::VecDeque::new(),
+            max_extent_m: 0.0,
+            bbox: None,
+            last_bbox: cluster.bbox,
+            predictable: false,
+            seen: 0,
+            steady: 0,
+            motion: Motion::new(
+                cluster.center,
+                Vector2::zeros(),
+                cfg.position_sigma_m,
+                0.5 * cfg.max_speed_m_s,
+            ),
+            levels: 0,
+            open_top_m: None,
+            moving: false,
+            smooth: false,
+            painted: Vec::new(),
+        });
+        self.next_id = self.next_id.wrapping_add(1);
+        self.tracks.len() - 1
+    }
+
+    /// Track `ti` seen at `cluster` at `t_s`: its motion, what it paints, whether it moves.
+    pub(super) fn follow(&mut self, ti: usize, t_s: f64, cluster: &Cluster) {
+        let cfg = &self.config;
+        let r = self.resolution_m;
+        let (lo, hi) = cluster.bbox;
+        let extent = r * (((hi.0 - lo.0 + 1).pow(2) + (hi.1 - lo.1 + 1).pow(2)) as f64).sqrt();
+        let track = &mut self.tracks[ti];
+        let dt = t_s - track.last_t_s;
+        let step = cluster.center - track.last;
+        let velocity = track.motion.velocity();
+        let miss = (step - velocity * dt).norm();
+        let tolerance = cfg.max_step_error_m + 0.5 * track.max_extent_m;
+        // A step its velocity does not explain (or after a gap) may be another object's hits
+        // taken over, or the same object seen anew. A mover seen again after a longer gap (it
+        // walked behind something, or through the blind zone) continues its motion when it is
+        // where its velocity said, within what its uncertainty grew by, and its size is its own.
+        let regained = track.moving
+            && dt > cfg.max_gap_s
+            && miss <= tolerance + 0.5 * dt
+            && extent <= track.max_extent_m + 2.0 * cfg.max_step_error_m;
+        track.smooth = dt > 0.0 && ((dt <= cfg.max_gap_s && miss <= tolerance) || regained);
+        if dt > 0.0 && !track.smooth && track.seen > 1 {
+            // Perhaps another object's hits now: what it painted so far is no longer its to
+            // clear (it keeps its state), and its motion starts over from here. A step beyond
+            // its own extent is another object's hits: a new track, under a new id, with no
+            // evidence yet that it moves (a crossing car gone from view, its track taken over
+            // by a ground return by the jet's wing 22 m away, is no mover there); within it,
+            // the same object seen anew (a truck's side coming into view as the nose hides its
+            // front).
+            track.painted.clear();
+            track.steady = 0;
+            let another = miss > track.max_extent_m + cfg.max_step_error_m;
+            if another {
+                track.id = self.next_id;
+                self.next_id = self.next_id.wrapping_add(1);
+                track.origin = cluster.center;
+                track.moving = false;
+                track.predictable = false;
+                track.levels = 0;
+                track.open_top_m = None;
+                track.max_extent_m = 0.0;
+                track.seen = 0;
+            }
+            track.first = cluster.center;
+            track.path_m = 0.0;
+            track.recent_speeds.clear();
+            track.motion = Motion::new(
+                cluster.center,
+                if another { Vector2::zeros() } else { velocity },
+                cfg.position_sigma_m,
+                0.5 * cfg.max_speed_m_s,
+            );
+        }
+        if dt > 0.0 {
+            track.motion.predict(dt, cfg.acceleration_sigma_m_s2);
+            track.motion.correct(cluster.center, cfg.position_sigma_m);
+            track.path_m += step.norm();
+        }
+        if track.smooth {
+            track.steady += 1;
+            let speed = track.motion.velocity().norm();
+            track.recent_speeds.push_back((t_s, speed));
+            while track
+                .recent_speeds
+                .front()
+                .is_some_and(|&(t, _)| t_s - t > PEAK_SPEED_S)
+            {
+                track.recent_speeds.pop_front();
+            }
+        }
+        track.seen += 1;
+        track.last = cluster.center;
+        track.last_t_s = t_s;
+        track.bbox = Some(cluster.bbox);
+        track.last_bbox = cluster.bbox;
+        track.levels |= cluster.levels;
+        if let Some(top) = cluster.open_top_m {
+            track.open_top_m = Some(track.open_top_m.map_or(top, |t| t.min(top)));
+        }
+        track.max_extent_m = track.max_extent_m.max(extent);
+        // What it hits on a step its motion does not explain (it took over another object's
+        // hits) it owns, so no other track clears it, but never clears itself.
+        let paints = track.smooth || track.seen <= 1;
+        for &c in &cluster.cells {
+            if let Some(rec) = self.cells.get_mut(&c) {
+                if rec.owner != track.id && paints {
+                    track.painted.push(c);
+                }
+                rec.owner = track.id;
+            }
+        }
+        let travel = (track.last - track.first).norm();
+        if !track.moving
+            && track.max_extent_m <= cfg.max_object_m
+            && travel >= cfg.min_travel_m.max(cfg.extent_factor * track.max_extent_m)
+            && track.path_m <= cfg.max_path_ratio * travel + 1.0
+        {
+            track.moving = true;
+        }
+    }
+}
