@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks a taxi-sim Rerun recording: every entity path the README lists is there, with the
+"""Checks a taxi-sim Rerun recording: every entity path docs/commands.md lists is there, with the
 archetype it should hold, on the `sim_time` timeline. Exits 1 naming what is missing.
 
 Usage: check_rrd.py RUN.rrd [--airport]   (with the rerun-sdk matching the crate, see .ci/run)
@@ -10,7 +10,7 @@ import sys
 
 import rerun as rr
 
-# (entity path or prefix ending in "/", archetype) - README "Replay in Rerun" lists them.
+# (entity path or prefix ending in "/", archetype) - docs/commands.md "Replay in Rerun" lists them.
 EXPECTED = [
     ("/world/ground", "rerun.archetypes.Boxes3D"),
     ("/world/objects/", None),

@@ -1,4 +1,4 @@
-//! Campaigns through the library on the smoke campaign (`scenarios/campaigns/smoke.toml`, 20
+//! Campaigns through the library on the smoke campaign (`scenarios/campaigns/smoke.toml`, 12
 //! runs of a car on a straight road): the results are the same whatever the number of jobs; a
 //! campaign resumes where it stopped, over a half-written last line, without running a variant
 //! twice; a stop leaves only whole runs; bad campaign files are refused with their place; an
@@ -15,7 +15,7 @@ use crate::smoke_campaign::{full, run, smoke, smoke_path};
 #[test]
 fn the_smoke_campaign_runs_every_variant_under_every_setting() {
     let (dir, records) = full();
-    assert_eq!(records.len(), 20);
+    assert_eq!(records.len(), 12);
     assert!(records.iter().enumerate().all(|(i, r)| r.index == i as u64));
     for pair in records.chunks(2) {
         // A sample's two runs drew the same world and differ in the setting only.
@@ -27,11 +27,11 @@ fn the_smoke_campaign_runs_every_variant_under_every_setting() {
     assert_eq!(read_results(dir.path()).unwrap(), *records);
     let summary = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
     assert!(
-        summary.contains("| autonomy.planner_safety_m = 0.4 | 10 |"),
+        summary.contains("| autonomy.planner_safety_m = 0.4 | 6 |"),
         "{summary}"
     );
     assert!(
-        summary.contains("| autonomy.planner_safety_m = 0.6 | 10 |"),
+        summary.contains("| autonomy.planner_safety_m = 0.6 | 6 |"),
         "{summary}"
     );
     // Every failing variant and only those has a failure file, listed in the error table, and
@@ -81,7 +81,7 @@ fn the_smoke_campaign_runs_every_variant_under_every_setting() {
     let svg = std::fs::read_to_string(dir.path().join("clearance.svg")).unwrap();
     assert_eq!(svg.matches("<circle").count(), records.len() + 2);
     assert!(summary.contains("(clearance.svg)"));
-    // One map served all 20 runs: the static world never changed.
+    // One map served all 12 runs: the static world never changed.
     assert_eq!(
         std::fs::read_dir(dir.path().join("maps")).unwrap().count(),
         1

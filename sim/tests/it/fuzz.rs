@@ -4,7 +4,7 @@
 //! their reader refuses infinities itself). Parsers: scenarios (with the pose files they name),
 //! vehicle sidecars, URDFs, campaign files, run configurations, map blocks, map manifests and
 //! ROS map YAML + PGM, ROS 2 point clouds, a capture's pose files. `TAXI_SIM_FUZZ_CASES` sets the cases per parser (default 64, the quick
-//! budget CI runs; README "Hostile input" has the long run).
+//! budget CI runs; docs/results.md "Faults and hostile input" has the long run).
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};

@@ -1,5 +1,5 @@
 //! The Rerun replay: a short run's recording is complete (every message decodes, the footer is
-//! there), holds the entity paths the README lists, and appears only when the run finished; bad
+//! there), holds the entity paths docs/commands.md lists, and appears only when the run finished; bad
 //! replay options name their flag. The command line's refusal of a bad replay option is tested in
 //! the `taxi-sim` package (`sim/cli/tests/it/replay.rs`).
 

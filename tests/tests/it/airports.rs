@@ -44,14 +44,3 @@ fn the_jet_taxis_from_a_stand_to_the_runway_by_b_and_a() {
         "{nearest:?}"
     );
 }
-
-/// KSYR from `../shared/data` (run with `--ignored`, as CI does): Gate 4 to runway 28, half the
-/// stands occupied - every expectation of the shipped scenario holds, the cone passed under.
-#[test]
-#[ignore = "reads ../shared/data"]
-fn shared_data_the_jet_taxis_ksyr_from_gate_4_to_runway_28() {
-    let s = scenario("airports/ksyr_gate_to_runway_28");
-    let r = run_with(&s, RunConfig::for_scenario(&s, None).unwrap());
-    assert!(r.expectations_met && r.contacts.is_empty(), "{r:#?}");
-    assert_eq!(r.obstacles[0].passes[0].outcome.as_str(), "passed");
-}

@@ -109,7 +109,7 @@ fn a_cart_passes_under_the_wing_a_fuel_truck_does_not() {
         first_stop.start_s,
         truck.contacts
     );
-    // FIXME (README, Known problems): the cart should not stop the jet at all; the jet holds
+    // FIXME (docs/known-problems.md): the cart should not stop the jet at all; the jet holds
     // short of it for about 9 s (the cart's predicted footprint, widened by what it may hide
     // and its uncertainty, reaches the gear's path; and until the cart is within 24 m the
     // sensor, 1.55 m up, cannot tell it from a 1.5 m van - its open top - and a fragment of it

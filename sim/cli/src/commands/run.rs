@@ -42,8 +42,12 @@ pub struct RunArgs {
     #[arg(long)]
     pub report: Option<PathBuf>,
     /// The offline map (default: out/maps/<scenario file name>; built there when missing or stale).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "maps_dir")]
     pub map_dir: Option<PathBuf>,
+    /// A map cache shared with `regress` and campaigns (`regress --maps-dir`): the scenario's map
+    /// is the one under DIR for its static world, built there on first use.
+    #[arg(long, value_name = "DIR")]
+    pub maps_dir: Option<PathBuf>,
     /// Where the stack's pose comes from: `truth`, or `particle-filter` (the configuration's
     /// settings, or the defaults). Default: the configuration's.
     #[arg(long, value_enum)]
@@ -117,17 +121,28 @@ pub fn run(args: &RunArgs) -> anyhow::Result<bool> {
     let replay_options = args.replay_options();
     replay_options.validate()?;
     let bag_path = bag_file(&args.record)?;
-    let dir = args
-        .map_dir
-        .clone()
-        .unwrap_or_else(|| default_map_dir(&scenario, &config));
-    if fresh_manifest(&scenario, &config, &dir)?.is_none() {
-        eprintln!(
-            "offline map {} is missing or stale: building it (mapping drive)",
-            dir.display()
-        );
-        super::map::build_map(&scenario, &config, &dir)?;
-    }
+    let dir = match &args.maps_dir {
+        // The cache's key is what the map depends on: an entry is never stale.
+        Some(cache) => {
+            std::fs::create_dir_all(cache)
+                .with_context(|| format!("creating the map cache {}", cache.display()))?;
+            sim::campaign::MapCache::new(cache.clone()).get_for_file(&scenario, &config)?
+        }
+        None => {
+            let dir = args
+                .map_dir
+                .clone()
+                .unwrap_or_else(|| default_map_dir(&scenario, &config));
+            if fresh_manifest(&scenario, &config, &dir)?.is_none() {
+                eprintln!(
+                    "offline map {} is missing or stale: building it (mapping drive)",
+                    dir.display()
+                );
+                super::map::build_map(&scenario, &config, &dir)?;
+            }
+            dir
+        }
+    };
     let setup = RunSetup {
         laps: args.laps,
         seed: args.seed,

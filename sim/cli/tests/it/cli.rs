@@ -184,3 +184,63 @@ fn a_campaign_stopped_by_ctrl_c_keeps_whole_runs_and_shows_them() {
     assert_eq!(code, 2);
     assert!(stderr.contains("not a campaign directory"), "{stderr}");
 }
+
+/// `run --maps-dir`: the map of the scenario's static world comes from a cache shared with
+/// `regress` and campaigns - built there on the first run, the same entry reused by the next
+/// (not rebuilt: its manifest is not rewritten) with the same result; `--map-dir` with it is
+/// refused.
+#[test]
+fn run_with_a_map_cache_builds_the_map_once_and_reuses_it() {
+    let d = tempfile::tempdir().unwrap();
+    let cache = d.path().join("maps");
+    let scenario = std::fs::canonicalize("../../scenarios/bridge_car.toml").unwrap();
+    let run = |report: &str| {
+        let (code, out, err) = taxi_sim(&[
+            "run",
+            scenario.to_str().unwrap(),
+            "--maps-dir",
+            cache.to_str().unwrap(),
+            "--report",
+            d.path().join(report).to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{out}\n{err}");
+        assert!(!err.contains("missing or stale"), "{err}");
+        let mut v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.path().join(report)).unwrap()).unwrap();
+        for k in ["wall_time_s", "real_time_factor", "time_split_s"] {
+            v.as_object_mut().unwrap().remove(k);
+        }
+        v
+    };
+    let entries = || -> Vec<std::path::PathBuf> {
+        std::fs::read_dir(&cache)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect()
+    };
+    let first = run("a.json");
+    let built = entries();
+    assert_eq!(built.len(), 1, "{built:?}");
+    let manifest = built[0].join("manifest.json");
+    let written = std::fs::metadata(&manifest).unwrap().modified().unwrap();
+    let second = run("b.json");
+    assert_eq!(entries(), built);
+    assert_eq!(
+        std::fs::metadata(&manifest).unwrap().modified().unwrap(),
+        written
+    );
+    assert_eq!(first, second);
+    let (code, _, err) = taxi_sim(&[
+        "run",
+        scenario.to_str().unwrap(),
+        "--maps-dir",
+        cache.to_str().unwrap(),
+        "--map-dir",
+        "elsewhere",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("--map-dir") && err.contains("--maps-dir"),
+        "{err}"
+    );
+}

@@ -21,7 +21,14 @@ pub fn scenario(name: &str) -> Scenario {
 /// The maps of this test binary: one mapping drive per static world (the campaigns' cache, keyed
 /// by what the drive depends on), in `CARGO_TARGET_TMPDIR` under this binary's build stamp so a
 /// later run of the same binary reuses them and a rebuilt one (the mapper changed) does not.
+/// With `TAXI_SIM_TEST_MAPS=DIR`, the cache under DIR instead, shared with `taxi-sim regress
+/// --maps-dir DIR` and `taxi-sim run --maps-dir DIR` of the same build (CI: one mapping drive per
+/// static world for the tests and the regression run together).
 static MAPS: LazyLock<MapCache> = LazyLock::new(|| {
+    if let Some(dir) = std::env::var_os("TAXI_SIM_TEST_MAPS") {
+        std::fs::create_dir_all(&dir).unwrap();
+        return MapCache::new(PathBuf::from(dir));
+    }
     let root = Path::new(env!("CARGO_TARGET_TMPDIR"));
     let exe = std::fs::metadata(std::env::current_exe().unwrap()).unwrap();
     let built = exe.modified().unwrap().duration_since(UNIX_EPOCH).unwrap();
