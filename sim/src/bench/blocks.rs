@@ -185,10 +185,13 @@ pub fn figures_for(
     let scenario = crate::scenario::Scenario::from_file(scenario)?;
     let config = crate::scenario::RunConfig::default();
     let dir = crate::offline_map::default_map_dir(&scenario, &config);
-    if crate::offline_map::fresh_manifest(&scenario, &config, &dir)?.is_none() {
-        progress("mapping drive");
-        crate::offline_map::map_drive(&scenario, &config, &dir, &mut |_, _| {})?;
-    }
+    crate::offline_map::ensure(
+        &scenario,
+        &config,
+        &dir,
+        &mut || progress("mapping drive"),
+        &mut |_, _| {},
+    )?;
     let map = config.mapping.map;
     let spec = mapper::BlockSpec {
         side: map.block_cells,

@@ -18,10 +18,13 @@ pub fn loop_figures(
     let scenario = crate::scenario::Scenario::from_file(scenario)?;
     let config = crate::scenario::RunConfig::default();
     let map_dir = &crate::offline_map::default_map_dir(&scenario, &config);
-    if crate::offline_map::fresh_manifest(&scenario, &config, map_dir)?.is_none() {
-        progress("mapping drive");
-        crate::offline_map::map_drive(&scenario, &config, map_dir, &mut |_, _| {})?;
-    }
+    crate::offline_map::ensure(
+        &scenario,
+        &config,
+        map_dir,
+        &mut || progress("mapping drive"),
+        &mut |_, _| {},
+    )?;
     let setup = |schedule| crate::engine::RunSetup {
         laps: (laps > 0).then_some(laps),
         config: crate::scenario::RunConfig {

@@ -26,10 +26,13 @@ pub fn figures_for(
     let scenario = crate::scenario::Scenario::from_file(scenario)?;
     let run = crate::scenario::RunConfig::default();
     let dir = crate::offline_map::default_map_dir(&scenario, &run);
-    if crate::offline_map::fresh_manifest(&scenario, &run, &dir)?.is_none() {
-        progress("mapping drive");
-        crate::offline_map::map_drive(&scenario, &run, &dir, &mut |_, _| {})?;
-    }
+    crate::offline_map::ensure(
+        &scenario,
+        &run,
+        &dir,
+        &mut || progress("mapping drive"),
+        &mut |_, _| {},
+    )?;
     progress("a revolution from the start");
     let vehicle = &scenario.vehicle.vehicle;
     let start = scenario.vehicle.world_from_start;

@@ -1,10 +1,11 @@
 //! The offline map's files in a map directory: a manifest that exists but cannot be read or
-//! parsed is an error saying so, where, and what to do; a missing or stale one means "build".
+//! parsed is an error saying so, where, and what to do; a missing or stale one means "build" -
+//! and `ensure` builds it then, once.
 
 use std::path::{Path, PathBuf};
 
 use sim::Error;
-use sim::offline_map::{ManifestError, MapManifest, fingerprint, fresh_manifest};
+use sim::offline_map::{Ensured, ManifestError, MapManifest, ensure, fingerprint, fresh_manifest};
 use sim::scenario::{RunConfig, Scenario};
 
 fn scenario() -> Scenario {
@@ -118,4 +119,53 @@ fn the_fingerprint_changes_with_the_vehicles_ceiling() {
         (levels.ceiling_m().unwrap() - 2.522).abs() < 1e-3,
         "{levels:?}"
     );
+}
+
+/// `ensure`: a fresh manifest is used as it is (no drive); a stale one is rebuilt once by the
+/// mapping drive, whose map the next call finds fresh; an unreadable one is an error, not a
+/// reason to build.
+#[test]
+fn ensure_reuses_a_fresh_map_and_builds_a_stale_one_once() {
+    let scenario = scenario();
+    let config = RunConfig::default();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("manifest.json");
+    let mut builds = 0;
+    let call = |builds: &mut usize| {
+        ensure(
+            &scenario,
+            &config,
+            dir.path(),
+            &mut || *builds += 1,
+            &mut |_, _| {},
+        )
+    };
+
+    let fresh = manifest(fingerprint(&scenario, &config).unwrap());
+    std::fs::write(&path, serde_json::to_string(&fresh).unwrap()).unwrap();
+    let got = call(&mut builds).unwrap();
+    assert!(matches!(got, Ensured::Fresh(_)), "{got:?}");
+    assert_eq!(got.manifest().scans, 1);
+    assert_eq!(builds, 0);
+    assert!(!dir.path().join("blocks").exists());
+
+    std::fs::write(
+        &path,
+        serde_json::to_string(&manifest("stale".into())).unwrap(),
+    )
+    .unwrap();
+    let got = call(&mut builds).unwrap();
+    assert!(matches!(got, Ensured::Built(_)), "{got:?}");
+    assert_eq!(builds, 1);
+    let built = got.manifest().clone();
+    assert_eq!(built.fingerprint, fresh.fingerprint);
+    assert!(built.scans > 100 && built.blocks > 0, "{built:?}");
+    let again = call(&mut builds).unwrap();
+    assert!(matches!(again, Ensured::Fresh(_)), "{again:?}");
+    assert_eq!(again.manifest().scans, built.scans);
+    assert_eq!(builds, 1);
+
+    std::fs::write(&path, "{ not json").unwrap();
+    assert!(call(&mut builds).is_err());
+    assert_eq!(builds, 1);
 }

@@ -10,7 +10,7 @@ use sim::engine::EndReason;
 use sim::engine::RunReport;
 use sim::engine::{NoObserver, Observer, Observers};
 use sim::engine::{RunHandles, RunSetup, run_with};
-use sim::offline_map::{default_map_dir, fresh_manifest};
+use sim::offline_map::default_map_dir;
 use sim::replay::{Replay, ReplayOptions};
 use sim::scenario::Scenario;
 use sim::scenario::{NoisyTruthConfig, PoseSourceConfig, RunConfig, Schedule};
@@ -121,28 +121,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<bool> {
     let replay_options = args.replay_options();
     replay_options.validate()?;
     let bag_path = bag_file(&args.record)?;
-    let dir = match &args.maps_dir {
-        // The cache's key is what the map depends on: an entry is never stale.
-        Some(cache) => {
-            std::fs::create_dir_all(cache)
-                .with_context(|| format!("creating the map cache {}", cache.display()))?;
-            sim::campaign::MapCache::new(cache.clone()).get_for_file(&scenario, &config)?
-        }
-        None => {
-            let dir = args
-                .map_dir
-                .clone()
-                .unwrap_or_else(|| default_map_dir(&scenario, &config));
-            if fresh_manifest(&scenario, &config, &dir)?.is_none() {
-                eprintln!(
-                    "offline map {} is missing or stale: building it (mapping drive)",
-                    dir.display()
-                );
-                super::map::build_map(&scenario, &config, &dir)?;
-            }
-            dir
-        }
-    };
+    let dir = offline_map_dir(args, &scenario, &config)?;
     let setup = RunSetup {
         laps: args.laps,
         seed: args.seed,
@@ -227,6 +206,47 @@ pub fn run(args: &RunArgs) -> anyhow::Result<bool> {
     }
     crate::emit(&table(&report))?;
     Ok(report.expectations_met)
+}
+
+/// The offline map the run drives on: from the shared cache (`--maps-dir`), or the map directory
+/// (`--map-dir`, default `out/maps/<name>`) made sure of by [`sim::offline_map::ensure`].
+fn offline_map_dir(
+    args: &RunArgs,
+    scenario: &Scenario,
+    config: &RunConfig,
+) -> anyhow::Result<PathBuf> {
+    Ok(match &args.maps_dir {
+        // The cache's key is what the map depends on: an entry is never stale.
+        Some(cache) => {
+            std::fs::create_dir_all(cache)
+                .with_context(|| format!("creating the map cache {}", cache.display()))?;
+            sim::campaign::MapCache::new(cache.clone()).get_for_file(scenario, config)?
+        }
+        None => {
+            let dir = args
+                .map_dir
+                .clone()
+                .unwrap_or_else(|| default_map_dir(scenario, config));
+            let bar = crate::bar(0, "mapping");
+            sim::offline_map::ensure(
+                scenario,
+                config,
+                &dir,
+                &mut || {
+                    eprintln!(
+                        "offline map {} is missing or stale: building it (mapping drive)",
+                        dir.display()
+                    );
+                },
+                &mut |done, total| {
+                    bar.set_length(total as u64);
+                    bar.set_position(done as u64);
+                },
+            )?;
+            bar.finish_and_clear();
+            dir
+        }
+    })
 }
 
 /// The `.mcap` of `--record`, if one is asked for; every file must be `.rrd` or `.mcap`, each
