@@ -1,0 +1,118 @@
+//! Hostile captures refused with errors naming the file, the packet and what is wrong; other
+//! traffic and other link layers read as the sensor's own packets.
+
+use velodyne::{Capture, VelodyneError};
+
+use crate::common::{ethernet_udp, packet, pcap, write};
+
+fn error_of(bytes: &[u8]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(dir.path(), "hostile.pcap", bytes);
+    let e = Capture::read(&path).expect_err("an error");
+    let text = e.to_string();
+    assert!(text.contains("hostile.pcap"), "{text}");
+    assert!(!matches!(e, VelodyneError::Io { .. }), "{text}");
+    text
+}
+
+/// Hostile captures: each a clear error naming the file, the packet and what is wrong.
+#[test]
+fn hostile_captures_are_located_errors() {
+    let good = packet([0; 12], 0).encode();
+    let whole = pcap(1, &[ethernet_udp(2368, &good), ethernet_udp(2368, &good)]);
+    // Cut inside the second packet.
+    let e = error_of(&whole[..whole.len() - 100]);
+    assert!(e.contains("cut short") && e.contains("packet 1"), "{e}");
+    // Not a capture at all.
+    let e = error_of(b"# not a capture\n");
+    assert!(e.contains("not a pcap"), "{e}");
+    // Another link type (IEEE 802.11).
+    let e = error_of(&pcap(105, &[ethernet_udp(2368, &good)]));
+    assert!(
+        e.contains("packet 0") && e.contains("link type 105 not supported"),
+        "{e}"
+    );
+    // A packet from another sensor (product byte 0x28, a VLP-32C).
+    let mut other = good.clone();
+    other[1205] = 0x28;
+    let e = error_of(&pcap(
+        1,
+        &[ethernet_udp(2368, &good), ethernet_udp(2368, &other)],
+    ));
+    assert!(
+        e.contains("packet 1") && e.contains("product byte 0x28"),
+        "{e}"
+    );
+    // A block whose flag is not 0xEEFF (an HDL-64E's lower bank).
+    let mut lower = good.clone();
+    lower[300] = 0xff;
+    lower[301] = 0xdd;
+    let e = error_of(&pcap(1, &[ethernet_udp(2368, &lower)]));
+    assert!(
+        e.contains("packet 0") && e.contains("block 3: flag 0xddff"),
+        "{e}"
+    );
+    // A VLP-16 packet among HDL-32E ones.
+    let mut vlp = good.clone();
+    vlp[1205] = 0x22;
+    let e = error_of(&pcap(
+        1,
+        &[ethernet_udp(2368, &good), ethernet_udp(2368, &vlp)],
+    ));
+    assert!(
+        e.contains("packet 1") && e.contains("another sensor"),
+        "{e}"
+    );
+    // A packet cut by the capture's snap length.
+    let mut snapped = pcap(1, &[ethernet_udp(2368, &good)[..200].to_vec()]);
+    snapped[24 + 12..24 + 16].copy_from_slice(&1248u32.to_le_bytes());
+    let e = error_of(&snapped);
+    assert!(
+        e.contains("packet 0") && e.contains("cut short by the capture"),
+        "{e}"
+    );
+    // No data packets at all.
+    let e = error_of(&pcap(1, &[ethernet_udp(53, b"dns")]));
+    assert!(e.contains("no Velodyne data packets"), "{e}");
+}
+
+/// Other traffic in a capture is skipped, even when it could not be read whole (a fragment, a
+/// packet snapped by the capture); 802.1Q-tagged and Linux cooked (v1, v2) captures read as
+/// Ethernet ones do.
+#[test]
+fn other_traffic_and_other_link_layers() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = packet([0; 12], 0).encode();
+    let sensor = ethernet_udp(2368, &good);
+    let mut fragment = ethernet_udp(53, b"a fragment of a DNS answer");
+    fragment[14 + 6] = 0x20; // more fragments
+    let snapped = ethernet_udp(53, &[7u8; 400])[..100].to_vec();
+    let mut bytes = pcap(1, &[fragment, sensor.clone(), snapped.clone()]);
+    // The snapped record says 100 of 442 bytes.
+    let third = bytes.len() - snapped.len() - 16;
+    bytes[third + 12..third + 16].copy_from_slice(&442u32.to_le_bytes());
+    let path = write(dir.path(), "mixed.pcap", &bytes);
+    let c = Capture::read(&path).unwrap();
+    assert_eq!(c.data.len(), 1);
+    assert_eq!(c.data[0].0, 1);
+    // The same packet behind an 802.1Q tag, and in Linux cooked captures.
+    let mut tagged = sensor[..12].to_vec();
+    tagged.extend_from_slice(&[0x81, 0x00, 0x00, 0x05]);
+    tagged.extend_from_slice(&sensor[12..]);
+    let ip = &sensor[14..];
+    let mut sll = vec![0u8; 14];
+    sll.extend_from_slice(&[0x08, 0x00]);
+    sll.extend_from_slice(ip);
+    let mut sll2 = vec![0x08, 0x00];
+    sll2.extend_from_slice(&[0u8; 18]);
+    sll2.extend_from_slice(ip);
+    for (link, record) in [(1, tagged), (113, sll), (276, sll2), (101, ip.to_vec())] {
+        let path = write(
+            dir.path(),
+            &format!("link{link}.pcap"),
+            &pcap(link, &[record]),
+        );
+        let c = Capture::read(&path).unwrap_or_else(|e| panic!("link {link}: {e}"));
+        assert_eq!(c.data[0].1, packet([0; 12], 0), "link {link}");
+    }
+}
