@@ -1,32 +1,13 @@
 //! The rules about movers ([`TrafficRules`]) on made-up tracks along a straight route: each
 //! test is named after the case that made its rule (`tests/found/*.toml`).
 
-use mapper::{Circle, CollisionModel, TrackState};
+use mapper::TrackState;
 use nalgebra::{Isometry2, Matrix4, Point2, Vector2, Vector4};
 
 use super::rules::{AtBody, MoverStreak};
+use super::tests::model;
 use super::*;
 use crate::planner::{AutonomyConfig, stopping_distance_m};
-
-/// A 10 m vehicle: six 1 m circles along its axis on level 0 (gear, fuselage) and one 8 m to
-/// the left on level 1 (a wing tip).
-fn model() -> CollisionModel {
-    let mut circles: Vec<Circle> = (0..6)
-        .map(|i| Circle {
-            x_m: i as f64 * 2.0,
-            y_m: 0.0,
-            radius_m: 1.0,
-            level: 0,
-        })
-        .collect();
-    circles.push(Circle {
-        x_m: 4.0,
-        y_m: 8.0,
-        radius_m: 1.0,
-        level: 1,
-    });
-    CollisionModel::new(circles, vec![0.0, 1.1]).unwrap()
-}
 
 fn rules() -> TrafficRules {
     TrafficRules::new(model(), 0.5)

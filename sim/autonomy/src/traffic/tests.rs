@@ -7,8 +7,8 @@ use mapper::{Circle, CollisionModel};
 use nalgebra::{Matrix4, Vector2};
 
 /// A 10 m vehicle on level 0 (gear, fuselage) with a 1 m circle on level 1 far out left
-/// (a wing tip).
-fn model() -> CollisionModel {
+/// (a wing tip); the rules' tests use it too.
+pub(super) fn model() -> CollisionModel {
     let mut circles: Vec<Circle> = (0..6)
         .map(|i| Circle {
             x_m: i as f64 * 2.0,
