@@ -8,8 +8,11 @@
 //! - [`verdict`]: a run judged against its file - passed, failed, or a known problem that still
 //!   ends as the file states (an expected failure, like pytest's strict xfail: once it passes it
 //!   fails, so the mark is removed);
+//! - [`golden`]: a case's golden numbers (`[regress] golden`), the quick tier's summary of what
+//!   the vehicle did, compared with its file or written anew (`--bless`);
 //! - [`results`]: the cases as JUnit XML, JSON lines and a Markdown summary.
 
+pub mod golden;
 pub mod results;
 
 use std::path::{Path, PathBuf};
@@ -186,6 +189,8 @@ pub struct Options<'a> {
     pub shard: Option<Shard>,
     /// A bound on each run's simulated time, seconds (`None`: the scenario's own).
     pub time_limit_s: Option<f64>,
+    /// Write each case's golden numbers (`[regress] golden`) instead of comparing them.
+    pub bless: bool,
     /// Set from outside (Ctrl-C): runs in flight end, cases not begun are not reported.
     pub stop: &'a AtomicBool,
     /// Told of every finished case.
@@ -316,7 +321,22 @@ fn run_case(
         Ok(r) => r,
         Err(e) => return Some(error_result(case, opts.tier, e.to_string())),
     };
-    let (status, messages) = verdict(&scenario, &report);
+    let (mut status, mut messages) = verdict(&scenario, &report);
+    // The golden numbers are the quick tier's laps; a time limit cuts the run short of them.
+    if let Some(path) = scenario
+        .golden
+        .as_ref()
+        .filter(|_| opts.tier == Tier::Quick && opts.time_limit_s.is_none())
+    {
+        match golden::check(path, &golden::summary(&report), opts.bless) {
+            Ok(lines) if lines.is_empty() => {}
+            Ok(lines) => {
+                status = Status::Failed;
+                messages.extend(lines);
+            }
+            Err(e) => return Some(error_result(case, opts.tier, e.to_string())),
+        }
+    }
     let mut r = blank(case, &scenario, opts.tier);
     r.laps_in_file = laps_in_file;
     r.status = status;

@@ -228,3 +228,48 @@ fn quick_laps_are_at_most_the_files_laps() {
     assert!(s.full_only);
     assert_eq!(super::laps_in(&s, Tier::Full), 1);
 }
+
+#[test]
+fn a_golden_file_is_a_json_path_beside_the_scenario() {
+    let text = format!("{SCENARIO}[regress]\ngolden = \"golden/k.json\"\n");
+    let s = crate::scenario::Scenario::from_str(&text, Path::new("cases/k.toml")).unwrap();
+    assert_eq!(s.golden.as_deref(), Some(Path::new("cases/golden/k.json")));
+    let e = scenario_with("[regress]\ngolden = \"golden/k.txt\"\n").unwrap_err();
+    assert!(
+        e.contains("k.toml:") && e.contains("regress.golden") && e.contains(".json"),
+        "{e}"
+    );
+}
+
+#[test]
+fn golden_numbers_differ_line_by_line_and_a_missing_file_says_how_to_write_it() {
+    use super::golden::{check, differences};
+    let p = Path::new("g.json");
+    assert!(differences(p, "{\n  \"a\": 1\n}\n", "{\n  \"a\": 1\n}\n").is_empty());
+    let d = differences(p, "{\n  \"a\": 1,\n  \"b\": 2\n}\n", "{\n  \"a\": 3\n}\n");
+    assert_eq!(
+        d[1..],
+        [
+            "line 2: golden \"a\": 1, | now \"a\": 3",
+            "line 3: golden \"b\": 2 | now }",
+            "line 4: golden } | now (no line)",
+        ],
+        "{d:?}"
+    );
+    assert!(
+        d[0].starts_with("golden numbers differ from g.json"),
+        "{d:?}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("new/g.json");
+    let v = serde_json::json!({"laps_completed": 1});
+    let missing = check(&path, &v, false).unwrap();
+    assert!(
+        missing.len() == 1 && missing[0].contains("--bless"),
+        "{missing:?}"
+    );
+    assert!(check(&path, &v, true).unwrap().is_empty());
+    assert!(check(&path, &v, false).unwrap().is_empty());
+    let other = serde_json::json!({"laps_completed": 2});
+    assert_eq!(check(&path, &other, false).unwrap().len(), 2);
+}

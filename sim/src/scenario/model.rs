@@ -393,6 +393,8 @@ pub struct Scenario {
     pub quick_laps: Option<u32>,
     /// `[regress] full_only`: run only in the full tier.
     pub full_only: bool,
+    /// `[regress] golden`: the quick tier's golden numbers (resolved against the file's folder).
+    pub golden: Option<PathBuf>,
 }
 
 /// A scenario's known problem: why it fails today, and how it ends today.

@@ -155,6 +155,9 @@ pub struct RegressSpec {
     /// Run only in the full tier (`--full`): a case too long to shorten. Default false.
     #[serde(default)]
     pub full_only: bool,
+    /// The quick tier's golden numbers, a `.json` file relative to this one (written by `regress
+    /// --bless`): the case fails when its run's summary differs.
+    pub golden: Option<Spanned<String>>,
 }
 
 /// How a scenario's run must end (`[expectations] end`).

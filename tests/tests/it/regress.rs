@@ -2,6 +2,7 @@
 //! known problem that still fails as stated (expected failure), one that was fixed and one that
 //! changed (both failures, as pytest's strict xfail), a file that is not a scenario (an error,
 //! the run going on), and a campaign file beside them (skipped). The four runs share one map.
+//! Then golden numbers: written by `--bless`, the same run matches them, a changed line fails.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -31,6 +32,10 @@ fn mark(text: &str, today: &str) -> String {
 }
 
 fn run_dir(dir: &Path, tier: Tier) -> Vec<CaseResult> {
+    run_dir_blessing(dir, tier, false)
+}
+
+fn run_dir_blessing(dir: &Path, tier: Tier, bless: bool) -> Vec<CaseResult> {
     let cases = discover(&[dir.to_path_buf()], None).unwrap();
     let maps = tempfile::tempdir().unwrap();
     let stop = AtomicBool::new(false);
@@ -42,6 +47,7 @@ fn run_dir(dir: &Path, tier: Tier) -> Vec<CaseResult> {
             maps_dir: maps.path().to_path_buf(),
             shard: None,
             time_limit_s: None,
+            bless,
             stop: &stop,
             progress: &|_| {},
             started: &|_| {},
@@ -140,5 +146,66 @@ fn regress_reports_passes_known_problems_fixed_and_changed_ones_and_bad_files() 
             "<skipped message=\"known problem: the car passes under the cone it should go round\""
         ),
         "{xml}"
+    );
+}
+
+/// `[regress] golden`, with `[regress]` before the first table.
+fn with_golden(text: &str, golden: &str) -> String {
+    text.replacen(
+        "laps = 1\n",
+        &format!("laps = 1\n\n[regress]\ngolden = \"{golden}\"\n"),
+        1,
+    )
+}
+
+#[test]
+fn golden_numbers_are_blessed_then_matched_and_a_changed_line_fails_the_case() {
+    let base = shipped("straight_cone_under_wing");
+    let d = tempfile::tempdir().unwrap();
+    let blessing = d.path().join("bless");
+    std::fs::create_dir(&blessing).unwrap();
+    std::fs::write(blessing.join("g.toml"), with_golden(&base, "golden/g.json")).unwrap();
+    let rs = run_dir_blessing(&blessing, Tier::Quick, true);
+    assert_eq!(rs[0].status, Status::Passed, "{rs:#?}");
+    let blessed = std::fs::read_to_string(blessing.join("golden/g.json")).unwrap();
+    assert!(
+        blessed.contains("\"laps_completed\": 1") && blessed.contains("cone_under_wing"),
+        "{blessed}"
+    );
+    // The same run against the blessed numbers, and against them with one lap time changed.
+    let checking = d.path().join("check");
+    std::fs::create_dir(&checking).unwrap();
+    std::fs::write(checking.join("same.json"), &blessed).unwrap();
+    let lap = blessed
+        .lines()
+        .skip_while(|l| !l.contains("lap_times_s"))
+        .nth(1)
+        .unwrap()
+        .trim()
+        .to_string();
+    let changed = blessed.replacen(&format!("    {lap}\n"), "    999.9\n", 1);
+    assert_ne!(changed, blessed);
+    std::fs::write(checking.join("changed.json"), changed).unwrap();
+    for (name, golden) in [("a_same", "same.json"), ("b_changed", "changed.json")] {
+        std::fs::write(
+            checking.join(format!("{name}.toml")),
+            with_golden(&base, golden),
+        )
+        .unwrap();
+    }
+    let rs = run_dir(&checking, Tier::Quick);
+    assert_eq!(
+        (rs[0].status, rs[1].status),
+        (Status::Passed, Status::Failed),
+        "{rs:#?}"
+    );
+    let m = &rs[1].messages;
+    assert!(
+        m[0].starts_with("golden numbers differ from") && m[0].contains("changed.json"),
+        "{m:?}"
+    );
+    assert!(
+        m.len() == 2 && m[1].ends_with(&format!("golden 999.9 | now {lap}")),
+        "{m:?}"
     );
 }

@@ -53,6 +53,11 @@ pub struct RegressArgs {
     /// summary), in the order one machine gives.
     #[arg(long, value_name = "JSON", num_args = 1..)]
     pub merge: Vec<PathBuf>,
+    /// Write the golden numbers of the cases that name a file (`[regress] golden`) from this
+    /// run instead of comparing them: after a change in behaviour that is meant. The golden
+    /// numbers are the quick tier's, compared only without a time limit.
+    #[arg(long, conflicts_with_all = ["full", "merge", "time_limit_s"])]
+    pub bless: bool,
 }
 
 /// Runs `taxi-sim regress`; returns its exit code (0 all passed or known problems, 1 a case
@@ -172,6 +177,7 @@ fn run_here(args: &RegressArgs) -> anyhow::Result<Vec<CaseResult>> {
             maps_dir,
             shard,
             time_limit_s: args.time_limit_s,
+            bless: args.bless,
             stop: &stop,
             started: &|c| {
                 if let Ok(mut r) = running.lock() {

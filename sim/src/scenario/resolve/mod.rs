@@ -14,7 +14,7 @@ mod rows;
 
 use std::collections::HashMap;
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use nalgebra::Point2;
 use toml::Spanned;
@@ -110,6 +110,7 @@ impl Resolver<'_> {
         patches.extend(self.patches(&spec.patches, &world, &mut ids)?);
         let obstacles = self.obstacles(&spec.obstacles, &world, &vehicle, &mut ids)?;
         let known_problem = self.known_problem(&mut spec.expectations)?;
+        let golden = self.golden(spec.regress.golden.take())?;
         if let Some(c) = &spec.config {
             crate::scenario::RunConfig::from_table(c.get_ref().clone())
                 .map_err(|m| LocatedError::at(self.file, self.text, c.span(), "config", m))?;
@@ -133,7 +134,21 @@ impl Resolver<'_> {
             known_problem,
             quick_laps: spec.regress.quick_laps.map(|q| q.0),
             full_only: spec.regress.full_only,
+            golden,
         })
+    }
+
+    /// `[regress] golden`: a `.json` file, relative to the scenario's folder.
+    fn golden(&self, g: Option<Spanned<String>>) -> Result<Option<PathBuf>, LocatedError> {
+        let Some(g) = g else { return Ok(None) };
+        if !g.get_ref().ends_with(".json") {
+            return Err(self.err(
+                g.span(),
+                "regress.golden",
+                "names the golden numbers' file: a path ending in `.json`",
+            ));
+        }
+        Ok(Some(self.dir.join(g.get_ref())))
     }
 
     /// `[expectations] known_problem` and `today`: both or neither; `today` states something.

@@ -1,0 +1,123 @@
+//! Golden numbers of a regression case (`[regress] golden = "FILE.json"`): a rounded summary of
+//! what the vehicle did in the quick tier's laps, compared line by line with the file, so a
+//! change in behaviour fails the case even while every expectation still holds; `regress
+//! --bless` writes the summaries anew after a change that is meant.
+
+use std::path::Path;
+
+use serde_json::{Value, json};
+
+use crate::engine::RunReport;
+use crate::error::{Error, Result};
+
+/// Differing lines shown at most, per case.
+const LINES_SHOWN: usize = 12;
+
+/// Rounds to a multiple of `step` (a summary must not change with the last bits of a float).
+fn round(x: f64, step: f64) -> Value {
+    if x.is_finite() {
+        json!(((x / step).round() * step * 1000.0).round() / 1000.0)
+    } else {
+        Value::Null
+    }
+}
+
+/// Everything in the report that says what the vehicle did, rounded (times to 0.1 s, distances
+/// to 0.05 m; a stop's place on the route to 0.5 m), with the static objects it came nearest
+/// (an airport's lights and signs, ground truth); wall time and real-time factor left out.
+pub fn summary(r: &RunReport) -> Value {
+    json!({
+        "scenario": r.scenario,
+        "seed": r.seed,
+        "expectations_met": r.expectations_met,
+        "laps_completed": r.laps_completed,
+        "lap_times_s": r.lap_times_s.iter().map(|t| round(*t, 0.1)).collect::<Vec<_>>(),
+        "contacts": r.contacts.iter().map(|c| format!("{} by {} at {:.1} s", c.object, c.part, c.time_s)).collect::<Vec<_>>(),
+        "stops": r.stops.iter().map(|s| json!({
+            "start_s": round(s.start_s, 0.1),
+            "end_s": s.end_s.map(|e| round(e, 0.1)),
+            "route_s_m": round(s.route_s_m, 0.5),
+        })).collect::<Vec<_>>(),
+        "min_clearance_m": r.min_clearance_m.iter().map(|d| round(*d, 0.05)).collect::<Vec<_>>(),
+        "obstacles": r.obstacles.iter().map(|o| json!({
+            "id": o.id,
+            "expected": o.expected,
+            "passes": o.passes.iter().map(|p| format!(
+                "lap {} {} offset {} clearance {} {}",
+                p.lap,
+                p.outcome.as_str(),
+                round(p.max_offset_m, 0.05),
+                p.min_clearance_m.iter().map(|d| round(*d, 0.05).to_string()).collect::<Vec<_>>().join("/"),
+                if p.met { "met" } else { "NOT MET" },
+            )).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "closest_static": r.closest_static.iter().map(|c| format!(
+            "{} {}", c.id, round(c.min_clearance_m, 0.05)
+        )).collect::<Vec<_>>(),
+        "sim_time_s": round(r.sim_time_s, 0.1),
+    })
+}
+
+/// The summary as the golden file holds it: pretty JSON, one field a line, a final newline.
+pub fn text(summary: &Value) -> String {
+    serde_json::to_string_pretty(summary).unwrap_or_default() + "\n"
+}
+
+/// Compares `summary` with the golden file at `path`; with `bless`, writes it there instead
+/// (atomically). Returns the lines saying how they differ (empty: the same, or blessed); a
+/// missing file is a difference that says how to write it.
+pub fn check(path: &Path, summary: &Value, bless: bool) -> Result<Vec<String>> {
+    let now = text(summary);
+    if bless {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+                what: "creating the golden file's folder",
+                path: dir.to_path_buf(),
+                source,
+            })?;
+        }
+        mapper::write_atomically(path, now.as_bytes())?;
+        return Ok(Vec::new());
+    }
+    let want = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) => {
+            return Ok(vec![format!(
+                "golden numbers {}: {e}; write them with `taxi-sim regress FILE --bless`",
+                path.display()
+            )]);
+        }
+    };
+    Ok(differences(path, &want, &now))
+}
+
+/// How `now` differs from the golden text `want`, line by line (empty: the same).
+pub fn differences(path: &Path, want: &str, now: &str) -> Vec<String> {
+    if want == now {
+        return Vec::new();
+    }
+    let (w, n): (Vec<&str>, Vec<&str>) = (want.lines().collect(), now.lines().collect());
+    let mut out = vec![format!(
+        "golden numbers differ from {} (`taxi-sim regress FILE --bless` if the change is meant):",
+        path.display()
+    )];
+    let differing = (0..w.len().max(n.len()))
+        .filter(|&i| w.get(i) != n.get(i))
+        .collect::<Vec<_>>();
+    for &i in differing.iter().take(LINES_SHOWN) {
+        let shown = |l: Option<&&str>| l.map_or("(no line)".to_string(), |l| l.trim().to_string());
+        out.push(format!(
+            "line {}: golden {} | now {}",
+            i + 1,
+            shown(w.get(i)),
+            shown(n.get(i))
+        ));
+    }
+    if differing.len() > LINES_SHOWN {
+        out.push(format!(
+            "... and {} more lines",
+            differing.len() - LINES_SHOWN
+        ));
+    }
+    out
+}
