@@ -222,14 +222,17 @@ pub fn run_cases(cases: &[Case], opts: &Options<'_>) -> Result<Vec<CaseResult>> 
     order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     let next = AtomicUsize::new(0);
     let workers = opts.jobs.max(1).min(order.len().max(1));
+    // One pool of `jobs` threads for every case: while each worker runs a case, its thread
+    // helps the other case's parallel parts whenever it waits on its own; once the last cases
+    // are running alone (the longest started first), they get the idle threads.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.jobs.max(1))
+        .build()
+        .map_err(|e| Error::Invalid(format!("thread pool: {e}")))?;
     let mut results: Vec<(usize, CaseResult)> = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..workers)
             .map(|_| {
                 scope.spawn(|| -> Result<Vec<(usize, CaseResult)>> {
-                    let pool = rayon::ThreadPoolBuilder::new()
-                        .num_threads(1)
-                        .build()
-                        .map_err(|e| Error::Invalid(format!("thread pool: {e}")))?;
                     let mut done = Vec::new();
                     loop {
                         let k = next.fetch_add(1, Ordering::Relaxed);
