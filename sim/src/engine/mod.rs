@@ -29,7 +29,8 @@ pub use outcome::{
 pub use pose_error::{ErrorLog, ErrorStats, LocalizationErrors, LocalizationReport};
 pub use pose_source::{LocalizationContext, Localizer, NoisyTruth, PoseSource, Truth, from_config};
 pub use report::{
-    CLOSE_STATIC_M, HiddenObstacle, Progress, RunReport, SpeedLowered, StaticClearance, TimeSplit,
+    CLOSE_STATIC_M, CLOSEST_STATIC_COUNT, HiddenObstacle, Progress, RunReport, SpeedLowered,
+    StaticClearance, TimeSplit,
 };
 pub use rig::{
     RunHandles, RunSetup, distance_cap_m, distance_map_half_size_m, longest_horizon_m, run,

@@ -221,44 +221,36 @@ pub fn run_cases(cases: &[Case], opts: &Options<'_>) -> Result<Vec<CaseResult>> 
         .collect();
     order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     let next = AtomicUsize::new(0);
-    let workers = opts.jobs.max(1).min(order.len().max(1));
-    // One pool of `jobs` threads for every case: while each worker runs a case, its thread
-    // helps the other case's parallel parts whenever it waits on its own; once the last cases
-    // are running alone (the longest started first), they get the idle threads.
+    // One pool of `jobs` threads, each pulling cases (a broadcast: a case is never a job another
+    // thread could take up while it waits on its own). While a thread runs a case it helps the
+    // other cases' parallel parts whenever it waits; a thread with no case left helps the last
+    // ones running (the longest started first).
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs.max(1))
         .build()
         .map_err(|e| Error::Invalid(format!("thread pool: {e}")))?;
-    let mut results: Vec<(usize, CaseResult)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..workers)
-            .map(|_| {
-                scope.spawn(|| -> Result<Vec<(usize, CaseResult)>> {
-                    let mut done = Vec::new();
-                    loop {
-                        let k = next.fetch_add(1, Ordering::Relaxed);
-                        if k >= order.len() || opts.stop.load(Ordering::Relaxed) {
-                            return Ok(done);
-                        }
-                        let (_, i, case) = order[k];
-                        (opts.started)(case);
-                        if let Some(mut r) = run_case(case, opts, &maps, &pool) {
-                            r.index = i;
-                            (opts.progress)(&r);
-                            done.push((i, r));
-                        }
-                    }
-                })
-            })
-            .collect();
-        let mut all = Vec::new();
-        for h in handles {
-            let part = h
-                .join()
-                .unwrap_or_else(|_| Err(Error::Invalid("a regress worker panicked".into())))?;
-            all.extend(part);
-        }
-        Ok::<_, Error>(all)
-    })?;
+    let parts = pool.broadcast(|_| {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            let mut done = Vec::new();
+            loop {
+                let k = next.fetch_add(1, Ordering::Relaxed);
+                if k >= order.len() || opts.stop.load(Ordering::Relaxed) {
+                    return done;
+                }
+                let (_, i, case) = order[k];
+                (opts.started)(case);
+                if let Some(mut r) = run_case(case, opts, &maps, &pool) {
+                    r.index = i;
+                    (opts.progress)(&r);
+                    done.push((i, r));
+                }
+            }
+        }))
+    });
+    let mut results: Vec<(usize, CaseResult)> = Vec::new();
+    for part in parts {
+        results.extend(part.map_err(|_| Error::Invalid("a regress worker panicked".into()))?);
+    }
     results.sort_by_key(|(i, _)| *i);
     Ok(results.into_iter().map(|(_, r)| r).collect())
 }
@@ -325,20 +317,8 @@ fn run_case(
         Err(e) => return Some(error_result(case, opts.tier, e.to_string())),
     };
     let (mut status, mut messages) = verdict(&scenario, &report);
-    // The golden numbers are the quick tier's laps; a time limit cuts the run short of them.
-    if let Some(path) = scenario
-        .golden
-        .as_ref()
-        .filter(|_| opts.tier == Tier::Quick && opts.time_limit_s.is_none())
-    {
-        match golden::check(path, &golden::summary(&report), opts.bless) {
-            Ok(lines) if lines.is_empty() => {}
-            Ok(lines) => {
-                status = Status::Failed;
-                messages.extend(lines);
-            }
-            Err(e) => return Some(error_result(case, opts.tier, e.to_string())),
-        }
+    if let Some(path) = &scenario.golden {
+        golden_numbers(path, &report, opts, &mut status, &mut messages);
     }
     let mut r = blank(case, &scenario, opts.tier);
     r.laps_in_file = laps_in_file;
@@ -362,6 +342,40 @@ fn run_case(
     r.wall_time_s = t0.elapsed().as_secs_f64();
     r.real_time_factor = report.real_time_factor;
     Some(r)
+}
+
+/// A case's golden numbers: compared with the file, or written there (`--bless`, a case that
+/// did not fail), in the quick tier without a time limit (the laps they hold); a difference
+/// fails the case, a file blessed says so.
+fn golden_numbers(
+    path: &Path,
+    report: &RunReport,
+    opts: &Options<'_>,
+    status: &mut Status,
+    messages: &mut Vec<String>,
+) {
+    if opts.tier != Tier::Quick || opts.time_limit_s.is_some() {
+        return;
+    }
+    if opts.bless && *status == Status::Failed {
+        messages.push(format!("not blessed (the case failed): {}", path.display()));
+        return;
+    }
+    match golden::check(path, &golden::summary(report), opts.bless) {
+        Ok(lines) if lines.is_empty() => {
+            if opts.bless {
+                messages.push(format!("golden numbers blessed: {}", path.display()));
+            }
+        }
+        Ok(lines) => {
+            *status = Status::Failed;
+            messages.extend(lines);
+        }
+        Err(e) => {
+            *status = Status::Failed;
+            messages.push(format!("golden numbers {}: {e}", path.display()));
+        }
+    }
 }
 
 /// A run's end as its report names it.

@@ -246,13 +246,18 @@ fn golden_numbers_differ_line_by_line_and_a_missing_file_says_how_to_write_it() 
     use super::golden::{check, differences};
     let p = Path::new("g.json");
     assert!(differences(p, "{\n  \"a\": 1\n}\n", "{\n  \"a\": 1\n}\n").is_empty());
-    let d = differences(p, "{\n  \"a\": 1,\n  \"b\": 2\n}\n", "{\n  \"a\": 3\n}\n");
+    // CRLF and a missing last newline are no difference.
+    assert!(differences(p, "{\r\n  \"a\": 1\r\n}\r\n", "{\n  \"a\": 1\n}").is_empty());
+    // A line changed, then a line inserted: the lines after an insertion are not all "changed".
+    let want = "{\n  \"a\": 1,\n  \"b\": 2,\n  \"c\": 3\n}\n";
+    let now = "{\n  \"a\": 9,\n  \"b\": 2,\n  \"x\": 0,\n  \"c\": 3\n}\n";
+    let d = differences(p, want, now);
     assert_eq!(
         d[1..],
         [
-            "line 2: golden \"a\": 1, | now \"a\": 3",
-            "line 3: golden \"b\": 2 | now }",
-            "line 4: golden } | now (no line)",
+            "golden line 2: \"a\": 1,",
+            "now line 2: \"a\": 9,",
+            "now line 4: \"x\": 0,",
         ],
         "{d:?}"
     );
@@ -271,5 +276,5 @@ fn golden_numbers_differ_line_by_line_and_a_missing_file_says_how_to_write_it() 
     assert!(check(&path, &v, true).unwrap().is_empty());
     assert!(check(&path, &v, false).unwrap().is_empty());
     let other = serde_json::json!({"laps_completed": 2});
-    assert_eq!(check(&path, &other, false).unwrap().len(), 2);
+    assert_eq!(check(&path, &other, false).unwrap().len(), 3);
 }

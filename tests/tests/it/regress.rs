@@ -204,8 +204,13 @@ fn golden_numbers_are_blessed_then_matched_and_a_changed_line_fails_the_case() {
         m[0].starts_with("golden numbers differ from") && m[0].contains("changed.json"),
         "{m:?}"
     );
-    assert!(
-        m.len() == 2 && m[1].ends_with(&format!("golden 999.9 | now {lap}")),
+    let lap_line = blessed.lines().position(|l| l.trim() == lap).unwrap() + 1;
+    assert_eq!(
+        m[1..],
+        [
+            format!("golden line {lap_line}: 999.9"),
+            format!("now line {lap_line}: {lap}")
+        ],
         "{m:?}"
     );
 }

@@ -526,3 +526,99 @@ fn a_van_crossing_ahead_stops_the_vehicle_short_of_its_zone() {
     r.restart();
     assert!(r.hold.is_none() && r.last_conflict_s.is_none() && r.streaks.is_empty());
 }
+
+/// A van crossing close ahead of the moving jet (issue 36's crossing traffic): too close to
+/// stop short of its path - standing in it would be the worst choice - the vehicle drives on
+/// when it clears the van by the committed margin (0.5 s, no resume margin); timed tighter, so
+/// that even the committed margin does not clear it, the conflict stands.
+#[test]
+fn a_vehicle_too_close_to_stop_short_drives_on_when_it_clears_the_van_by_the_committed_margin() {
+    // Crossing 20 m ahead at 3 m/s: from 22 m off it reaches the path after the vehicle has
+    // passed by more than the committed margin (from 20.5 to 23 m off: not by the full one);
+    // from 15 m off, not even by that.
+    let (clears_y, tight_y) = (-22.0, -15.0);
+    let config = AutonomyConfig::default();
+    let poses = straight();
+    let crossing = |y: f64| [track(7, 0.0, (20.0, y), (0.0, 3.0), 0b01)];
+    let clears = crossing(clears_y);
+    let i = inputs(&poses, &clears, &[], 0.0, 5.0, &config);
+    let mut r = rules();
+    let full = r
+        .traffic_conflict(&i, 5.0, false)
+        .expect("with the full margin, a conflict");
+    assert!(i.stopping_m >= full.zone_m, "{} {full:?}", i.stopping_m);
+    assert_eq!(r.traffic_conflict(&i, 5.0, true), None);
+    let d = rules().decide(&i);
+    assert_eq!(
+        (d.conflict, d.stop_at_m, d.held_for),
+        (None, None, None),
+        "{d:?}"
+    );
+    let tight = crossing(tight_y);
+    let i = inputs(&poses, &tight, &[], 0.0, 5.0, &config);
+    let d = rules().decide(&i);
+    let c = d
+        .conflict
+        .expect("not cleared even by the committed margin");
+    assert!(i.stopping_m >= c.zone_m, "{} {c:?}", i.stopping_m);
+}
+
+/// A van lost behind the wing strikes it (`van_lost_behind_the_wing_strikes_it`): a mover seen
+/// moving and predicted, then coasting out of view towards the standing vehicle, is remembered;
+/// once its track drops, if it may reach the body within 2 s at up to its peak speed, it is
+/// waited for as one lost there. Not by a moving vehicle, not one heading away, not one that
+/// coasted only briefly.
+#[test]
+fn a_mover_that_coasted_out_of_view_towards_the_standing_jet_is_waited_for_once_dropped() {
+    let config = AutonomyConfig::default();
+    let (cfg, hidden_after_s) = (&config.traffic, config.hidden_after_s);
+    let pose = Isometry2::identity();
+    // Seen last at 10 s, 12 m off the fuselage's side, heading for it at 4 m/s.
+    let coasting = |vy: f64| {
+        let van = track(21, 10.0, (4.0, -13.0), (0.0, vy), 0b01);
+        let mut r = rules();
+        r.streaks.push(MoverStreak {
+            id: 21,
+            last_s: 10.0,
+            since_s: 9.0,
+            mover_s: Some(10.0),
+        });
+        r.predictions = predict(std::slice::from_ref(&van), 10.0, cfg);
+        // Out of view for half a second: coasting, not at the body yet.
+        let held = r.movers_at_body(&[van], &pose, 10.5, true, cfg, hidden_after_s);
+        assert_eq!(held, None);
+        assert_eq!(r.coasting.iter().map(|t| t.id).collect::<Vec<_>>(), [21]);
+        r
+    };
+    // Dropped 2.5 s after it was last seen: waited for where it was last seen, lost.
+    let mut r = coasting(4.0);
+    assert_eq!(
+        r.movers_at_body(&[], &pose, 12.5, true, cfg, hidden_after_s),
+        Some(BodyHold::Lost {
+            at: Point2::new(4.0, -13.0),
+            last_seen_s: 10.0
+        })
+    );
+    // ... and for good: not seen away.
+    assert!(matches!(
+        r.movers_at_body(&[], &pose, 30.0, true, cfg, hidden_after_s),
+        Some(BodyHold::Lost { .. })
+    ));
+    // A moving vehicle leaves it to the space-time check.
+    let mut r = coasting(4.0);
+    assert_eq!(
+        r.movers_at_body(&[], &pose, 12.5, false, cfg, hidden_after_s),
+        None
+    );
+    // One heading away, or out of view only a second before its track dropped: let go.
+    let mut r = coasting(-4.0);
+    assert_eq!(
+        r.movers_at_body(&[], &pose, 12.5, true, cfg, hidden_after_s),
+        None
+    );
+    let mut r = coasting(4.0);
+    assert_eq!(
+        r.movers_at_body(&[], &pose, 11.0, true, cfg, hidden_after_s),
+        None
+    );
+}

@@ -125,6 +125,12 @@ fn bad_paths_globs_and_numbers_are_refused_by_name() {
         ),
         (&["regress", "."][..], "no scenario files under ."),
         (&["regress", ".", "--shard", "3/2"][..], "3/2"),
+        // Golden numbers are the quick tier's whole run: not blessed from --full or a cut run.
+        (&["regress", ".", "--bless", "--full"][..], "--full"),
+        (
+            &["regress", ".", "--bless", "--time-limit-s", "5"][..],
+            "--time-limit-s",
+        ),
     ] {
         let (code, _, err) = taxi_sim(d.path(), args);
         assert_eq!(code, 2, "{args:?}: {err}");
