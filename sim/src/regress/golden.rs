@@ -8,7 +8,7 @@ use std::path::Path;
 use serde_json::{Value, json};
 
 use crate::engine::{CLOSEST_STATIC_COUNT, RunReport, StaticClearance};
-use crate::error::{Error, Result};
+use crate::error::Result;
 
 /// Differing lines shown at most, per case.
 const LINES_SHOWN: usize = 12;
@@ -96,14 +96,7 @@ pub fn text(summary: &Value) -> String {
 pub fn check(path: &Path, summary: &Value, bless: bool) -> Result<Vec<String>> {
     let now = text(summary);
     if bless {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|source| Error::Io {
-                what: "creating the golden file's folder",
-                path: dir.to_path_buf(),
-                source,
-            })?;
-        }
-        mapper::write_atomically(path, now.as_bytes())?;
+        super::results::write(path, &now)?;
         return Ok(Vec::new());
     }
     let want = match std::fs::read_to_string(path) {

@@ -151,11 +151,11 @@ fn test_case(r: &CaseResult) -> TestCase {
     case
 }
 
-/// Writes `text` to `path` atomically.
-fn write(path: &Path, text: &str) -> Result<()> {
+/// Writes `text` to `path` atomically, its folder made if missing.
+pub(super) fn write(path: &Path, text: &str) -> Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|source| Error::Io {
-            what: "creating the results' folder",
+            what: "creating the folder",
             path: dir.to_path_buf(),
             source,
         })?;
