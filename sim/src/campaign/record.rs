@@ -219,6 +219,13 @@ pub fn failures_of(scenario: &Scenario, r: &RunReport) -> (Vec<String>, usize) {
             .unwrap_or_default();
         failures.push(format!("ended {end}, expected {:?}", scenario.expected_end).to_lowercase());
     }
+    if let Some(m) = scenario.max_stops.filter(|&m| r.stops.len() > m) {
+        failures.push(format!("{} stops, at most {m} expected", r.stops.len()));
+    }
+    failures.extend(crate::engine::localization_misses(
+        scenario,
+        r.localization.as_ref(),
+    ));
     if !r.expectations_met && failures.is_empty() {
         failures.push("an expectation was not met".into());
     }

@@ -26,7 +26,9 @@ pub use observer::{NoObserver, Observer, Observers, RevolutionFrame, RunStart, S
 pub use outcome::{
     AT_FAULT_SPEED_M_S, EndReason, Event, JudgedContact, ObstacleReport, Pass, PassOutcome, Stop,
 };
-pub use pose_error::{ErrorLog, ErrorStats, LocalizationErrors, LocalizationReport};
+pub use pose_error::{
+    ErrorLog, ErrorStats, LocalizationErrors, LocalizationReport, localization_misses,
+};
 pub use pose_source::{LocalizationContext, Localizer, NoisyTruth, PoseSource, Truth, from_config};
 pub use report::{
     CLOSE_STATIC_M, CLOSEST_STATIC_COUNT, HiddenObstacle, Progress, RunReport, SpeedLowered,

@@ -128,6 +128,40 @@ impl ErrorLog {
     }
 }
 
+/// What the run's localization missed of the scenario's `[expectations]`
+/// (`max_cross_track_rmse_m`, `max_heading_rmse_rad`) over the whole run, one line each with the
+/// numbers; nothing when the run had no estimate to compare (the true pose).
+pub fn localization_misses(
+    scenario: &crate::scenario::Scenario,
+    report: Option<&LocalizationReport>,
+) -> Vec<String> {
+    let Some(run) = report.map(|r| &r.run) else {
+        return Vec::new();
+    };
+    // Within the bound, or a miss (a NaN error is one too).
+    let within = |x: f64, max: f64| x.partial_cmp(&max).is_some_and(|o| o.is_le());
+    let mut misses = Vec::new();
+    if let Some(max) = scenario
+        .max_cross_track_rmse_m
+        .filter(|&m| !within(run.cross_m.rmse, m))
+    {
+        misses.push(format!(
+            "cross-track RMSE {:.3} m, at most {max} m expected",
+            run.cross_m.rmse
+        ));
+    }
+    if let Some(max) = scenario
+        .max_heading_rmse_rad
+        .filter(|&m| !within(run.heading_rad.rmse, m))
+    {
+        misses.push(format!(
+            "heading RMSE {:.4} rad, at most {max} rad expected",
+            run.heading_rad.rmse
+        ));
+    }
+    misses
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

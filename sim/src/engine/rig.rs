@@ -344,10 +344,13 @@ impl<'a> Rig<'a> {
         let verdict = self
             .judge
             .verdict(end, self.scenario.expected_end, &contacts);
+        let localization = self.localization_errors.as_ref().map(|l| l.report());
+        let localized =
+            super::pose_error::localization_misses(self.scenario, localization.as_ref());
         RunReport {
             scenario: self.scenario.name.clone(),
             seed: self.seed,
-            expectations_met: verdict.expectations_met,
+            expectations_met: verdict.expectations_met && localized.is_empty(),
             end,
             waiting_for,
             laps: self.laps,
@@ -374,7 +377,7 @@ impl<'a> Rig<'a> {
                 spurious_returns: self.spurious_returns.load(Ordering::Relaxed),
                 ..self.fault_counts
             },
-            localization: self.localization_errors.as_ref().map(|l| l.report()),
+            localization,
             speed_lowered: self
                 .driver
                 .route_speed_lowered()

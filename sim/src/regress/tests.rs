@@ -278,3 +278,45 @@ fn golden_numbers_differ_line_by_line_and_a_missing_file_says_how_to_write_it() 
     let other = serde_json::json!({"laps_completed": 2});
     assert_eq!(check(&path, &other, false).unwrap().len(), 3);
 }
+
+#[test]
+fn localization_bounds_name_the_error_and_a_run_without_an_estimate_has_none() {
+    use crate::engine::{ErrorStats, LocalizationErrors, LocalizationReport, localization_misses};
+    let s = scenario_with(
+        "[expectations]\nmax_cross_track_rmse_m = 0.1\nmax_heading_rmse_rad = 0.01\nmax_stops = 2\n",
+    )
+    .unwrap();
+    assert_eq!(s.max_stops, Some(2));
+    let report = |cross: f64, heading: f64| LocalizationReport {
+        run: LocalizationErrors {
+            cross_m: ErrorStats {
+                rmse: cross,
+                ..ErrorStats::default()
+            },
+            heading_rad: ErrorStats {
+                rmse: heading,
+                ..ErrorStats::default()
+            },
+            ..LocalizationErrors::default()
+        },
+        laps: Vec::new(),
+    };
+    assert!(localization_misses(&s, Some(&report(0.1, 0.01))).is_empty());
+    assert!(localization_misses(&s, None).is_empty());
+    assert_eq!(
+        localization_misses(&s, Some(&report(0.1234, 0.02))),
+        [
+            "cross-track RMSE 0.123 m, at most 0.1 m expected",
+            "heading RMSE 0.0200 rad, at most 0.01 rad expected"
+        ]
+    );
+    assert_eq!(
+        localization_misses(&s, Some(&report(f64::NAN, 0.0))).len(),
+        1
+    );
+    // Unchecked without the bounds; a bound must be positive.
+    let plain = scenario_with("").unwrap();
+    assert!(localization_misses(&plain, Some(&report(5.0, 1.0))).is_empty());
+    let e = scenario_with("[expectations]\nmax_cross_track_rmse_m = 0.0\n").unwrap_err();
+    assert!(e.contains("max_cross_track_rmse_m"), "{e}");
+}

@@ -383,6 +383,13 @@ pub struct Scenario {
     pub expected_end: ExpectedEnd,
     /// `[expectations] no_contact_at_fault`: a contact while the vehicle moved fails the run.
     pub no_contact_at_fault: bool,
+    /// `[expectations] max_stops`: at most this many stops over the run (`None`: not checked).
+    pub max_stops: Option<usize>,
+    /// `[expectations] max_cross_track_rmse_m`: the pose estimate's cross-track RMSE over the
+    /// run at most this, metres (`None`: not checked; nor without an estimate).
+    pub max_cross_track_rmse_m: Option<f64>,
+    /// `[expectations] max_heading_rmse_rad`: its heading RMSE at most this, radians.
+    pub max_heading_rmse_rad: Option<f64>,
     /// The `[config]` table (validated): the run configuration over the defaults.
     pub config: Option<toml::Table>,
     /// `[expectations] known_problem` with its `today`: the run is known not to meet its

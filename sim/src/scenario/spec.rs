@@ -91,6 +91,14 @@ pub struct ExpectationsSpec {
     /// rule. Default false.
     #[serde(default)]
     pub no_contact_at_fault: bool,
+    /// At most this many stops over the whole run (stops for obstacles, real or not): a stack
+    /// that stops again and again on a clear way fails it. Default none: not checked.
+    pub max_stops: Option<usize>,
+    /// The pose estimate's cross-track RMSE over the run, metres, > 0: at most this. Checked when
+    /// the stack estimates its pose (the particle filter, noisy truth); default none.
+    pub max_cross_track_rmse_m: Option<Positive>,
+    /// The pose estimate's heading RMSE over the run, radians, > 0: at most this (as above).
+    pub max_heading_rmse_rad: Option<Positive>,
     /// A known problem: the run does not meet the expectations above today, and this text says
     /// why. Given with `today` (the outcome as it is now), `taxi-sim regress` reports the case as
     /// an expected failure while it still ends as `today` states, and as a failure once it meets

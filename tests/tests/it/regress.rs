@@ -2,6 +2,7 @@
 //! known problem that still fails as stated (expected failure), one that was fixed and one that
 //! changed (both failures, as pytest's strict xfail), a file that is not a scenario (an error,
 //! the run going on), and a campaign file beside them (skipped). The four runs share one map.
+//! A copy of the low bar that allows no stop fails on `max_stops` with the count.
 //! Then golden numbers: written by `--bless`, the same run matches them, a changed line fails.
 
 use std::path::{Path, PathBuf};
@@ -75,6 +76,13 @@ fn regress_reports_passes_known_problems_fixed_and_changed_ones_and_bad_files() 
         &mark(&expecting_deviation(&base), "end = \"blocked\""),
     );
     write("e_broken.toml", "name = \"broken\"\nlaps = \"many\"\n");
+    // The low bar: one stop for it, where the copy allows none.
+    let low_bar = shipped("low_bar_car");
+    let golden = low_bar.find("[regress]").unwrap();
+    write(
+        "f_stops.toml",
+        &low_bar[..golden].replace("max_stops = 1\n", "max_stops = 0\n"),
+    );
     std::fs::create_dir(d.path().join("campaigns")).unwrap();
     std::fs::write(
         d.path().join("campaigns/family.toml"),
@@ -92,6 +100,7 @@ fn regress_reports_passes_known_problems_fixed_and_changed_ones_and_bad_files() 
             ("c_fixed", Status::Failed),
             ("d_changed", Status::Failed),
             ("e_broken", Status::Error),
+            ("f_stops", Status::Failed),
         ],
         "{rs:#?}"
     );
@@ -113,6 +122,7 @@ fn regress_reports_passes_known_problems_fixed_and_changed_ones_and_bad_files() 
         broken.contains("e_broken.toml:2") && broken.contains("laps"),
         "{broken}"
     );
+    assert_eq!(by("f_stops").messages, ["1 stops, at most 0 expected"]);
     let pass = by("a_pass");
     assert_eq!(pass.end.as_deref(), Some("completed"));
     assert!(
@@ -137,7 +147,7 @@ fn regress_reports_passes_known_problems_fixed_and_changed_ones_and_bad_files() 
             c.errors,
             c.exit_code()
         ),
-        (1, 1, 2, 1, 2)
+        (1, 1, 3, 1, 2)
     );
     // JUnit: one suite (the folder), the known problem skipped with its text.
     let xml = junit("r", &rs).to_string().unwrap();

@@ -53,6 +53,11 @@ pub struct BenchArgs {
     /// `.ci/check_figures`.
     #[arg(long, value_name = "FILE")]
     pub json_out: Option<PathBuf>,
+    /// `bench figures`: end each run at this simulated time, seconds (the mapping drive is
+    /// never cut): a shorter measurement of the same map and, peak memory being flat in the
+    /// route's length, of about the same peak (CI's).
+    #[arg(long, value_name = "S")]
+    pub time_limit_s: Option<f64>,
     /// `bench representations`: how they are compared.
     #[command(flatten)]
     pub representations: super::representations::RepresentationArgs,
@@ -95,6 +100,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             out: args.out.as_deref(),
             keep: args.keep,
             json_out: args.json_out.as_deref(),
+            time_limit_s: args.time_limit_s,
         });
     }
     if let BenchTarget::Representations = args.what {

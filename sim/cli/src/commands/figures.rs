@@ -8,6 +8,11 @@
 //! (`ru_maxrss` from `wait4`, Linux only) and its wall time (informational); per map built: its
 //! size on disk (every regular file under the directory, recursively), its block files and the
 //! manifest's occupied cells per level. MB is 10^6 bytes throughout.
+//!
+//! `--time-limit-s S` ends each child's lap at S seconds of simulated time (CI's measurement):
+//! the maps are the mapping drive's, which the limit never cuts, so their figures are the same,
+//! and peak memory is flat in the route's length (docs/performance.md), so it moves by a few
+//! percent at most - both shown side by side in that document.
 
 use std::fmt::Write as _;
 use std::io;
@@ -41,6 +46,8 @@ pub struct FiguresOptions<'a> {
     pub keep: bool,
     /// Also write the JSON object to this file, atomically.
     pub json_out: Option<&'a Path>,
+    /// Each child run's `--time-limit-s` (default: none, the whole lap).
+    pub time_limit_s: Option<f64>,
 }
 
 /// One child `taxi-sim run`, measured.
@@ -76,6 +83,12 @@ pub fn run(options: &FiguresOptions<'_>) -> anyhow::Result<()> {
         "`bench figures` needs Linux: the peak memory of a child process comes from wait4's \
          ru_maxrss"
     );
+    if let Some(t) = options.time_limit_s {
+        anyhow::ensure!(
+            t.is_finite() && t > 0.0,
+            "--time-limit-s {t}: a positive number of seconds"
+        );
+    }
     for scenario in [AERODROME, PARKING_LOT] {
         anyhow::ensure!(
             Path::new(scenario).is_file(),
@@ -99,7 +112,12 @@ pub fn run(options: &FiguresOptions<'_>) -> anyhow::Result<()> {
         ensure_absent_or_empty(dir)?;
     }
     let exe = std::env::current_exe().context("finding this binary")?;
-    let figures = measure(&exe, &work, &aerodrome_map, &parking_lot_map).with_context(|| {
+    let children = Children {
+        exe: &exe,
+        work: &work,
+        time_limit_s: options.time_limit_s,
+    };
+    let figures = measure(&children, &aerodrome_map, &parking_lot_map).with_context(|| {
         format!(
             "measuring the figures (the working directory {} is kept)",
             work.display()
@@ -144,8 +162,7 @@ fn ensure_absent_or_empty(dir: &Path) -> anyhow::Result<()> {
 
 /// The three runs, with a spinner; the JSON object of their figures.
 fn measure(
-    exe: &Path,
-    work: &Path,
+    children: &Children<'_>,
     aerodrome_map: &Path,
     parking_lot_map: &Path,
 ) -> anyhow::Result<Value> {
@@ -155,7 +172,7 @@ fn measure(
         let message = format!("{what}...");
         progress.set_message(message.clone());
         progress.suspend(|| eprintln!("{message}"));
-        let figures = run_child(exe, work, label, scenario, map)?;
+        let figures = children.run(label, scenario, map)?;
         progress.suspend(|| {
             eprintln!(
                 "  {:.1} s wall, peak memory {:.0} MB{}",
@@ -199,6 +216,7 @@ fn measure(
     let parking_lot = map_figures(parking_lot_map)?;
     progress.finish_and_clear();
     Ok(json!({
+        "time_limit_s": children.time_limit_s,
         "aerodrome_first_run": first_run_json(&aerodrome_first, &aerodrome),
         "aerodrome_later_run": run_json(&aerodrome_later),
         "parking_lot_first_run": first_run_json(&parking_lot_first, &parking_lot),
@@ -230,28 +248,46 @@ fn first_run_json(run: &RunFigures, map: &MapFigures) -> Value {
     value
 }
 
-/// Runs `taxi-sim run SCENARIO --laps 1 --map-dir MAP --report WORK/LABEL.json`, its output to
-/// `WORK/LABEL.stdout.txt` and `.stderr.txt`; its peak memory and wall time.
-fn run_child(
+/// How the child runs are started: this binary, in the working directory, with the time limit.
+struct Children<'a> {
+    exe: &'a Path,
+    work: &'a Path,
+    time_limit_s: Option<f64>,
+}
+
+impl Children<'_> {
+    /// Runs `taxi-sim run SCENARIO --laps 1 --map-dir MAP --report WORK/LABEL.json` (and
+    /// `--time-limit-s S` when given), its output to `WORK/LABEL.stdout.txt` and `.stderr.txt`;
+    /// its peak memory and wall time.
+    fn run(&self, label: &str, scenario: &str, map: &Path) -> anyhow::Result<RunFigures> {
+        let (exe, work) = (self.exe, self.work);
+        let report = work.join(format!("{label}.json"));
+        let stdout_path = work.join(format!("{label}.stdout.txt"));
+        let stderr_path = work.join(format!("{label}.stderr.txt"));
+        let mut args: Vec<std::ffi::OsString> = vec![
+            "run".into(),
+            scenario.into(),
+            "--laps".into(),
+            "1".into(),
+            "--map-dir".into(),
+            map.into(),
+            "--report".into(),
+            report.into(),
+        ];
+        if let Some(t) = self.time_limit_s {
+            args.extend(["--time-limit-s".into(), t.to_string().into()]);
+        }
+        run_measured(exe, &args, &stdout_path, &stderr_path)
+    }
+}
+
+/// Runs `exe ARGS`, its output to the two files; its peak memory and wall time.
+fn run_measured(
     exe: &Path,
-    work: &Path,
-    label: &str,
-    scenario: &str,
-    map: &Path,
+    args: &[std::ffi::OsString],
+    stdout_path: &Path,
+    stderr_path: &Path,
 ) -> anyhow::Result<RunFigures> {
-    let report = work.join(format!("{label}.json"));
-    let stdout_path = work.join(format!("{label}.stdout.txt"));
-    let stderr_path = work.join(format!("{label}.stderr.txt"));
-    let args: Vec<std::ffi::OsString> = vec![
-        "run".into(),
-        scenario.into(),
-        "--laps".into(),
-        "1".into(),
-        "--map-dir".into(),
-        map.into(),
-        "--report".into(),
-        report.into(),
-    ];
     let command = std::iter::once(exe.as_os_str())
         .chain(args.iter().map(|a| a.as_os_str()))
         .map(|a| a.to_string_lossy())
@@ -262,10 +298,10 @@ fn run_child(
     };
     let start = Instant::now();
     let child = Command::new(exe)
-        .args(&args)
+        .args(args)
         .stdin(Stdio::null())
-        .stdout(create(&stdout_path)?)
-        .stderr(create(&stderr_path)?)
+        .stdout(create(stdout_path)?)
+        .stderr(create(stderr_path)?)
         .spawn()
         .with_context(|| format!("starting `{command}`"))?;
     let (status, peak_kib) =
@@ -277,7 +313,7 @@ fn run_child(
         _ => anyhow::bail!(
             "`{command}` failed ({status}); the end of its error output ({}):\n{}",
             stderr_path.display(),
-            tail(&stderr_path, 10)
+            tail(stderr_path, 10)
         ),
     };
     Ok(RunFigures {

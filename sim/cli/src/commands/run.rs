@@ -32,6 +32,10 @@ pub struct RunArgs {
     /// Laps (default: the scenario's; at least 1).
     #[arg(long)]
     pub laps: Option<u32>,
+    /// End the run at this simulated time, seconds, when its own limit (60 s plus four times
+    /// the route's length over its speed) is later; the mapping drive is not cut.
+    #[arg(long, value_name = "S")]
+    pub time_limit_s: Option<f64>,
     /// Run configuration (TOML; `taxi-sim config` prints the defaults). Flags below override it.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
@@ -116,6 +120,12 @@ pub fn run(args: &RunArgs) -> anyhow::Result<bool> {
         args.laps != Some(0),
         "--laps 0: a run drives at least one lap"
     );
+    if let Some(t) = args.time_limit_s {
+        anyhow::ensure!(
+            t.is_finite() && t > 0.0,
+            "--time-limit-s {t}: a positive number of seconds"
+        );
+    }
     let scenario = Scenario::from_file(&args.scenario)?;
     let config = run_config(args, &scenario)?;
     let replay_options = args.replay_options();
@@ -126,6 +136,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<bool> {
         laps: args.laps,
         seed: args.seed,
         config,
+        time_limit_s: args.time_limit_s,
         ..RunSetup::new(dir)
     };
     let stop = Arc::new(AtomicBool::new(false));

@@ -84,6 +84,7 @@ pub struct Judge {
     /// Every contact judged, in the world's order.
     contacts: Vec<JudgedContact>,
     no_contact_at_fault: bool,
+    max_stops: Option<usize>,
     wheelbase_m: f64,
     /// How far the vehicle's parts reach ahead of its reference point, metres.
     front_m: f64,
@@ -176,6 +177,7 @@ impl Judge {
             events: Vec::new(),
             contacts: Vec::new(),
             no_contact_at_fault: scenario.no_contact_at_fault,
+            max_stops: scenario.max_stops,
             wheelbase_m: scenario.vehicle.vehicle.spec.motion.wheelbase_m,
             front_m: parts
                 .iter()
@@ -316,7 +318,8 @@ impl Judge {
 
     /// The verdicts: the run ended as `expected` (every lap driven, or waiting for a hidden
     /// obstacle), every obstacle passed as expected on every pass, no contact (with
-    /// `no_contact_at_fault`: none while the vehicle moved); each mover's traffic conflicts.
+    /// `no_contact_at_fault`: none while the vehicle moved), no more stops than `max_stops`;
+    /// each mover's traffic conflicts.
     pub fn verdict(
         mut self,
         end: EndReason,
@@ -355,8 +358,9 @@ impl Judge {
         } else {
             contacts.is_empty()
         };
+        let stops_ok = self.max_stops.is_none_or(|m| self.stops.len() <= m);
         Verdict {
-            expectations_met: ended_as_expected && every_pass_met && contact_ok,
+            expectations_met: ended_as_expected && every_pass_met && contact_ok && stops_ok,
             laps_completed: self.laps_completed(),
             lap_times_s: self.lap_times_s,
             obstacles: self.obstacles,
