@@ -70,6 +70,9 @@ enum ModelCommand {
     Fit(commands::model::ModelFitArgs),
     /// Print every part's underside and the candidate heights of interest they give.
     Levels(commands::model::ModelLevelsArgs),
+    /// What the vehicle's LiDAR cannot see, per height level: the blind ground around the
+    /// airframe (area, nearest to each gear and wing tip, how far ahead), with a picture.
+    Coverage(commands::coverage::ModelCoverageArgs),
 }
 
 /// Raised by [`emit`] when stdout's reader went away (`taxi-sim ... | head`): not an error.
@@ -133,6 +136,7 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
         Command::Bench(args) => commands::bench::run(&args),
         Command::Model(ModelCommand::Fit(args)) => commands::model::run(&args),
         Command::Model(ModelCommand::Levels(args)) => commands::model::levels(&args),
+        Command::Model(ModelCommand::Coverage(args)) => commands::coverage::run(&args),
         Command::SmallObstacles(args) => commands::small::run(&args),
         Command::CompareLidar(args) => commands::compare_lidar::run(&args),
         Command::Check(args) => commands::check::run(&args),

@@ -6,6 +6,7 @@ pub mod bench;
 pub mod campaign;
 pub mod check;
 pub mod compare_lidar;
+pub mod coverage;
 pub mod demo;
 pub mod figures;
 pub mod map;

@@ -244,3 +244,41 @@ fn run_with_a_map_cache_builds_the_map_once_and_reuses_it() {
         "{err}"
     );
 }
+
+#[test]
+fn model_coverage_reports_each_level_and_draws_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let pictures = dir.path().join("pictures");
+    let (code, stdout, stderr) = taxi_sim(&[
+        "model",
+        "coverage",
+        "praetor600",
+        "--margin-m",
+        "6",
+        "--json",
+        "--picture",
+        pictures.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let c: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let levels = c["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 2, "{stdout}");
+    // Level 0's object is the 0.1 m the map holds; level 1's the 1.1 m height of interest.
+    assert_eq!(levels[0]["object_height_m"], 0.1);
+    assert_eq!(levels[1]["object_height_m"], 1.1);
+    assert!(
+        levels
+            .iter()
+            .all(|l| l["blind_area_m2"].as_f64().unwrap() > 0.0)
+    );
+    for ext in ["svg", "png"] {
+        assert!(
+            pictures
+                .join(format!("coverage-praetor600.{ext}"))
+                .is_file()
+        );
+    }
+    let (code, _, stderr) = taxi_sim(&["model", "coverage", "praetor600", "--cell-m", "0"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("cell"), "{stderr}");
+}

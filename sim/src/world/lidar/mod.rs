@@ -585,6 +585,21 @@ impl Lidar {
         })
     }
 
+    /// Every ray of a revolution in the vehicle frame, `[column * beams + beam]`: its unit
+    /// direction and how far it goes before the vehicle itself stops it (`None`: it does not),
+    /// metres - the self-occlusion the casts above use, from the sensor's mount.
+    pub fn rays_in_vehicle(&self, world: &World) -> Vec<([f64; 3], Option<f64>)> {
+        let rotation = self.vehicle_from_sensor.rotation;
+        self.directions
+            .iter()
+            .zip(self.self_hits(world))
+            .map(|(d, hit)| {
+                let v = rotation * Vector3::new(f64::from(d[0]), f64::from(d[1]), f64::from(d[2]));
+                ([v.x, v.y, v.z], hit.as_ref().map(|(t, _)| f64::from(*t)))
+            })
+            .collect()
+    }
+
     /// Elevations of the beams, radians, lowest first.
     pub fn elevations_rad(&self) -> &[f64] {
         &self.elevations_rad
