@@ -144,7 +144,9 @@ pub fn coverage(
             options.cell_m, options.margin_m, options.low_object_m
         )));
     }
-    let (lo, hi) = parts_bounds(vehicle);
+    // The vehicle's origin inside too.
+    let origin = Point2::new(0.0, 0.0);
+    let (lo, hi) = bounds(vehicle.parts.iter(), (origin, origin));
     let grid = GroundGrid {
         min_m: [lo.x - options.margin_m, lo.y - options.margin_m],
         cell_m: options.cell_m,
@@ -191,17 +193,19 @@ pub fn coverage(
     })
 }
 
-/// The parts' footprints' bounds.
-fn parts_bounds(vehicle: &aircraft::Vehicle) -> (Point2<f64>, Point2<f64>) {
-    vehicle.parts.iter().map(|p| p.footprint().bounds()).fold(
-        (Point2::new(0.0, 0.0), Point2::new(0.0, 0.0)),
-        |(lo, hi), (a, b)| {
+/// The parts' footprints' bounds, grown from `start` (a box around a point).
+fn bounds<'a>(
+    parts: impl Iterator<Item = &'a aircraft::Part>,
+    start: (Point2<f64>, Point2<f64>),
+) -> (Point2<f64>, Point2<f64>) {
+    parts
+        .map(|p| p.footprint().bounds())
+        .fold(start, |(lo, hi), (a, b)| {
             (
                 Point2::new(lo.x.min(a.x), lo.y.min(a.y)),
                 Point2::new(hi.x.max(b.x), hi.y.max(b.y)),
             )
-        },
-    )
+        })
 }
 
 /// Per cell: some ray passes between the ground and `h` above it before anything stops it.
@@ -307,7 +311,11 @@ fn nearest_blind(
         .collect();
     gears.dedup();
     for gear in gears {
-        let (lo, hi) = link_bounds(low, gear);
+        let empty = (
+            Point2::new(f64::INFINITY, f64::INFINITY),
+            Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        );
+        let (lo, hi) = bounds(low.iter().copied().filter(|p| p.link == gear), empty);
         let distance_m = cells
             .iter()
             .filter(|(x, y)| *x > hi.x && (lo.y..=hi.y).contains(y))
@@ -342,26 +350,6 @@ fn nearest_blind(
         });
     }
     out
-}
-
-/// The bounds of a link's parts.
-fn link_bounds(parts: &[&aircraft::Part], link: &str) -> (Point2<f64>, Point2<f64>) {
-    parts
-        .iter()
-        .filter(|p| p.link == link)
-        .map(|p| p.footprint().bounds())
-        .fold(
-            (
-                Point2::new(f64::INFINITY, f64::INFINITY),
-                Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
-            ),
-            |(lo, hi), (a, b)| {
-                (
-                    Point2::new(lo.x.min(a.x), lo.y.min(a.y)),
-                    Point2::new(hi.x.max(b.x), hi.y.max(b.y)),
-                )
-            },
-        )
 }
 
 /// How far the vehicle must travel straight ahead before every ground cell its level's parts
