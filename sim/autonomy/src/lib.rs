@@ -29,7 +29,7 @@ pub use messages::{Command, LidarRevolution, Odometry, PoseEstimate};
 pub use online_map::{ForgettingConfig, ForgettingRule, OnlineMap, trusted_range_m};
 pub use planner::{AutonomyConfig, Behaviour, Candidate, Plan, avoid, plan, pure_pursuit};
 pub use route::{RoutePath, wrap_angle};
-pub use stack::{Driver, DriverStatus, PilotCall, PlanTimes, VehicleModel};
+pub use stack::{BlindZone, Driver, DriverStatus, PilotCall, PlanTimes, VehicleModel};
 pub use traffic::{Conflict, MoverDecision, MoverInputs, Prediction, TrafficConfig, TrafficRules};
 
 impl Behaviour {

@@ -209,6 +209,7 @@ pub fn failures_of(scenario: &Scenario, r: &RunReport) -> (Vec<String>, usize) {
     let end_met = match scenario.expected_end {
         ExpectedEnd::Completed => r.end == EndReason::Completed,
         ExpectedEnd::WaitingForHiddenObstacle => r.end == EndReason::WaitingForHiddenObstacle,
+        ExpectedEnd::WaitingForWalkAround => r.end == EndReason::WaitingForWalkAround,
         ExpectedEnd::StoppedForGood => r.end != EndReason::Completed,
         ExpectedEnd::Any => true,
     };

@@ -38,7 +38,15 @@ impl Rig<'_> {
             match self.driver.calls_for_pilot(self.t_s) {
                 Some(PilotCall::HiddenObstacle) => return Ok(EndReason::WaitingForHiddenObstacle),
                 Some(PilotCall::Blocked) => return Ok(EndReason::Blocked),
+                Some(PilotCall::WalkAround) => return Ok(EndReason::WaitingForWalkAround),
                 None => {}
+            }
+            if let Some(at_s) = self.walk_around_at_s
+                && self.t_s >= at_s
+            {
+                self.walk_around_at_s = None;
+                self.driver.on_walk_around();
+                observer.event(self.t_s, &Event::WalkAround)?;
             }
             let physics = Instant::now();
             self.move_obstacles();

@@ -69,9 +69,32 @@ pub enum EndReason {
     /// Stopped for an obstacle the sensor could no longer see, the vehicle waited
     /// `pilot_call_after_s` and called for a pilot (the thesis' pilot intervention).
     WaitingForHiddenObstacle,
+    /// Never moved off: part of the ground its first plan sweeps is ground its LiDAR cannot see
+    /// from the start, no walk-around confirmed it (`[vehicle] walk_around`), and after
+    /// `pilot_call_after_s` the vehicle called for a pilot (the start-up rule).
+    WaitingForWalkAround,
     /// Stood for obstacles in its path (in view or hidden) for `blocked_call_after_s` (60 s),
     /// the vehicle called for a pilot: its way is blocked (an aircraft never steers round).
     Blocked,
+}
+
+impl EndReason {
+    /// How a run that did not complete its laps ended, in words for a person (`None` when it
+    /// did): the run's table and the replay's end event say it in brackets.
+    pub fn note(self) -> Option<&'static str> {
+        match self {
+            EndReason::Completed => None,
+            EndReason::TimedOut => Some("timed out"),
+            EndReason::Interrupted => Some("interrupted"),
+            EndReason::WaitingForHiddenObstacle => {
+                Some("waiting for a hidden obstacle: pilot called")
+            }
+            EndReason::Blocked => Some("blocked: pilot called"),
+            EndReason::WaitingForWalkAround => {
+                Some("waiting for a walk-around of ground it cannot see: pilot called")
+            }
+        }
+    }
 }
 
 /// One pass of the vehicle by an obstacle.
@@ -185,6 +208,9 @@ pub enum Event {
         /// Its time, seconds.
         time_s: f64,
     },
+    /// The crew's walk-around confirmed the ground round the vehicle that its LiDAR cannot see
+    /// (`[vehicle] walk_around` at a time): the start-up rule lets it move off.
+    WalkAround,
     /// The stack's watchdog stopped the vehicle (no fresh LiDAR revolution) or let it go again.
     Watchdog {
         /// True when it began holding the vehicle, false when revolutions returned.

@@ -18,10 +18,16 @@ pub struct RunReport {
     /// True when every expectation held and every lap was completed.
     pub expectations_met: bool,
     /// Why the run ended: `completed`, `timed_out`, `interrupted`,
-    /// `waiting_for_hidden_obstacle` or `blocked` (the last two call for a pilot).
+    /// `waiting_for_hidden_obstacle`, `waiting_for_walk_around` or `blocked` (the last three call
+    /// for a pilot).
     pub end: EndReason,
     /// When the run ended waiting for a hidden obstacle: which, and since when.
     pub waiting_for: Option<HiddenObstacle>,
+    /// The start-up rule's first check (when the scenario's walk-around is not before the
+    /// start): the ground the first plan would sweep that the LiDAR cannot see from the start,
+    /// square metres (0: none; the vehicle moved off at once).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub start_unseen_m2: Option<f64>,
     /// Laps asked for.
     pub laps: u32,
     /// Laps completed.

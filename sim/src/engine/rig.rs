@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use autonomy::{
-    AutonomyConfig, Behaviour, Driver, DriverStatus, OnlineMap, RoutePath, VehicleModel,
+    AutonomyConfig, Behaviour, BlindZone, Driver, DriverStatus, OnlineMap, RoutePath, VehicleModel,
 };
 use mapper::{CollisionModel, MultiHeightMap};
 use nalgebra::{Isometry2, Point2};
@@ -24,11 +24,11 @@ use super::pose_source::PoseSource;
 use super::report::{HiddenObstacle, Progress, RunReport, SpeedLowered, TimeSplit};
 use super::schedule::Scheduler;
 use crate::error::{Error, Result};
-use crate::scenario::RunConfig;
-use crate::scenario::Scenario;
+use crate::scenario::{RunConfig, Scenario, WalkAround};
 use crate::world::Captured;
 use crate::world::Lidar;
 use crate::world::World;
+use crate::world::coverage::{CoverageOptions, coverage};
 use crate::world::{Bicycle, VehicleState};
 
 /// What to run besides the scenario: its offline map, laps and seed, and the configuration.
@@ -184,6 +184,8 @@ pub(super) struct Rig<'a> {
     pub(super) watchdog_holding: bool,
     /// Revolutions taken and not yet delivered (LiDAR latency): when each is due, in order.
     pub(super) in_transit: std::collections::VecDeque<(f64, Captured)>,
+    /// When the crew's walk-around is still to come (`[vehicle] walk_around` at a time), seconds.
+    pub(super) walk_around_at_s: Option<f64>,
     /// The live map's scratch directory, removed with the rig.
     pub(super) _live: tempfile::TempDir,
 }
@@ -234,7 +236,11 @@ impl<'a> Rig<'a> {
                 }
             })?;
         let (online, live) = online_map(scenario, &config, &model, setup, &start)?;
-        let driver = driver(scenario, &config, &model, &route);
+        let mut driver = driver(scenario, &config, &model, &route);
+        let walk_around = scenario.vehicle.walk_around;
+        if walk_around != WalkAround::BeforeStart {
+            driver.await_walk_around(blind_zone(vehicle, &config.lidar, &model)?);
+        }
         let first_obstacle = scenario.objects.len();
         let judge = Judge::new(
             scenario,
@@ -294,6 +300,10 @@ impl<'a> Rig<'a> {
             fault_counts: crate::world::FaultCounts::default(),
             watchdog_holding: false,
             in_transit: std::collections::VecDeque::new(),
+            walk_around_at_s: match walk_around {
+                WalkAround::At(t) => Some(t),
+                _ => None,
+            },
             config,
             _live: live,
         })
@@ -320,7 +330,10 @@ impl<'a> Rig<'a> {
         let contacts = self.world.contacts().to_vec();
         if matches!(
             end,
-            EndReason::TimedOut | EndReason::WaitingForHiddenObstacle | EndReason::Blocked
+            EndReason::TimedOut
+                | EndReason::WaitingForHiddenObstacle
+                | EndReason::Blocked
+                | EndReason::WaitingForWalkAround
         ) {
             // The vehicle may stand before an obstacle: its pass closes as it stands.
             self.judge.close_open_passes(self.t_s, end);
@@ -353,6 +366,7 @@ impl<'a> Rig<'a> {
             expectations_met: verdict.expectations_met && localized.is_empty(),
             end,
             waiting_for,
+            start_unseen_m2: self.driver.start_unseen_m2(),
             laps: self.laps,
             laps_completed: verdict.laps_completed,
             lap_times_s: verdict.lap_times_s,
@@ -425,6 +439,29 @@ fn online_map(
         config.mapping.max_return_error_m,
     );
     Ok((online, live))
+}
+
+/// The ground round `vehicle` that its LiDAR (`lidar`) cannot see, per level of `model` (the
+/// levels' heights as the model has them), on 0.2 m cells out to 20 m: what the stack knows of
+/// its own sensor layout for the start-up rule.
+fn blind_zone(
+    vehicle: &aircraft::Vehicle,
+    lidar: &crate::world::LidarConfig,
+    model: &CollisionModel,
+) -> Result<BlindZone> {
+    let mut v = vehicle.clone();
+    v.spec.heights_of_interest_m = model.level_heights_m().to_vec();
+    let options = CoverageOptions {
+        cell_m: 0.2,
+        ..CoverageOptions::default()
+    };
+    let c = coverage(&v, lidar, &options)?;
+    Ok(BlindZone {
+        min_m: c.grid.min_m,
+        cell_m: c.grid.cell_m,
+        cells: c.grid.cells,
+        levels: c.levels.into_iter().map(|l| l.blind).collect(),
+    })
 }
 
 /// The stack under test's driver over `route`, with the vehicle's collision model and motion.

@@ -2,7 +2,7 @@
 
 use rerun::components::TextLogLevel;
 
-use crate::engine::{EndReason, Event, RunReport};
+use crate::engine::{Event, RunReport};
 
 /// An event's line and level (a `TextLogLevel` name).
 pub(super) fn event_line(event: &Event) -> (String, &'static str) {
@@ -19,6 +19,10 @@ pub(super) fn event_line(event: &Event) -> (String, &'static str) {
             TextLogLevel::INFO,
         ),
         Event::BackOnRoute => ("back on the route".to_string(), TextLogLevel::INFO),
+        Event::WalkAround => (
+            "walk-around: the crew confirms the ground the LiDAR cannot see".to_string(),
+            TextLogLevel::INFO,
+        ),
         Event::Watchdog { holding: true } => (
             "watchdog: no fresh LiDAR revolution, stopping".to_string(),
             TextLogLevel::WARN,
@@ -75,13 +79,11 @@ pub(super) fn end_line(report: &RunReport) -> (String, &'static str) {
         } else {
             "expectations not met"
         },
-        match report.end {
-            EndReason::Completed => "",
-            EndReason::TimedOut => " (timed out)",
-            EndReason::Interrupted => " (interrupted)",
-            EndReason::WaitingForHiddenObstacle => " (waiting for a hidden obstacle: pilot called)",
-            EndReason::Blocked => " (blocked: pilot called)",
-        }
+        report
+            .end
+            .note()
+            .map(|n| format!(" ({n})"))
+            .unwrap_or_default()
     );
     let level = if report.expectations_met {
         TextLogLevel::INFO

@@ -37,6 +37,21 @@ pub struct ScenarioVehicle {
     pub vehicle: aircraft::Vehicle,
     /// Start pose of the vehicle frame in the world.
     pub world_from_start: Isometry2<f64>,
+    /// When the crew's walk-around confirms the ground the LiDAR cannot see from the start.
+    pub walk_around: WalkAround,
+}
+
+/// When the crew's walk-around confirms the ground round the vehicle that its LiDAR cannot see
+/// from the start (`[vehicle] walk_around`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum WalkAround {
+    /// Before the run starts: the start-up rule has nothing to wait for.
+    #[default]
+    BeforeStart,
+    /// Never: a vehicle whose first plan sweeps ground it cannot see waits, and calls for a pilot.
+    Never,
+    /// At this simulated time, seconds (> 0): until then it waits as for `Never`.
+    At(f64),
 }
 
 /// The route.

@@ -80,7 +80,9 @@ pub struct ExpectationsSpec {
     pub danger_distance_m: Option<Positive>,
     /// How the run must end: `completed` (every lap driven; the default),
     /// `waiting_for_hidden_obstacle` (stopped for an obstacle the sensor can no longer see, the
-    /// vehicle calls for a pilot rather than guess it has gone) or `stopped_for_good` (stopped
+    /// vehicle calls for a pilot rather than guess it has gone), `waiting_for_walk_around` (it
+    /// never moved off: ground it would sweep first is ground its LiDAR cannot see, and no
+    /// walk-around confirmed it) or `stopped_for_good` (stopped
     /// before an obstacle that never goes, timed out or calling for a pilot: waiting for a
     /// hidden obstacle, or blocked) or `any` (only
     /// contacts and the obstacles' expectations count, and an obstacle never passed counts for
@@ -114,8 +116,8 @@ pub struct ExpectationsSpec {
 #[derive(Debug, Default, Deserialize, serde::Serialize, Clone, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct TodaySpec {
-    /// How the run ends today: `completed`, `timed_out`, `waiting_for_hidden_obstacle` or
-    /// `blocked`.
+    /// How the run ends today: `completed`, `timed_out`, `waiting_for_hidden_obstacle`,
+    /// `waiting_for_walk_around` or `blocked`.
     pub end: Option<TodayEnd>,
     /// Contacts in all.
     pub contacts: Option<usize>,
@@ -137,6 +139,8 @@ pub enum TodayEnd {
     TimedOut,
     /// Waiting for a hidden obstacle: a pilot called.
     WaitingForHiddenObstacle,
+    /// Waiting for a walk-around at the start: a pilot called.
+    WaitingForWalkAround,
     /// Blocked for good: a pilot called.
     Blocked,
 }
@@ -148,6 +152,7 @@ impl TodayEnd {
             TodayEnd::Completed => "completed",
             TodayEnd::TimedOut => "timed_out",
             TodayEnd::WaitingForHiddenObstacle => "waiting_for_hidden_obstacle",
+            TodayEnd::WaitingForWalkAround => "waiting_for_walk_around",
             TodayEnd::Blocked => "blocked",
         }
     }
@@ -177,6 +182,8 @@ pub enum ExpectedEnd {
     Completed,
     /// Waiting for a hidden obstacle, calling for a pilot.
     WaitingForHiddenObstacle,
+    /// Never moved off, waiting for a walk-around, calling for a pilot.
+    WaitingForWalkAround,
     /// Stopped for good before an obstacle that never goes: the run ends timed out or calling
     /// for a pilot (waiting for a hidden obstacle, or blocked), the vehicle still standing.
     StoppedForGood,
@@ -212,6 +219,21 @@ pub struct VehicleEntry {
     /// Start pose of the vehicle frame (origin on the ground under the rear axle / main gear).
     /// Default: on the first route point, heading to the second.
     pub start: Option<Spanned<StartPose>>,
+    /// The crew's walk-around, which confirms the ground round the vehicle that its LiDAR cannot
+    /// see from the start (the stack's start-up rule): `"before_start"` (the default: confirmed
+    /// before the run starts), `"none"` (never: a vehicle whose first plan sweeps blind ground
+    /// waits and calls for a pilot), or a time in seconds (it waits until then).
+    pub walk_around: Option<Spanned<WalkAroundSpec>>,
+}
+
+/// `[vehicle] walk_around`: a word or a time.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub enum WalkAroundSpec {
+    /// `"before_start"` or `"none"`.
+    Word(String),
+    /// Seconds of simulated time.
+    At(f64),
 }
 
 /// A start pose, `{ x_m = .., y_m = .., yaw_rad = .. }`.

@@ -1,11 +1,12 @@
 //! The simulator's side of the message boundary: what a world is made of ([`Scene`]), the Rapier
 //! world holding it with its ground truth ([`World`]: contacts, clearances), the vehicle's motion
 //! ([`Bicycle`]), the sensors ([`Lidar`], [`OdometrySensor`]), the faults between the sensors and
-//! the stack ([`FaultsConfig`]), and the capture of a revolution ([`Sensor`]: cast, degraded,
+//! the stack ([`FaultsConfig`]), what the vehicle's LiDAR cannot see per level ([`coverage`]), and the capture of a revolution ([`Sensor`]: cast, degraded,
 //! re-expressed at the pose estimate). The only module of the crate that names Rapier or parry;
 //! the one place nalgebra (f64) becomes glam (f32).
 
 mod capture;
+pub mod coverage;
 mod faults;
 mod lidar;
 mod motion;

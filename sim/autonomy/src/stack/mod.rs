@@ -19,10 +19,13 @@ use crate::planner::{
 use crate::route::{RoutePath, wrap_angle};
 use crate::traffic::{Conflict, MoverInputs, Prediction, TrafficRules};
 
+mod start;
 mod status;
 #[cfg(test)]
 mod tests;
 
+pub use start::BlindZone;
+use start::StartRule;
 pub use status::{DriverStatus, PilotCall};
 
 /// Half length of the stretch of route searched around the last progress when the estimate is
@@ -79,6 +82,10 @@ pub struct Driver {
     stopped_since_s: Option<f64>,
     /// The rules about movers and what they remember from plan to plan.
     traffic: TrafficRules,
+    /// The start-up rule: the blind zone while it awaits a walk-around.
+    start: StartRule,
+    /// The unseen ground the start-up rule's first check found, square metres.
+    start_unseen_m2: Option<f64>,
 }
 
 impl Driver {
@@ -114,6 +121,8 @@ impl Driver {
             last_revolution_s: None,
             stopped_since_s: None,
             traffic,
+            start: StartRule::Done,
+            start_unseen_m2: None,
         }
     }
 
@@ -235,11 +244,14 @@ impl Driver {
         chosen.collision_at_m = decision.stop_at_m;
         let (mut v, _) = avoid(&chosen, decision.wanted_m_s, decel, &config);
         let body = decision.body.map(|b| self.body_status(b, estimate.t_s));
-        if body.is_some() {
+        let walk_around =
+            self.walk_around_status(&estimate.world_from_vehicle, &chosen.poses, estimate.t_s);
+        if body.is_some() || walk_around.is_some() {
             v = 0.0;
         }
         self.speed_command_m_s = v;
         self.status = match conflict {
+            _ if let Some(waiting) = walk_around => waiting,
             _ if let Some(held) = body => held,
             _ if v > 0.0 => DriverStatus::Driving,
             _ if let Some((obstacle, last_seen_s)) = decision.walker => DriverStatus::StoppedFor {

@@ -32,6 +32,15 @@ pub enum DriverStatus {
         /// When the wait began, seconds.
         since_s: f64,
     },
+    /// Not moved off yet: part of the ground its first plan sweeps is ground its sensors cannot
+    /// see from where it stands, and no walk-around has confirmed it (the start-up rule,
+    /// [`Driver::await_walk_around`]); after `pilot_call_after_s` the run calls for a pilot.
+    WaitingForWalkAround {
+        /// That unseen ground, square metres.
+        unseen_m2: f64,
+        /// When the wait began, seconds.
+        since_s: f64,
+    },
     /// Stopped short of where a mover is predicted to cross its path: it drives on once the
     /// mover is predicted clear.
     Yielding {
@@ -49,6 +58,8 @@ pub enum PilotCall {
     HiddenObstacle,
     /// It has stood for obstacles in its path for `blocked_call_after_s`: the way is blocked.
     Blocked,
+    /// It has waited at the start for a walk-around of ground its sensors cannot see.
+    WalkAround,
 }
 
 impl Driver {
@@ -118,9 +129,14 @@ impl Driver {
     }
 
     /// Whether the driver calls for a pilot at `now_s`, and why: it has waited for a hidden
-    /// obstacle longer than `pilot_call_after_s`, or stood for obstacles longer than
+    /// obstacle or a walk-around longer than `pilot_call_after_s`, or stood for obstacles longer than
     /// `blocked_call_after_s`.
     pub fn calls_for_pilot(&self, now_s: f64) -> Option<PilotCall> {
+        if matches!(self.status, DriverStatus::WaitingForWalkAround { since_s, .. }
+            if now_s - since_s >= self.config.pilot_call_after_s)
+        {
+            return Some(PilotCall::WalkAround);
+        }
         if matches!(self.status, DriverStatus::WaitingForHiddenObstacle { since_s, .. }
             if now_s - since_s >= self.config.pilot_call_after_s)
         {

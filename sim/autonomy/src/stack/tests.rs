@@ -249,3 +249,97 @@ fn between_estimates_the_pose_is_dead_reckoned_on_odometry() {
     d.on_pose(at(1.0, 7.0, 0.0, 0.0));
     assert_eq!(d.estimate().unwrap().world_from_vehicle.translation.x, 7.0);
 }
+
+/// A zone of 0.5 m cells over x -10..10, y -5..5 of the vehicle frame, blind on level 0 where
+/// `blind(x, y)` says (at the cell's centre).
+fn zone(blind: impl Fn(f64, f64) -> bool) -> BlindZone {
+    let (cell_m, cells) = (0.5, [40, 20]);
+    let cell = (0..cells[0] * cells[1])
+        .map(|k| {
+            let (i, j) = (k % cells[0], k / cells[0]);
+            blind(
+                -10.0 + (i as f64 + 0.5) * cell_m,
+                -5.0 + (j as f64 + 0.5) * cell_m,
+            )
+        })
+        .collect();
+    BlindZone {
+        min_m: [-10.0, -5.0],
+        cell_m,
+        cells,
+        levels: vec![cell],
+    }
+}
+
+/// A 1 m circle at the origin on `level` of `heights`.
+fn one_circle(level: usize, heights: Vec<f64>) -> CollisionModel {
+    let circle = Circle {
+        x_m: 0.0,
+        y_m: 0.0,
+        radius_m: 1.0,
+        level,
+    };
+    CollisionModel::new(vec![circle], heights).unwrap()
+}
+
+/// The swept blind ground is each blind cell whose centre some circle of its level covers,
+/// counted once: here one 1 m circle (level 0) at the origin over a blind square 2 m ahead.
+#[test]
+fn the_unseen_swept_ground_counts_each_blind_cell_a_circle_covers_once() {
+    let square = zone(|x, y| (2.0..3.0).contains(&x) && (0.0..1.0).contains(&y));
+    let model = one_circle(0, vec![0.0]);
+    let here = Isometry2::new(Vector2::new(100.0, 50.0), 0.3);
+    let ahead = |x: f64| here * Isometry2::translation(x, 0.0);
+    // At the start the circle reaches x 1.0: none of the square (centres 2.25 and 2.75).
+    assert_eq!(square.unseen_swept_m2(&model, &here, &[ahead(0.0)]), 0.0);
+    // Centred on (2.5, 0): centres (2.25 | 2.75, 0.25 | 0.75) are all within 1 m: 4 cells.
+    let all = square.unseen_swept_m2(&model, &here, &[ahead(0.0), ahead(2.5), ahead(2.6)]);
+    assert_eq!(all, 4.0 * 0.25);
+    // At (1.5, 0): only (2.25, 0.25) is within 1 m (0.79); (2.25, 0.75) is 1.06 away.
+    assert_eq!(square.unseen_swept_m2(&model, &here, &[ahead(1.5)]), 0.25);
+    // A level the zone does not list has no blind ground.
+    let high = one_circle(1, vec![0.0, 1.0]);
+    assert_eq!(square.unseen_swept_m2(&high, &here, &[ahead(2.5)]), 0.0);
+}
+
+/// Blind ground ahead: the driver does not move off, says why, calls for a pilot after
+/// `pilot_call_after_s`, and goes once the walk-around has confirmed the ground.
+#[test]
+fn blind_ground_ahead_holds_the_vehicle_until_the_walk_around() {
+    let mut d = driver();
+    d.await_walk_around(zone(|x, _| (3.0..6.0).contains(&x)));
+    let mut map = empty_map();
+    d.on_pose(at(0.0, 10.0, 0.0, 0.0));
+    d.plan(&mut map).unwrap();
+    assert_eq!(d.speed_command_m_s(), 0.0);
+    let DriverStatus::WaitingForWalkAround { unseen_m2, since_s } = d.status() else {
+        panic!("{:?}", d.status());
+    };
+    // The two circles (x 0 and 2, radius 1) sweep a band 2 m wide along the 3 m of blind x.
+    assert!((5.0..=7.0).contains(&unseen_m2), "{unseen_m2}");
+    assert_eq!((since_s, d.start_unseen_m2()), (0.0, Some(unseen_m2)));
+    let wait = AutonomyConfig::default().pilot_call_after_s;
+    d.on_pose(at(wait - 0.1, 10.0, 0.0, 0.0));
+    d.plan(&mut map).unwrap();
+    assert_eq!(d.calls_for_pilot(wait - 0.1), None);
+    assert_eq!(d.calls_for_pilot(wait), Some(PilotCall::WalkAround));
+    d.on_walk_around();
+    d.plan(&mut map).unwrap();
+    assert_eq!(d.status(), DriverStatus::Driving);
+    assert_eq!(d.speed_command_m_s(), 5.0);
+    assert_eq!(d.calls_for_pilot(wait), None);
+}
+
+/// Blind ground the plan does not sweep (behind the vehicle) holds nothing: it moves off at
+/// once, and the rule is done.
+#[test]
+fn blind_ground_behind_the_vehicle_does_not_hold_it() {
+    let mut d = driver();
+    d.await_walk_around(zone(|x, _| x < -2.0));
+    let mut map = empty_map();
+    d.on_pose(at(0.0, 10.0, 0.0, 0.0));
+    d.plan(&mut map).unwrap();
+    assert_eq!(d.status(), DriverStatus::Driving);
+    assert_eq!(d.speed_command_m_s(), 5.0);
+    assert_eq!(d.start_unseen_m2(), Some(0.0));
+}

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use anyhow::Context as _;
-use sim::studies::coverage::{CoverageOptions, coverage, draw};
+use sim::world::coverage::{CoverageOptions, coverage, draw};
 
 /// Arguments of `taxi-sim model coverage`.
 #[derive(Debug, Clone, clap::Args)]

@@ -6,7 +6,6 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context as _;
-use sim::engine::EndReason;
 use sim::engine::RunReport;
 use sim::engine::{NoObserver, Observer, Observers};
 use sim::engine::{RunHandles, RunSetup, run_with};
@@ -372,15 +371,19 @@ pub fn table(r: &RunReport) -> String {
                 r.contacts_at_fault, r.contacts_struck
             )
         },
-        match r.end {
-            EndReason::Completed => "",
-            EndReason::TimedOut => "  (timed out)",
-            EndReason::Interrupted => "  (interrupted)",
-            EndReason::WaitingForHiddenObstacle =>
-                "  (waiting for a hidden obstacle: pilot called)",
-            EndReason::Blocked => "  (blocked: pilot called)",
-        }
+        r.end.note().map(|n| format!("  ({n})")).unwrap_or_default(),
     );
+    if let Some(a) = r.start_unseen_m2 {
+        let _ = writeln!(
+            t,
+            "start-up rule: {a:.1} m2 of the ground the first plan sweeps is out of the LiDAR's sight from the start{}",
+            if a > 0.0 {
+                " (held until a walk-around)"
+            } else {
+                ""
+            }
+        );
+    }
     let f = &r.faults;
     if *f != sim::world::FaultCounts::default() {
         let _ = writeln!(

@@ -50,6 +50,16 @@ const CASES: &[Case] = &[
         says: &[":9:1:", "unknown field `speeed`"],
     },
     Case {
+        file: "scenario_walk_around_bad.toml",
+        args: CHECK,
+        says: &[
+            ":18:15:",
+            "`vehicle.walk_around`",
+            "\"soon\"",
+            "a time in seconds > 0",
+        ],
+    },
+    Case {
         file: "scenario_seed_negative.toml",
         args: CHECK,
         says: &[":8:", "`seed`", "-4"],

@@ -344,6 +344,7 @@ impl Judge {
                 end == EndReason::Completed && self.laps_completed() == self.laps
             }
             ExpectedEnd::WaitingForHiddenObstacle => end == EndReason::WaitingForHiddenObstacle,
+            ExpectedEnd::WaitingForWalkAround => end == EndReason::WaitingForWalkAround,
             ExpectedEnd::Any => end != EndReason::Interrupted,
             ExpectedEnd::StoppedForGood => {
                 matches!(

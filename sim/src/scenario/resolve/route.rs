@@ -7,8 +7,8 @@ use nalgebra::{Isometry2, Point2, Vector2};
 use toml::Spanned;
 
 use super::Resolver;
-use crate::scenario::model::{Ground, Route, ScenarioVehicle};
-use crate::scenario::spec::{RouteSpec, VehicleEntry};
+use crate::scenario::model::{Ground, Route, ScenarioVehicle, WalkAround};
+use crate::scenario::spec::{RouteSpec, VehicleEntry, WalkAroundSpec};
 use crate::toml_file::LocatedError;
 
 impl Resolver<'_> {
@@ -178,7 +178,31 @@ impl Resolver<'_> {
             description: v.description.get_ref().clone(),
             vehicle,
             world_from_start,
+            walk_around: self.walk_around(v.walk_around.as_ref())?,
         })
+    }
+
+    /// `[vehicle] walk_around`: `"before_start"` (the default), `"none"`, or seconds > 0.
+    fn walk_around(&self, w: Option<&Spanned<WalkAroundSpec>>) -> Result<WalkAround, LocatedError> {
+        let Some(w) = w else {
+            return Ok(WalkAround::BeforeStart);
+        };
+        match w.get_ref() {
+            WalkAroundSpec::Word(s) if s == "before_start" => Ok(WalkAround::BeforeStart),
+            WalkAroundSpec::Word(s) if s == "none" => Ok(WalkAround::Never),
+            WalkAroundSpec::At(t) if t.is_finite() && *t > 0.0 => Ok(WalkAround::At(*t)),
+            other => Err(self.err(
+                w.span(),
+                "vehicle.walk_around",
+                format!(
+                    "{}: expected \"before_start\", \"none\" or a time in seconds > 0",
+                    match other {
+                        WalkAroundSpec::Word(s) => format!("{s:?}"),
+                        WalkAroundSpec::At(t) => t.to_string(),
+                    }
+                ),
+            )),
+        }
     }
 
     /// A vehicle description: a shipped name or a sidecar path relative to the scenario file.

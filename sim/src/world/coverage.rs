@@ -16,8 +16,8 @@ use std::path::Path;
 use nalgebra::{Isometry2, Point2};
 use serde::Serialize;
 
+use super::{Lidar, LidarConfig, Scene, World};
 use crate::error::{Error, Result};
-use crate::world::{Lidar, LidarConfig, Scene, World};
 
 /// How the blind zone is computed.
 #[derive(Clone, Copy, Debug)]
