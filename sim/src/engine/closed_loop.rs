@@ -8,6 +8,7 @@ use std::time::Instant;
 use autonomy::PilotCall;
 use nalgebra::Isometry2;
 
+use super::external::{Answer, LatePolicy, StackInput, command_of_twist};
 use super::observer::{Observer, RevolutionFrame, StepFrame};
 use super::outcome::{EndReason, Event};
 use super::report::Progress;
@@ -35,11 +36,15 @@ impl Rig<'_> {
             if self.t_s > self.timeout_s {
                 return Ok(EndReason::TimedOut);
             }
-            match self.driver.calls_for_pilot(self.t_s) {
-                Some(PilotCall::HiddenObstacle) => return Ok(EndReason::WaitingForHiddenObstacle),
-                Some(PilotCall::Blocked) => return Ok(EndReason::Blocked),
-                Some(PilotCall::WalkAround) => return Ok(EndReason::WaitingForWalkAround),
-                None => {}
+            if self.external.is_none() {
+                match self.driver.calls_for_pilot(self.t_s) {
+                    Some(PilotCall::HiddenObstacle) => {
+                        return Ok(EndReason::WaitingForHiddenObstacle);
+                    }
+                    Some(PilotCall::Blocked) => return Ok(EndReason::Blocked),
+                    Some(PilotCall::WalkAround) => return Ok(EndReason::WaitingForWalkAround),
+                    None => {}
+                }
             }
             if let Some(at_s) = self.walk_around_at_s
                 && self.t_s >= at_s
@@ -53,18 +58,20 @@ impl Rig<'_> {
             self.split.physics += physics.elapsed().as_secs_f64();
             let truth = self.state.world_from_vehicle();
             self.sense_pose(&truth);
-            if self.step.is_multiple_of(self.steps_per_scan) {
-                self.revolution(tasks, &truth, observer)?;
-            }
-            self.deliver_due(tasks, observer)?;
-            let holding = self.driver.watchdog_tripped();
-            if holding != self.watchdog_holding {
-                self.watchdog_holding = holding;
-                self.fault_counts.watchdog_stops += u64::from(holding);
-                observer.event(self.t_s, &Event::Watchdog { holding })?;
-            }
+            let command = if self.external.is_some() {
+                if self.step.is_multiple_of(self.steps_per_scan)
+                    && let Some(end) = self.exchange(&truth)?
+                {
+                    return Ok(end);
+                }
+                self.external
+                    .as_ref()
+                    .map(|e| e.command)
+                    .unwrap_or_default()
+            } else {
+                self.own_stack_step(tasks, &truth, observer)?
+            };
             let physics = Instant::now();
-            let command = self.driver.command();
             self.bicycle.step(&mut self.state, &command, dt);
             self.t_s += dt;
             self.step += 1;
@@ -99,6 +106,27 @@ impl Rig<'_> {
         Ok(EndReason::Completed)
     }
 
+    /// The shipped stack's part of a step: a revolution when one is due, the late ones
+    /// delivered, the watchdog watched; its command.
+    fn own_stack_step<'s>(
+        &mut self,
+        tasks: &rayon::Scope<'s>,
+        truth: &Isometry2<f64>,
+        observer: &mut (dyn Observer + Send),
+    ) -> Result<autonomy::Command> {
+        if self.step.is_multiple_of(self.steps_per_scan) {
+            self.revolution(tasks, truth, observer)?;
+        }
+        self.deliver_due(tasks, observer)?;
+        let holding = self.driver.watchdog_tripped();
+        if holding != self.watchdog_holding {
+            self.watchdog_holding = holding;
+            self.fault_counts.watchdog_stops += u64::from(holding);
+            observer.event(self.t_s, &Event::Watchdog { holding })?;
+        }
+        Ok(self.driver.command())
+    }
+
     /// The odometry of this step to the stack and the pose source; the pose source's estimate
     /// (through the pose faults) to the stack, its error logged.
     fn sense_pose(&mut self, truth: &Isometry2<f64>) {
@@ -106,6 +134,10 @@ impl Rig<'_> {
             self.odometry
                 .measure(self.t_s, self.state.speed_m_s, self.state.steering_rad);
         self.driver.on_odometry(odometry);
+        if let Some(external) = &mut self.external {
+            let dt = 1.0 / self.config.physics_hz;
+            external.dead_reckon(&odometry, self.bicycle.limits().wheelbase_m, dt);
+        }
         let t0 = Instant::now();
         self.pose_source.on_odometry(&odometry);
         let published = self.pose_source.publish(self.t_s, truth);
@@ -123,7 +155,7 @@ impl Rig<'_> {
     }
 
     /// The pose source reads a revolution as the stack receives it.
-    fn localize(&mut self, captured: &Captured) -> Result<()> {
+    pub(super) fn localize(&mut self, captured: &Captured) -> Result<()> {
         let t0 = Instant::now();
         self.pose_source.on_revolution(&captured.revolution)?;
         self.split.localization += t0.elapsed().as_secs_f64();
@@ -298,5 +330,82 @@ impl Rig<'_> {
         self.world
             .set_vehicle_pose(&self.state.world_from_vehicle(), self.t_s);
         Ok(())
+    }
+}
+
+impl Rig<'_> {
+    /// One control step of an external stack: the revolution taken (unless the faults lose it)
+    /// and handed over with the odometry and the pose estimate; its answer checked and held.
+    /// The run's end when the stack is late (strict), fails, or asks for the absurd.
+    pub(super) fn exchange(&mut self, truth: &Isometry2<f64>) -> Result<Option<EndReason>> {
+        // The stamp from the step count, not the summed time: exact, as it goes on the wire.
+        let t_s = self.step as f64 / self.config.physics_hz;
+        let (index, seed) = (self.step / self.steps_per_scan, self.seed);
+        let estimate = self.driver.estimate().copied();
+        let faults = &self.config.faults;
+        let captured = if faults.any() && self.lost.is_lost(faults, seed, index) {
+            self.fault_counts.lost_revolutions += 1;
+            None
+        } else {
+            let sensor = Sensor {
+                world: &self.world,
+                lidar: &self.lidar,
+                faults,
+                seed,
+                dropped: &self.dropped_returns,
+                spurious: &self.spurious_returns,
+            };
+            let at = estimate.unwrap_or_else(|| autonomy::PoseEstimate::exact(t_s, *truth));
+            Some(sensor.capture(truth, &at, index, t_s)?)
+        };
+        if let Some(c) = &captured {
+            self.split.lidar += c.lidar_s;
+            self.localize(c)?;
+        }
+        let points = captured
+            .as_ref()
+            .map(|c| super::external::cloud_points(&c.revolution.scan));
+        let Some(external) = self.external.as_mut() else {
+            return Ok(None);
+        };
+        let input = StackInput {
+            t_s,
+            step: index,
+            cloud: points.as_deref(),
+            odom_from_vehicle: external.odom_from_vehicle,
+            odometry: external.odometry,
+            estimate,
+        };
+        external.report.steps += 1;
+        let answer = match external.stack.step(&input) {
+            Ok(answer) => answer,
+            Err(e) => {
+                external.report.error = Some(e.to_string());
+                return Ok(Some(EndReason::StackFailed));
+            }
+        };
+        match answer {
+            Answer::Command(twist) => {
+                let held = external.command.steering_rad;
+                match command_of_twist(t_s, twist, self.bicycle.limits(), held) {
+                    Ok(command) => {
+                        external.command = command;
+                        external.report.commands += 1;
+                    }
+                    Err(why) => {
+                        external.report.error = Some(why);
+                        return Ok(Some(EndReason::StackFailed));
+                    }
+                }
+            }
+            Answer::Late { topic } => {
+                external.report.late += 1;
+                external.report.first_late.get_or_insert((t_s, topic));
+                if external.report.policy == LatePolicy::Strict {
+                    return Ok(Some(EndReason::StackTimeout));
+                }
+            }
+        }
+        Ok(None)
     }
 }

@@ -11,6 +11,7 @@
 
 mod closed_loop;
 mod conflict;
+mod external;
 mod judge;
 mod observer;
 mod outcome;
@@ -21,6 +22,10 @@ mod rig;
 mod schedule;
 mod traffic;
 
+pub use external::{
+    ABSURD_YAW_RATE_RAD_S, Answer, ExternalStack, LatePolicy, StackInput, StackReport, StackStart,
+    Twist, cloud_points, command_of_twist,
+};
 pub use judge::{DEVIATION_M, Judge, StepVerdict, Verdict};
 pub use observer::{NoObserver, Observer, Observers, RevolutionFrame, RunStart, StepFrame};
 pub use outcome::{
@@ -36,7 +41,7 @@ pub use report::{
 };
 pub use rig::{
     RunHandles, RunSetup, distance_cap_m, distance_map_half_size_m, longest_horizon_m, run,
-    run_with,
+    run_external, run_with,
 };
 pub use schedule::{Planned, Scheduler};
 pub use traffic::Traffic;

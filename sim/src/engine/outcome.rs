@@ -76,6 +76,12 @@ pub enum EndReason {
     /// Stood for obstacles in its path (in view or hidden) for `blocked_call_after_s` (60 s),
     /// the vehicle called for a pilot: its way is blocked (an aircraft never steers round).
     Blocked,
+    /// A stack outside the process ([`super::external`]) gave no command for a control step
+    /// within its transport's timeout, under the strict policy.
+    StackTimeout,
+    /// A stack outside the process failed: its transport or process ended, or it asked for
+    /// what no vehicle can do (the report's `stack.error` says which).
+    StackFailed,
 }
 
 impl EndReason {
@@ -93,6 +99,8 @@ impl EndReason {
             EndReason::WaitingForWalkAround => {
                 Some("waiting for a walk-around of ground it cannot see: pilot called")
             }
+            EndReason::StackTimeout => Some("the external stack did not answer in time"),
+            EndReason::StackFailed => Some("the external stack failed"),
         }
     }
 }

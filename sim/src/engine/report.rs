@@ -28,6 +28,9 @@ pub struct RunReport {
     /// square metres (0: none; the vehicle moved off at once).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub start_unseen_m2: Option<f64>,
+    /// What the stack outside the process did, when one drove ([`super::run_external`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stack: Option<super::external::StackReport>,
     /// Laps asked for.
     pub laps: u32,
     /// Laps completed.

@@ -1,6 +1,7 @@
 //! The rig: everything a closed-loop run is made of - the world and its sensors, the pose
 //! source, the stack under test, the schedule and the judge - built from a scenario and a run
-//! configuration ([`run`], [`run_with`]); the loop that ticks it is `closed_loop`.
+//! configuration ([`run`], [`run_with`]; with a stack outside the process, [`run_external`]); the
+//! loop that ticks it is `closed_loop`.
 //!
 //! Rates: physics (vehicle motion, ground truth, moving obstacles) at `physics_hz` (100 Hz); one
 //! LiDAR revolution, map update and plan every `1 / scan_hz` (10 Hz). The stack gets sensor
@@ -17,6 +18,7 @@ use autonomy::{
 use mapper::{CollisionModel, MultiHeightMap};
 use nalgebra::{Isometry2, Point2};
 
+use super::external::{External, ExternalStack, LatePolicy, StackReport, StackStart};
 use super::judge::Judge;
 use super::observer::{NoObserver, Observer, RunStart};
 use super::outcome::EndReason;
@@ -130,8 +132,35 @@ pub fn run_with(
     setup: &RunSetup,
     handles: RunHandles<'_>,
 ) -> Result<RunReport> {
-    let wall = Instant::now();
+    run_rig(Rig::new(scenario, setup)?, handles)
+}
+
+/// [`run_with`], with `stack` - a stack outside the process, through its transport - driving the
+/// vehicle in lockstep instead of the shipped one ([`super::external`]); `policy` says what a
+/// late answer costs.
+pub fn run_external<'a>(
+    scenario: &'a Scenario,
+    setup: &RunSetup,
+    handles: RunHandles<'_>,
+    stack: &'a mut dyn ExternalStack,
+    policy: LatePolicy,
+) -> Result<RunReport> {
     let mut rig = Rig::new(scenario, setup)?;
+    let route_m: Vec<Point2<f64>> = scenario.route.waypoints_m.clone();
+    stack.start(&StackStart {
+        scenario: &scenario.name,
+        world_from_odom: scenario.vehicle.world_from_start,
+        vehicle_from_lidar: scenario.vehicle.vehicle.vehicle_from_lidar(),
+        route_m: &route_m,
+        model: &rig.model,
+        map_dir: &setup.map_dir,
+    })?;
+    rig.external = Some(External::new(stack, policy));
+    run_rig(rig, handles)
+}
+
+fn run_rig(mut rig: Rig<'_>, handles: RunHandles<'_>) -> Result<RunReport> {
+    let wall = Instant::now();
     let RunHandles {
         stop,
         progress,
@@ -186,6 +215,8 @@ pub(super) struct Rig<'a> {
     pub(super) in_transit: std::collections::VecDeque<(f64, Captured)>,
     /// When the crew's walk-around is still to come (`[vehicle] walk_around` at a time), seconds.
     pub(super) walk_around_at_s: Option<f64>,
+    /// A stack outside the process driving the vehicle instead of `driver`, if any.
+    pub(super) external: Option<External<'a>>,
     /// The live map's scratch directory, removed with the rig.
     pub(super) _live: tempfile::TempDir,
 }
@@ -305,6 +336,7 @@ impl<'a> Rig<'a> {
                 _ => None,
             },
             config,
+            external: None,
             _live: live,
         })
     }
@@ -334,6 +366,8 @@ impl<'a> Rig<'a> {
                 | EndReason::WaitingForHiddenObstacle
                 | EndReason::Blocked
                 | EndReason::WaitingForWalkAround
+                | EndReason::StackTimeout
+                | EndReason::StackFailed
         ) {
             // The vehicle may stand before an obstacle: its pass closes as it stands.
             self.judge.close_open_passes(self.t_s, end);
@@ -367,6 +401,10 @@ impl<'a> Rig<'a> {
             end,
             waiting_for,
             start_unseen_m2: self.driver.start_unseen_m2(),
+            stack: self.external.as_ref().map(|e| StackReport {
+                stale: e.stack.stale(),
+                ..e.report.clone()
+            }),
             laps: self.laps,
             laps_completed: verdict.laps_completed,
             lap_times_s: verdict.lap_times_s,

@@ -9,7 +9,8 @@ use nalgebra::{Isometry2, Isometry3};
 use ros2::msgs::{self, Pose, Time};
 use ros2::{BagWriter, Qos, TopicId};
 
-use super::{bag_error, cloud_points, planar, pose3, stamp_ns, transform};
+use super::{bag_error, planar, pose3, stamp_ns, transform};
+use crate::engine::cloud_points;
 use crate::error::Result;
 
 /// Writes a mapping drive's revolutions.

@@ -32,7 +32,7 @@ pub use from_bag::{BagMapOptions, BagMapReport, PoseSource, map_from_bag};
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Isometry2, Isometry3, UnitQuaternion};
-use ros2::msgs::{self, Pose, Time, Transform, VelodynePoint};
+use ros2::msgs::{self, Pose, Time, Transform};
 use ros2::{BagThread, BagWriter, Qos, TopicId};
 
 use crate::engine::{Event, Observer, RevolutionFrame, RunReport, RunStart, StepFrame};
@@ -178,31 +178,6 @@ pub(crate) fn transform(t_s: f64, parent: &str, child: &str, pose: Pose) -> Tran
     }
 }
 
-/// The revolution's returns in the sensor frame (each column's own pose), with their beam. Their
-/// `time` is 0: the closed loop takes a revolution at one instant (a consumer that deskews by
-/// it moves nothing).
-pub(crate) fn cloud_points(scan: &mapper::Scan) -> Vec<VelodynePoint> {
-    let mut points = Vec::with_capacity(scan.returns().len());
-    for c in 0..scan.column_count() {
-        let Some((column, returns)) = scan.column(c) else {
-            continue;
-        };
-        let sensor_from_world = column.world_from_sensor.inverse();
-        for (beam, r) in returns.iter().enumerate() {
-            if let Some(r) = r {
-                let p = sensor_from_world * r.point_in_world;
-                points.push(VelodynePoint {
-                    xyz: [p.x as f32, p.y as f32, p.z as f32],
-                    intensity: r.intensity * 255.0,
-                    ring: beam as u16,
-                    time: 0.0,
-                });
-            }
-        }
-    }
-    points
-}
-
 /// A planar covariance (x, y, yaw) as ROS's 6x6 over (x, y, z, roll, pitch, yaw).
 fn covariance6(c: &nalgebra::Matrix3<f64>) -> [f64; 36] {
     let mut out = [0.0; 36];
@@ -310,7 +285,11 @@ impl Observer for RosBag {
         ]);
         self.write(|t| t.tf, t, tf)?;
         let stamp = Time::from_ns(stamp_ns(t));
-        let cloud = msgs::velodyne_cloud(stamp, "velodyne", &cloud_points(&frame.revolution.scan));
+        let cloud = msgs::velodyne_cloud(
+            stamp,
+            "velodyne",
+            &crate::engine::cloud_points(&frame.revolution.scan),
+        );
         self.write(|t| t.cloud, t, cloud)?;
         if let Some(e) = &frame.pose_estimate {
             let pose = msgs::pose_with_covariance(
