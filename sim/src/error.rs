@@ -49,6 +49,9 @@ pub enum Error {
     /// The replay (Rerun) failed.
     #[error("replay: {0}")]
     Replay(String),
+    /// A stack outside the process, or its transport, failed (the message says where).
+    #[error("external stack: {0}")]
+    Stack(String),
     /// JSON could not be written.
     #[error("JSON: {0}")]
     Json(#[from] serde_json::Error),

@@ -407,6 +407,37 @@ pub struct VelodynePoint {
 /// Bytes of one [`VelodynePoint`] in the cloud.
 pub const VELODYNE_POINT_STEP: u32 = 22;
 
+/// The Velodyne point's fields: name, byte offset, ROS datatype (7 float32, 4 uint16).
+pub const VELODYNE_FIELDS: [(&str, u32, u8); 6] = [
+    ("x", 0, 7),
+    ("y", 4, 7),
+    ("z", 8, 7),
+    ("intensity", 12, 7),
+    ("ring", 16, 4),
+    ("time", 18, 7),
+];
+
+fn velodyne_point(p: &VelodynePoint) -> [u8; VELODYNE_POINT_STEP as usize] {
+    let mut b = [0u8; VELODYNE_POINT_STEP as usize];
+    for (k, v) in p.xyz.iter().enumerate() {
+        b[4 * k..4 * k + 4].copy_from_slice(&v.to_le_bytes());
+    }
+    b[12..16].copy_from_slice(&p.intensity.to_le_bytes());
+    b[16..18].copy_from_slice(&p.ring.to_le_bytes());
+    b[18..22].copy_from_slice(&p.time.to_le_bytes());
+    b
+}
+
+/// The points packed as a cloud's `data` (little-endian, [`VELODYNE_FIELDS`]).
+#[must_use]
+pub fn velodyne_data(points: &[VelodynePoint]) -> Vec<u8> {
+    let mut data = Vec::with_capacity(VELODYNE_POINT_STEP as usize * points.len());
+    for p in points {
+        data.extend_from_slice(&velodyne_point(p));
+    }
+    data
+}
+
 /// `sensor_msgs/msg/PointCloud2` of Velodyne points, unorganised (height 1), dense.
 #[must_use]
 pub fn velodyne_cloud(stamp: Time, frame_id: &str, points: &[VelodynePoint]) -> Vec<u8> {
@@ -415,16 +446,8 @@ pub fn velodyne_cloud(stamp: Time, frame_id: &str, points: &[VelodynePoint]) -> 
     header(&mut w, stamp, frame_id);
     w.u32(1);
     w.u32(u32::try_from(points.len()).unwrap_or(u32::MAX));
-    let fields: [(&str, u32, u8); 6] = [
-        ("x", 0, 7),
-        ("y", 4, 7),
-        ("z", 8, 7),
-        ("intensity", 12, 7),
-        ("ring", 16, 4),
-        ("time", 18, 7),
-    ];
-    w.count(fields.len());
-    for (name, offset, datatype) in fields {
+    w.count(VELODYNE_FIELDS.len());
+    for (name, offset, datatype) in VELODYNE_FIELDS {
         w.string(name);
         w.u32(offset);
         w.u8(datatype);
@@ -436,14 +459,7 @@ pub fn velodyne_cloud(stamp: Time, frame_id: &str, points: &[VelodynePoint]) -> 
     // The points straight into the message (no second copy of 1.5 MB a revolution).
     w.count(step * points.len());
     for p in points {
-        let mut b = [0u8; VELODYNE_POINT_STEP as usize];
-        for (k, v) in p.xyz.iter().enumerate() {
-            b[4 * k..4 * k + 4].copy_from_slice(&v.to_le_bytes());
-        }
-        b[12..16].copy_from_slice(&p.intensity.to_le_bytes());
-        b[16..18].copy_from_slice(&p.ring.to_le_bytes());
-        b[18..22].copy_from_slice(&p.time.to_le_bytes());
-        w.raw(&b);
+        w.raw(&velodyne_point(p));
     }
     w.bool(true);
     w.finish()

@@ -25,6 +25,8 @@ pub struct StackStart<'a> {
     pub world_from_odom: Isometry2<f64>,
     /// The LiDAR's mount on the vehicle.
     pub vehicle_from_lidar: Isometry3<f64>,
+    /// The vehicle's wheelbase (rear axle to the steered wheels), metres.
+    pub wheelbase_m: f64,
     /// The route's waypoints, world frame, metres.
     pub route_m: &'a [Point2<f64>],
     /// The vehicle's collision model (height-tagged circles).

@@ -151,6 +151,7 @@ pub fn run_external<'a>(
         scenario: &scenario.name,
         world_from_odom: scenario.vehicle.world_from_start,
         vehicle_from_lidar: scenario.vehicle.vehicle.vehicle_from_lidar(),
+        wheelbase_m: rig.bicycle.limits().wheelbase_m,
         route_m: &route_m,
         model: &rig.model,
         map_dir: &setup.map_dir,

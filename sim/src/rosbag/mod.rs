@@ -179,7 +179,7 @@ pub(crate) fn transform(t_s: f64, parent: &str, child: &str, pose: Pose) -> Tran
 }
 
 /// A planar covariance (x, y, yaw) as ROS's 6x6 over (x, y, z, roll, pitch, yaw).
-fn covariance6(c: &nalgebra::Matrix3<f64>) -> [f64; 36] {
+pub fn covariance6(c: &nalgebra::Matrix3<f64>) -> [f64; 36] {
     let mut out = [0.0; 36];
     let index = [0, 1, 5];
     for (i, &r) in index.iter().enumerate() {

@@ -16,4 +16,5 @@ pub mod representations;
 pub mod run;
 pub mod scan;
 pub mod small;
+pub mod stack;
 pub mod tune;

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::Context as _;
 use sim::engine::RunReport;
 use sim::engine::{NoObserver, Observer, Observers};
-use sim::engine::{RunHandles, RunSetup, run_with};
+use sim::engine::{RunHandles, RunSetup};
 use sim::offline_map::default_map_dir;
 use sim::replay::{Replay, ReplayOptions};
 use sim::scenario::Scenario;
@@ -92,6 +92,9 @@ pub struct RunArgs {
     /// Replay: vehicle pose and time series per second of simulated time.
     #[arg(long, value_name = "HZ", default_value_t = ReplayOptions::default().steps_hz)]
     pub replay_steps_hz: f64,
+    /// Which stack drives the vehicle, and how an external one is waited for.
+    #[command(flatten)]
+    pub stack: super::stack::StackArgs,
 }
 
 impl RunArgs {
@@ -167,7 +170,8 @@ pub fn run(args: &RunArgs) -> anyhow::Result<bool> {
         }
     };
     let progress = crate::bar(1000, "running");
-    let report = run_with(
+    let report = super::stack::drive(
+        &args.stack,
         &scenario,
         &setup,
         RunHandles {
@@ -338,6 +342,25 @@ fn speed_lowered_line(t: &mut String, r: &RunReport) {
     );
 }
 
+/// The table's lines on the start-up rule and on an external stack, when the run had them.
+fn start_and_stack(t: &mut String, r: &RunReport) {
+    use std::fmt::Write as _;
+    if let Some(s) = &r.stack {
+        let _ = writeln!(t, "{}", super::stack::summary(s));
+    }
+    if let Some(a) = r.start_unseen_m2 {
+        let _ = writeln!(
+            t,
+            "start-up rule: {a:.1} m2 of the ground the first plan sweeps is out of the LiDAR's sight from the start{}",
+            if a > 0.0 {
+                " (held until a walk-around)"
+            } else {
+                ""
+            }
+        );
+    }
+}
+
 pub fn table(r: &RunReport) -> String {
     use std::fmt::Write as _;
     let mut t = String::new();
@@ -373,17 +396,7 @@ pub fn table(r: &RunReport) -> String {
         },
         r.end.note().map(|n| format!("  ({n})")).unwrap_or_default(),
     );
-    if let Some(a) = r.start_unseen_m2 {
-        let _ = writeln!(
-            t,
-            "start-up rule: {a:.1} m2 of the ground the first plan sweeps is out of the LiDAR's sight from the start{}",
-            if a > 0.0 {
-                " (held until a walk-around)"
-            } else {
-                ""
-            }
-        );
-    }
+    start_and_stack(&mut t, r);
     let f = &r.faults;
     if *f != sim::world::FaultCounts::default() {
         let _ = writeln!(

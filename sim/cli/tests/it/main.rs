@@ -29,4 +29,5 @@ mod regress;
 mod replay;
 #[path = "../../../tests/it/smoke_campaign.rs"]
 mod smoke_campaign;
+mod stack;
 mod tune;
