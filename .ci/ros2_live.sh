@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Your stack in the loop, proven with a real ROS 2 peer: deploy/ros2/follow_route.py (rclpy on
-# Fast DDS, from PyPI's ROS wheels in target/rclpy-venv) drives `taxi-sim run --stack ros2`
+# Fast DDS, from PyPI's ROS wheels in target/rclpy-venv) drives the jet of
+# scenarios/cone_in_path_jet.toml through `taxi-sim run --stack ros2`
 # (ros2-client on RustDDS) in lockstep, inside a private network namespace
 # (deploy/ros2/netns.sh). Five runs, each report checked: a whole route answered at every step,
 # twice, the same to the step;
@@ -15,17 +16,19 @@ maps=${TAXI_SIM_TEST_MAPS:-target/ci-maps}
 out=target/ci-ros2
 rm -rf "$out" && mkdir -p "$out"
 export ROS_DOMAIN_ID=61 FASTDDS_DEFAULT_PROFILES_FILE=$PWD/deploy/ros2/fastdds_udp_buffers.xml
-scenario=scenarios/straight_cone_under_wing.toml
+# The jet down a taxiway, a cone on the centreline until 60 s: the stack must stop short of it.
+scenario=scenarios/cone_in_path_jet.toml
 
 live() {  # live NAME [STACK ARGS...] -- [RUN ARGS...]
     local name=$1; shift
     local stack_args=()
     while [ $# -gt 0 ] && [ "$1" != -- ]; do stack_args+=("$1"); shift; done
     shift || true
-    timeout 120 "$py" deploy/ros2/follow_route.py "${stack_args[@]}" > "$out/$name.stack.log" 2>&1 &
+    timeout 900 "$py" deploy/ros2/follow_route.py --corridor-half-width 2.5 --lookahead 20 "${stack_args[@]}" \
+        > "$out/$name.stack.log" 2>&1 &
     local pid=$!
     local rc=0
-    timeout 300 "$bin" run "$scenario" --stack ros2 --maps-dir "$maps" \
+    timeout 600 "$bin" run "$scenario" --stack ros2 --maps-dir "$maps" \
         --report "$out/$name.json" "$@" > "$out/$name.log" 2>&1 || rc=$?
     kill -INT "$pid" 2>/dev/null || true
     wait "$pid" 2>/dev/null || true
@@ -57,6 +60,9 @@ check(r["end"] == "completed" and r["laps_completed"] == 1, f"whole: the route c
 check(s["steps"] > 300 and s["commands"] == s["steps"] and s["late"] == 0,
       f"whole: every one of {s['steps']} steps answered in time ({s['commands']} commands, {s['late']} late, {s['stale']} stale)")
 check(len(r["contacts"]) == 0, "whole: no contact")
+p = r["obstacles"][0]["passes"]
+check(len(p) == 1 and p[0]["outcome"] == "stopped" and r["expectations_met"],
+      f"whole: stopped short of the cone, then went on: every expectation held ({p})")
 a = report("again")
 check(a["sim_time_s"] == r["sim_time_s"] and a["obstacles"] == r["obstacles"] and a["stack"]["steps"] == s["steps"],
       f"again: the same run, step for step ({a['stack']['steps']} steps, lap {a['lap_times_s']} s)")

@@ -140,7 +140,7 @@ class FollowRoute(Node):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--speed", type=float, default=3.0, help="m/s")
-    ap.add_argument("--lookahead", type=float, default=6.0, help="pure pursuit, m")
+    ap.add_argument("--lookahead", type=float, default=15.0, help="pure pursuit, m (>= 2 wheelbases)")
     ap.add_argument("--corridor-half-width", type=float, default=1.2, help="m, sensor frame")
     ap.add_argument("--stop-within", type=float, default=8.0, help="m ahead of the sensor")
     ap.add_argument(
