@@ -3,10 +3,15 @@
 # Fast DDS, from PyPI's ROS wheels in target/rclpy-venv) drives the jet of
 # scenarios/cone_in_path_jet.toml through `taxi-sim run --stack ros2`
 # (ros2-client on RustDDS) in lockstep, inside a private network namespace
-# (deploy/ros2/netns.sh). Five runs, each report checked: a whole route answered at every step,
-# twice, the same to the step;
-# a stack that goes silent (strict: stack_timeout, the time and topic named); one that commands
-# NaN (stack_failed, the field named); no stack at all (the missing topics named).
+# (deploy/ros2/netns.sh). Nine runs and two small campaigns, each report checked: a whole route
+# answered at every step, twice, the same to the step (the second time the simulator starts the
+# stack itself, --stack-command, and the stack floods ten junk commands a step: discarded); the
+# hostile peers: a stack that goes silent (strict: stack_timeout, the time and topic named), one
+# that commands NaN (stack_failed, the field named), one that stamps its commands with the
+# revolution before (stale, then stack_timeout), one that answers once 1.5 s late (--lenient:
+# held, counted, the run goes on), one that crashes (its status and last log line named), one
+# that never subscribes, and no stack at all (the missing topics named); and a campaign of two
+# variants run two jobs at a time on two ROS domains, then one job: the same records.
 #   deploy/ros2/netns.sh .ci/ros2_live.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,10 +41,41 @@ live() {  # live NAME [STACK ARGS...] -- [RUN ARGS...]
     echo "[ros2] $name: taxi-sim exit $rc"; tail -n 4 "$out/$name.log" | sed 's/^/    /'
 }
 
+# The same, the simulator starting and stopping the stack (`--stack-command`).
+spawned() {  # spawned NAME [STACK ARGS...] -- [RUN ARGS...]
+    local name=$1; shift
+    local stack_args=()
+    while [ $# -gt 0 ] && [ "$1" != -- ]; do stack_args+=("$1"); shift; done
+    shift || true
+    local rc=0
+    timeout 600 "$bin" run "$scenario" --stack ros2 --maps-dir "$maps" --report "$out/$name.json" \
+        --stack-command "$py deploy/ros2/follow_route.py --corridor-half-width 2.5 --lookahead 20 ${stack_args[*]}" \
+        --stack-log "$out/$name.stack.log" "$@" > "$out/$name.log" 2>&1 || rc=$?
+    echo "$rc" > "$out/$name.rc"
+    echo "[ros2] $name: taxi-sim exit $rc"; tail -n 4 "$out/$name.log" | sed 's/^/    /'
+}
+
 live whole
-live again
+spawned again --flood 10
 live silent --stop-answering-at 3.0 -- --stack-timeout-s 2
 live nan --nan-at 2.0
+live wrong --wrong-stamp-from 3.0 -- --stack-timeout-s 2
+live late --late-at 3.0 --late-by 1.5 -- --stack-timeout-s 1 --lenient --time-limit-s 8
+spawned crash --crash-at 3.0
+live deaf --no-subscribe -- --discovery-timeout-s 3
+# Your stack in a campaign (scenarios/campaigns/your_stack.toml, two variants): two jobs at a
+# time, each on a ROS domain of its own (62, 63), each run's stack started by the simulator; then
+# one job. The records must be the same: no job heard another's.
+for jobs in 2 1; do
+    rc=0
+    timeout 600 "$bin" campaign run scenarios/campaigns/your_stack.toml --out "$out/campaign-$jobs" \
+        --maps-dir "$maps" --jobs "$jobs" --stack ros2 --ros-domain-id 62 \
+        --stack-command "$py deploy/ros2/follow_route.py --corridor-half-width 2.5 --lookahead 20" \
+        > "$out/campaign-$jobs.log" 2>&1 || rc=$?
+    echo "$rc" > "$out/campaign-$jobs.rc"
+    echo "[ros2] campaign, $jobs jobs: taxi-sim exit $rc"; tail -n 2 "$out/campaign-$jobs.log" | sed 's/^/    /'
+done
+
 # No stack: the run must not start, and say which topics had no peer.
 rc=0; timeout 60 "$bin" run "$scenario" --stack ros2 --maps-dir "$maps" \
     --discovery-timeout-s 3 > "$out/none.log" 2>&1 || rc=$?
@@ -63,9 +99,13 @@ check(len(r["contacts"]) == 0, "whole: no contact")
 p = r["obstacles"][0]["passes"]
 check(len(p) == 1 and p[0]["outcome"] == "stopped" and r["expectations_met"],
       f"whole: stopped short of the cone, then went on: every expectation held ({p})")
+whole = r
 a = report("again")
 check(a["sim_time_s"] == r["sim_time_s"] and a["obstacles"] == r["obstacles"] and a["stack"]["steps"] == s["steps"],
       f"again: the same run, step for step ({a['stack']['steps']} steps, lap {a['lap_times_s']} s)")
+check("started the stack (pid " in (out / "again.log").read_text(), "again: the simulator started the stack")
+check(a["stack"]["stale"] >= 10 and a["stack"]["commands"] == a["stack"]["steps"],
+      f"again: {a['stack']['stale']} junk commands (10 a step, other times) discarded, every step answered")
 r = report("silent"); s = r["stack"]
 check(r["end"] == "stack_timeout" and rc("silent") == 1, f"silent: ends stack_timeout ({r['end']}), exit 1")
 check(s["first_late"] == [3.0, "/cmd_vel"] and s["commands"] == 30,
@@ -73,6 +113,31 @@ check(s["first_late"] == [3.0, "/cmd_vel"] and s["commands"] == 30,
 r = report("nan"); s = r["stack"]
 check(r["end"] == "stack_failed" and "twist.linear.x = NaN" in s.get("error", "")
       and "t = 2.000 s" in s.get("error", ""), f"nan: ends stack_failed naming the field and time ({s.get('error')})")
+r = report("wrong"); s = r["stack"]
+check(r["end"] == "stack_timeout" and rc("wrong") == 1 and s["first_late"] == [3.0, "/cmd_vel"]
+      and s["stale"] >= 1 and s["commands"] == 30,
+      f"wrong: commands for the revolution before are stale ({s['stale']}), then stack_timeout at 3.0 s ({r['end']}, {s['first_late']})")
+r = report("late"); s = r["stack"]
+check(r["end"] == "timed_out" and s["late"] == 1 and s["first_late"] == [3.0, "/cmd_vel"]
+      and s["stale"] >= 1 and s["commands"] == s["steps"] - 1 and not r["contacts"],
+      f"late, lenient: one step late at 3.0 s held and counted ({s['late']} late, {s['stale']} stale), the run went on to its 8 s limit ({r['end']})")
+r = report("crash"); s = r["stack"]; e = s.get("error", "")
+check(r["end"] == "stack_failed" and rc("crash") == 1 and "exited with status 3 at t = 3.000 s" in e
+      and "crashing on purpose" in e, f"crash: stack_failed with its status, the time and its last log line ({e!r})")
+log = (out / "deaf.log").read_text()
+check(rc("deaf") != 0 and "no subscriber of /velodyne_points" in log and "no publisher of /cmd_vel" not in log,
+      "deaf: refused, naming the cloud's missing subscriber only")
+def records(d):
+    rows = [json.loads(l) for l in (out / d / "results.jsonl").read_text().splitlines() if l.strip()]
+    return sorted(({k: v for k, v in r.items() if "wall" not in k} for r in rows), key=lambda r: r["index"])
+two, one = records("campaign-2"), records("campaign-1")
+check(rc("campaign-2") == 0 and rc("campaign-1") == 0 and len(two) == 2 and two == one,
+      f"campaign: two jobs on domains 62 and 63 give one job's records ({[(r['end'], r['sim_time_s']) for r in two]})")
+outcomes = [[o["outcome"] for o in r["obstacles"]] for r in two]
+check(all(r["contacts"] == 0 for r in two) and outcomes[0] != outcomes[1],
+      f"campaign: the two variants differ (so crosstalk would show), no contact ({outcomes})")
+check(all((out / "campaign-2" / f"stack-job-{j}.log").exists() for j in (0, 1)),
+      "campaign: each job's stack wrote its own log")
 log = (out / "none.log").read_text()
 check(rc("none") != 0 and "no subscriber of /velodyne_points" in log and "no publisher of /cmd_vel" in log,
       "none: refused, naming both missing topics")

@@ -10,13 +10,19 @@ a box ahead of the vehicle (the wheels' corridor, from a height above the ground
 top; returns within --min-range of the sensor are the vehicle itself): a template for your own stack, not a good one (no map, no memory of what it saw).
 
   deploy/ros2/follow_route.py [--speed 3.0] [--corridor-half-width 1.2] [--stop-within 8.0]
-      [--min-range 2.5] [--min-height 0.15] [--max-height 1.8] [--stop-answering-at S] [--nan-at S]
+      [--min-range 2.5] [--min-height 0.15] [--max-height 1.8]
 
---stop-answering-at and --nan-at make it misbehave on purpose (CI checks the simulator's answer).
+A hostile peer on purpose (CI checks the simulator's answer to each): --stop-answering-at S goes
+silent, --nan-at S commands NaN, --wrong-stamp-from S stamps each command with the revolution
+before, --late-at S --late-by W answers one revolution W wall seconds late, --crash-at S exits with
+status 3 mid-run, --flood N sends N commands for other times before each answer, --no-subscribe
+never subscribes to the cloud.
 """
 import argparse
 import math
+import os
 import sys
+import time
 
 import numpy as np
 import rclpy
@@ -59,13 +65,16 @@ class FollowRoute(Node):
         self.route = None
         self.pose = None
         self.answered = 0
+        self.was_late = False
         self.pub = self.create_publisher(TwistStamped, "/cmd_vel", qos(10))
         self.create_subscription(Path, "/route", self.on_route, qos(1, latched=True))
         self.create_subscription(
             PoseWithCovarianceStamped, "/localization/pose", self.on_pose, qos(10)
         )
-        self.create_subscription(PointCloud2, "/velodyne_points", self.on_cloud, qos(1))
+        if not args.no_subscribe:
+            self.create_subscription(PointCloud2, "/velodyne_points", self.on_cloud, qos(1))
         self.clouds, self.poses = {}, {}
+        self.previous_stamp = None
 
     def on_route(self, m):
         self.route = np.array([[p.pose.position.x, p.pose.position.y] for p in m.poses])
@@ -122,16 +131,33 @@ class FollowRoute(Node):
     def answer(self, cloud):
         t = cloud.header.stamp.sec - EPOCH_S + cloud.header.stamp.nanosec * 1e-9
         a = self.args
-        if a.stop_answering_at is not None and t >= a.stop_answering_at:
+        at = lambda s: s is not None and t >= s - 1e-6  # noqa: E731
+        if at(a.stop_answering_at):
             return
+        if at(a.crash_at):
+            self.get_logger().error(f"crashing on purpose at t = {t:.3f} s")
+            sys.stdout.flush()
+            os._exit(3)
         m = TwistStamped()
         m.header.stamp = cloud.header.stamp
         m.header.frame_id = "base_link"
         if not self.blocked(cloud):
             m.twist.linear.x = a.speed
             m.twist.angular.z = self.steer()
-        if a.nan_at is not None and t >= a.nan_at:
+        if at(a.nan_at):
             m.twist.linear.x = float("nan")
+        if at(a.wrong_stamp_from) and self.previous_stamp is not None:
+            m.header.stamp = self.previous_stamp
+        self.previous_stamp = cloud.header.stamp
+        if at(a.late_at) and not self.was_late:
+            self.was_late = True
+            time.sleep(a.late_by)
+        for k in range(a.flood):
+            junk = TwistStamped()
+            junk.header.stamp.sec = cloud.header.stamp.sec + (k % 7) - 3
+            junk.header.stamp.nanosec = (cloud.header.stamp.nanosec + 1000 * (k + 1)) % 1_000_000_000
+            junk.twist.linear.x = 100.0  # absurd: taken, it would end the run stack_failed
+            self.pub.publish(junk)
         self.pub.publish(m)
         self.answered += 1
 
@@ -150,12 +176,16 @@ def main():
     ap.add_argument("--max-height", type=float, default=1.8, help="m above the ground")
     ap.add_argument("--stop-answering-at", type=float, help="sim s: go silent (a test)")
     ap.add_argument("--nan-at", type=float, help="sim s: command NaN (a test)")
+    ap.add_argument("--wrong-stamp-from", type=float, help="sim s: answer with the last stamp (a test)")
+    ap.add_argument("--late-at", type=float, help="sim s: answer this revolution late (a test)")
+    ap.add_argument("--late-by", type=float, default=2.0, help="wall s, with --late-at")
+    ap.add_argument("--crash-at", type=float, help="sim s: exit with status 3 (a test)")
+    ap.add_argument("--flood", type=int, default=0, help="junk commands before each answer (a test)")
+    ap.add_argument("--no-subscribe", action="store_true", help="never take the cloud (a test)")
     ap.add_argument("--exit-after-s", type=float, default=600.0, help="wall s")
     args = ap.parse_args()
     rclpy.init()
     node = FollowRoute(args)
-    import time
-
     end = time.monotonic() + args.exit_after_s
     try:
         while rclpy.ok() and time.monotonic() < end:

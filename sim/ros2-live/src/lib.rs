@@ -16,6 +16,9 @@
 //! | `/cmd_vel` (taken) | geometry_msgs/TwistStamped, stamped with the step it answers | reliable, keep last 10 |
 
 pub mod msgs;
+mod process;
+
+pub use process::StackProcess;
 
 use std::time::{Duration, Instant};
 
@@ -50,6 +53,11 @@ pub struct LiveOptions {
     pub discovery_timeout_s: f64,
     /// How long to wait at a step for its command, wall seconds.
     pub stack_timeout_s: f64,
+    /// The stack to start (`sh -c COMMAND` on the domain) and stop with the run; `None`: one
+    /// already running is attached to.
+    pub command: Option<String>,
+    /// Where a started stack's output goes (default: the simulator's stderr).
+    pub log: Option<std::path::PathBuf>,
 }
 
 impl LiveOptions {
@@ -94,6 +102,8 @@ pub struct Ros2Stack {
     options: LiveOptions,
     wheelbase_m: f64,
     stale: u64,
+    /// The stack's process, when the simulator started it.
+    process: Option<StackProcess>,
 }
 
 fn qos(depth: i32, latched: bool) -> QosPolicies {
@@ -176,6 +186,15 @@ impl Ros2Stack {
         let poll = Poll::new().map_err(|e| dds("poll", e))?;
         poll.register(&cmd, Token(1), Ready::readable(), PollOpt::edge())
             .map_err(|e| dds("poll /cmd_vel", e))?;
+        // Started once the simulator's endpoints exist, so the stack finds them at once.
+        let process = match &options.command {
+            Some(c) => Some(StackProcess::spawn(
+                c,
+                options.domain_id,
+                options.log.as_deref(),
+            )?),
+            None => None,
+        };
         Ok(Ros2Stack {
             node,
             clock,
@@ -191,13 +210,25 @@ impl Ros2Stack {
             options,
             wheelbase_m: 1.0,
             stale: 0,
+            process,
         })
     }
 
+    /// The process id of the stack the simulator started.
+    pub fn process_id(&self) -> Option<u32> {
+        self.process.as_ref().map(StackProcess::id)
+    }
+
+    /// `Err` when the stack the simulator started has exited.
+    fn check_process(&mut self, when: &str) -> Result<()> {
+        self.process.as_mut().map_or(Ok(()), |p| p.check(when))
+    }
+
     /// Waits until the stack subscribes to the cloud and publishes commands.
-    fn discover(&self) -> Result<()> {
+    fn discover(&mut self) -> Result<()> {
         let deadline = Instant::now() + Duration::from_secs_f64(self.options.discovery_timeout_s);
         loop {
+            self.check_process("before it was discovered")?;
             let readers = self.cloud.get_subscription_count(&self.node);
             let writers = self.cmd.get_publisher_count(&self.node);
             if readers > 0 && writers > 0 {
@@ -366,6 +397,7 @@ impl Ros2Stack {
                 }
                 self.stale += 1;
             }
+            self.check_process(&format!("at t = {t_s:.3} s"))?;
             if self.cmd.get_publisher_count(&self.node) == 0 {
                 return Err(Error::Stack(format!(
                     "the stack's /cmd_vel publisher left at t = {t_s:.3} s"

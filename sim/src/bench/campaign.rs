@@ -47,6 +47,7 @@ fn in_process(campaign: &Campaign, n: u64, jobs: usize, dir: &Path) -> Result<f6
             stop: &stop,
             record_failures: false,
             progress: &|_| {},
+            stack: None,
         },
     )?;
     Ok(t.elapsed().as_secs_f64())

@@ -15,7 +15,10 @@ use super::record::{RunRecord, invalid, read_results, record};
 use super::sampler::{self, Proposal, SamplerKind};
 use super::shard::{Shard, claim};
 use super::{Campaign, Variant};
-use crate::engine::{EndReason, NoObserver, RunHandles, RunSetup, run_with};
+use crate::engine::{
+    EndReason, ExternalStack, LatePolicy, NoObserver, RunHandles, RunReport, RunSetup,
+    run_external, run_with,
+};
 use crate::error::{Error, Result};
 use crate::scenario::Scenario;
 
@@ -39,6 +42,35 @@ pub struct RunOptions<'a> {
     pub record_failures: bool,
     /// Told of every recorded run.
     pub progress: &'a (dyn Fn(&RunRecord) + Sync),
+    /// The stack outside the process that drives every run (`None`: the shipped stack).
+    pub stack: Option<ExternalStacks<'a>>,
+}
+
+/// A stack outside the process for a campaign's runs: a fresh one per run, made for the worker
+/// that runs it (worker `w` of `jobs`: a transport isolates each worker's runs from the others',
+/// e.g. on ROS domain `base + w`).
+#[derive(Clone, Copy)]
+pub struct ExternalStacks<'a> {
+    /// Makes worker `w`'s stack for its next run.
+    pub make: &'a (dyn Fn(usize) -> Result<Box<dyn ExternalStack>> + Sync),
+    /// What a late answer costs.
+    pub policy: LatePolicy,
+}
+
+/// One run by the shipped stack, or by worker `worker`'s external stack.
+fn drive(
+    scenario: &Scenario,
+    setup: &RunSetup,
+    handles: RunHandles<'_>,
+    stack: Option<(ExternalStacks<'_>, usize)>,
+) -> Result<RunReport> {
+    match stack {
+        None => run_with(scenario, setup, handles),
+        Some((stacks, worker)) => {
+            let mut stack = (stacks.make)(worker)?;
+            run_external(scenario, setup, handles, stack.as_mut(), stacks.policy)
+        }
+    }
 }
 
 /// What a campaign run did.
@@ -116,7 +148,7 @@ fn run_variant(
     maps: &MapCache,
     (dir, record_failures): (&Path, bool),
     stop: &AtomicBool,
-    pool: &rayon::ThreadPool,
+    (pool, stack): (&rayon::ThreadPool, Option<(ExternalStacks<'_>, usize)>),
 ) -> Result<Option<RunRecord>> {
     let scenario = match Scenario::from_str(&v.text, &campaign.variant_path(v.index)) {
         Ok(s) => s,
@@ -131,7 +163,7 @@ fn run_variant(
         ..RunSetup::new(map_dir)
     };
     let report = pool.install(|| {
-        run_with(
+        drive(
             &scenario,
             &setup,
             RunHandles {
@@ -139,6 +171,7 @@ fn run_variant(
                 progress: &mut |_| {},
                 observer: &mut NoObserver,
             },
+            stack,
         )
     })?;
     if report.end == EndReason::Interrupted {
@@ -152,7 +185,7 @@ fn run_variant(
                 .join("failures")
                 .join(v.index.to_string())
                 .join(format!("{}.mcap", v.index));
-            record_again(&scenario, &setup, &bag, stop, pool, &report)?;
+            record_again(&scenario, &setup, &bag, stop, (pool, stack), &report)?;
         }
     }
     Ok(Some(rec))
@@ -165,8 +198,8 @@ fn record_again(
     setup: &RunSetup,
     bag: &Path,
     stop: &AtomicBool,
-    pool: &rayon::ThreadPool,
-    first: &crate::engine::RunReport,
+    (pool, stack): (&rayon::ThreadPool, Option<(ExternalStacks<'_>, usize)>),
+    first: &RunReport,
 ) -> Result<()> {
     if let Some(parent) = bag.parent() {
         std::fs::create_dir_all(parent).map_err(|source| Error::Io {
@@ -177,7 +210,7 @@ fn record_again(
     }
     let mut writer = crate::rosbag::RosBag::create(bag)?;
     let again = pool.install(|| {
-        run_with(
+        drive(
             scenario,
             setup,
             RunHandles {
@@ -185,9 +218,10 @@ fn record_again(
                 progress: &mut |_| {},
                 observer: &mut writer,
             },
+            stack,
         )
     })?;
-    let same = |r: &crate::engine::RunReport| (r.end, r.contacts.len(), r.stops.len());
+    let same = |r: &RunReport| (r.end, r.contacts.len(), r.stops.len());
     if again.end != EndReason::Interrupted && same(&again) != same(first) {
         return Err(Error::Invalid(format!(
             "{}: the failure ran again ended {:?} with {} contacts and {} stops, not {:?} with \
@@ -204,6 +238,10 @@ fn record_again(
     Ok(())
 }
 
+/// Runs one variant on a worker's pool: the worker's number is the third argument.
+type RunOne<'a> =
+    dyn Fn(&Variant, &rayon::ThreadPool, usize) -> Result<Option<RunRecord>> + Sync + 'a;
+
 /// Runs `each` over `todo` on `jobs` worker threads, each pulling the next variant; a worker
 /// runs a variant's stages on its own rayon pool of `jobs / todo` threads (one when there are
 /// more variants than cores). Stops taking variants once `stop` is set.
@@ -211,15 +249,16 @@ fn run_parallel(
     todo: &[Variant],
     jobs: usize,
     stop: &AtomicBool,
-    each: &(dyn Fn(&Variant, &rayon::ThreadPool) -> Result<Option<RunRecord>> + Sync),
+    each: &RunOne<'_>,
 ) -> Result<Vec<RunRecord>> {
     let next = std::sync::atomic::AtomicUsize::new(0);
     let workers = jobs.min(todo.len()).max(1);
     let threads = (jobs / workers).max(1);
     let results: Vec<Result<Vec<RunRecord>>> = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..workers)
-            .map(|_| {
-                scope.spawn(|| -> Result<Vec<RunRecord>> {
+            .map(|worker| {
+                let next = &next;
+                scope.spawn(move || -> Result<Vec<RunRecord>> {
                     let pool = rayon::ThreadPoolBuilder::new()
                         .num_threads(threads)
                         .build()
@@ -230,7 +269,7 @@ fn run_parallel(
                         if i >= todo.len() || stop.load(Ordering::Relaxed) {
                             return Ok(mine);
                         }
-                        mine.extend(each(&todo[i], &pool)?);
+                        mine.extend(each(&todo[i], &pool, worker)?);
                     }
                 })
             })
@@ -315,14 +354,14 @@ pub fn run_campaign(campaign: &Campaign, opts: &RunOptions<'_>) -> Result<Outcom
             .filter(|i| !have.contains(i) && opts.shard.is_none_or(|s| s.holds(*i)))
             .map(|i| variant(campaign, i, &records))
             .collect();
-        let fresh = run_parallel(&todo, opts.jobs.max(1), opts.stop, &|v, pool| {
+        let fresh = run_parallel(&todo, opts.jobs.max(1), opts.stop, &|v, pool, worker| {
             let rec = run_variant(
                 campaign,
                 v,
                 &maps,
                 (dir, opts.record_failures),
                 opts.stop,
-                pool,
+                (pool, opts.stack.map(|s| (s, worker))),
             )?;
             if let Some(r) = &rec {
                 out.push(r)?;

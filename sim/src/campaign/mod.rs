@@ -18,7 +18,9 @@ pub mod sampler;
 mod shard;
 pub mod summary;
 
-pub use execute::{Outcome, RunOptions, proposals_for, run_campaign, total_runs, variant};
+pub use execute::{
+    ExternalStacks, Outcome, RunOptions, proposals_for, run_campaign, total_runs, variant,
+};
 pub use map_cache::{MapCache, static_world_key};
 pub use record::{INVALID, ObstacleOutcome, RunRecord, failures_of, read_results, record};
 pub use shard::Shard;

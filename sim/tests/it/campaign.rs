@@ -123,6 +123,7 @@ fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
             stop: &stop,
             record_failures: false,
             progress: &|_| {},
+            stack: None,
         },
     )
     .unwrap();
@@ -161,6 +162,7 @@ fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
             stop: &stop,
             record_failures: false,
             progress: &|_| {},
+            stack: None,
         },
     )
     .unwrap_err()
@@ -188,6 +190,7 @@ fn a_stop_keeps_only_whole_runs_and_the_rest_runs_later() {
             stop: &stop,
             record_failures: false,
             progress: &|_| stop.store(true, Ordering::Relaxed),
+            stack: None,
         },
     )
     .unwrap();
@@ -322,7 +325,8 @@ fn every_shipped_campaign_reads_and_its_first_variants_are_valid_scenarios() {
             "tune_a320",
             "tune_car",
             "tune_praetor",
-            "tune_smoke"
+            "tune_smoke",
+            "your_stack"
         ]
     );
 }
@@ -383,6 +387,7 @@ fn the_falsifier_cannot_be_sharded() {
             stop: &stop,
             record_failures: false,
             progress: &|_| {},
+            stack: None,
         },
     )
     .unwrap_err()

@@ -48,6 +48,7 @@ pub fn run_recording(
             stop: &stop,
             record_failures,
             progress: &|_| {},
+            stack: None,
         },
     )
     .unwrap_or_else(|e| panic!("{e}"))

@@ -7,7 +7,13 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sim::campaign::Campaign;
-use sim::campaign::{RunOptions, Shard, read_results, run_campaign, total_runs};
+use sim::campaign::{ExternalStacks, RunOptions, Shard, read_results, run_campaign, total_runs};
+use sim::engine::ExternalStack;
+
+use super::stack::StackKind;
+
+/// Makes job `j`'s external stack for its next run.
+type MakeStack<'a> = dyn Fn(usize) -> sim::Result<Box<dyn ExternalStack>> + Sync + 'a;
 
 /// `taxi-sim campaign ...`.
 #[derive(Debug, clap::Subcommand)]
@@ -69,6 +75,11 @@ pub struct CampaignRunArgs {
     /// `ros2 bag play`, `taxi-sim map --from-bag`); runs are reproducible, so only failures pay.
     #[arg(long)]
     pub record_failures: bool,
+    /// The stack that drives every run (`--stack ros2`: yours over DDS, each parallel job on ROS
+    /// domain `--ros-domain-id` + its number, a stack `--stack-command` starts per run; its
+    /// output in OUT/stack-job-J.log, or `--stack-log` with the job in its extension).
+    #[command(flatten)]
+    pub stack: super::stack::StackArgs,
 }
 
 /// Runs `taxi-sim campaign ...`; returns whether no run failed.
@@ -151,6 +162,7 @@ pub(crate) fn run_args(args: &CampaignRunArgs) -> anyhow::Result<(usize, bool)> 
         campaign.settings.len(),
         jobs
     );
+    let stacks = external_stacks(args, jobs)?;
     let stop = Arc::new(AtomicBool::new(false));
     let flag = stop.clone();
     let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
@@ -171,6 +183,10 @@ pub(crate) fn run_args(args: &CampaignRunArgs) -> anyhow::Result<(usize, bool)> 
                 bar.set_message(format!("{f} failed"));
                 bar.inc(1);
             },
+            stack: stacks.as_ref().map(|make| ExternalStacks {
+                make: &**make,
+                policy: args.stack.policy(),
+            }),
         },
     )?;
     bar.finish_and_clear();
@@ -219,4 +235,45 @@ fn merge(out: &std::path::Path, shards: &[PathBuf]) -> anyhow::Result<bool> {
     }
     crate::emit(&text)?;
     Ok(m.missing.is_empty())
+}
+
+/// `--stack ros2`: each job's stack on its own ROS domain (`--ros-domain-id` + the job), so
+/// parallel runs never hear each other; `None` for the shipped stack.
+fn external_stacks(
+    args: &CampaignRunArgs,
+    jobs: usize,
+) -> anyhow::Result<Option<Box<MakeStack<'_>>>> {
+    if args.stack.stack == StackKind::Shipped {
+        return Ok(None);
+    }
+    let base = ros2_live::LiveOptions::domain_id(args.stack.ros_domain_id)?;
+    let last = base as usize + jobs - 1;
+    anyhow::ensure!(
+        last <= ros2_live::MAX_DOMAIN_ID as usize,
+        "--ros-domain-id {base} with {jobs} jobs: domains up to {last}, beyond {}",
+        ros2_live::MAX_DOMAIN_ID
+    );
+    args.stack.live_options(base)?;
+    eprintln!(
+        "each run driven by a ROS 2 stack{}, job j on ROS domain {base} + j",
+        if args.stack.stack_command.is_some() {
+            " the simulator starts"
+        } else {
+            " already running"
+        }
+    );
+    Ok(Some(Box::new(move |job: usize| {
+        let mut options = args
+            .stack
+            .live_options(base + job as u16)
+            .map_err(|e| sim::Error::Invalid(e.to_string()))?;
+        if options.command.is_some() {
+            // One log per job: the jobs' stacks run side by side.
+            options.log = Some(match &args.stack.stack_log {
+                Some(p) => p.with_extension(format!("job-{job}.log")),
+                None => args.out.join(format!("stack-job-{job}.log")),
+            });
+        }
+        Ok(Box::new(ros2_live::Ros2Stack::new(options)?) as Box<dyn ExternalStack>)
+    })))
 }

@@ -36,6 +36,49 @@ pub struct StackArgs {
     /// `stack_timeout`.
     #[arg(long)]
     pub lenient: bool,
+    /// `--stack ros2`: start the stack as `sh -c CMD` with `ROS_DOMAIN_ID` set to the run's
+    /// domain, and stop it (SIGINT, then SIGKILL after 5 s) when the run ends; without it, a
+    /// stack already running on the domain is attached to.
+    #[arg(long, value_name = "CMD")]
+    pub stack_command: Option<String>,
+    /// `--stack-command`: write the stack's output to this file (default: this stderr); its
+    /// last lines are quoted if the stack exits during the run.
+    #[arg(long, value_name = "FILE", requires = "stack_command")]
+    pub stack_log: Option<std::path::PathBuf>,
+}
+
+impl StackArgs {
+    /// The live options of `--stack ros2` on `domain_id`; an error names a bad flag.
+    pub fn live_options(&self, domain_id: u16) -> anyhow::Result<ros2_live::LiveOptions> {
+        for (flag, s) in [
+            ("--stack-timeout-s", self.stack_timeout_s),
+            ("--discovery-timeout-s", self.discovery_timeout_s),
+        ] {
+            anyhow::ensure!(
+                s.is_finite() && s > 0.0,
+                "{flag} {s}: a positive number of seconds"
+            );
+        }
+        if let Some(c) = &self.stack_command {
+            anyhow::ensure!(!c.trim().is_empty(), "--stack-command is empty");
+        }
+        Ok(ros2_live::LiveOptions {
+            domain_id,
+            discovery_timeout_s: self.discovery_timeout_s,
+            stack_timeout_s: self.stack_timeout_s,
+            command: self.stack_command.clone(),
+            log: self.stack_log.clone(),
+        })
+    }
+
+    /// What a late answer costs.
+    pub fn policy(&self) -> LatePolicy {
+        if self.lenient {
+            LatePolicy::Lenient
+        } else {
+            LatePolicy::Strict
+        }
+    }
 }
 
 /// Runs the scenario with the stack `args` picks.
@@ -45,34 +88,22 @@ pub fn drive(
     setup: &RunSetup,
     handles: RunHandles<'_>,
 ) -> anyhow::Result<RunReport> {
-    for (flag, s) in [
-        ("--stack-timeout-s", args.stack_timeout_s),
-        ("--discovery-timeout-s", args.discovery_timeout_s),
-    ] {
-        anyhow::ensure!(
-            s.is_finite() && s > 0.0,
-            "{flag} {s}: a positive number of seconds"
-        );
-    }
     Ok(match args.stack {
         StackKind::Shipped => run_with(scenario, setup, handles)?,
         StackKind::Ros2 => {
-            let options = ros2_live::LiveOptions {
-                domain_id: ros2_live::LiveOptions::domain_id(args.ros_domain_id)?,
-                discovery_timeout_s: args.discovery_timeout_s,
-                stack_timeout_s: args.stack_timeout_s,
-            };
-            eprintln!(
-                "waiting up to {} s for a ROS 2 stack on domain {} (a subscriber of /velodyne_points, a publisher of /cmd_vel)",
-                options.discovery_timeout_s, options.domain_id
+            let domain = ros2_live::LiveOptions::domain_id(args.ros_domain_id)?;
+            let mut stack = ros2_live::Ros2Stack::new(args.live_options(domain)?)?;
+            let wait = format!(
+                "waiting up to {} s for it (a subscriber of /velodyne_points, a publisher of /cmd_vel)",
+                args.discovery_timeout_s
             );
-            let mut stack = ros2_live::Ros2Stack::new(options)?;
-            let policy = if args.lenient {
-                LatePolicy::Lenient
-            } else {
-                LatePolicy::Strict
-            };
-            run_external(scenario, setup, handles, &mut stack, policy)?
+            match stack.process_id() {
+                Some(pid) => {
+                    eprintln!("started the stack (pid {pid}) on ROS domain {domain}; {wait}")
+                }
+                None => eprintln!("attaching to a ROS 2 stack on domain {domain}; {wait}"),
+            }
+            run_external(scenario, setup, handles, &mut stack, args.policy())?
         }
     })
 }

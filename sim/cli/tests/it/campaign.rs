@@ -81,6 +81,7 @@ fn run_shard(campaign: &Campaign, out: &Path, maps: &Path, shard: Shard) -> Vec<
             stop: &stop,
             record_failures: false,
             progress: &|_| {},
+            stack: None,
         },
     )
     .unwrap_or_else(|e| panic!("{e}"))
@@ -123,6 +124,7 @@ fn shards_merged_equal_the_single_machine_run_and_a_lost_shard_is_named_and_reru
             stop: &stop,
             record_failures: false,
             progress: &|_| {},
+            stack: None,
         },
     )
     .unwrap_err()

@@ -1,6 +1,7 @@
 //! `run --stack ros2` refuses what it cannot use by name: a domain id beyond DDS's range, a
 //! timeout that is not a positive number, and - after waiting its discovery timeout on a domain
-//! nobody else uses - the absence of a stack, naming both topics it found no peer on.
+//! nobody else uses - the absence of a stack, naming both topics it found no peer on; a stack it
+//! started that exits before it is found, with its status and the last lines it wrote.
 
 use super::taxi_sim_in;
 
@@ -32,6 +33,8 @@ fn bad_stack_options_are_refused_by_name() {
             &["--discovery-timeout-s", "nan"][..],
             "--discovery-timeout-s NaN",
         ),
+        (&["--stack-command", " "][..], "--stack-command is empty"),
+        (&["--stack-log", "s.log"][..], "--stack-command <CMD>"),
     ] {
         let mut all = vec!["run", "short.toml", "--stack", "ros2"];
         all.extend_from_slice(args);
@@ -65,6 +68,38 @@ fn with_no_stack_on_the_domain_the_run_does_not_start() {
         err.contains("no stack found on ROS domain 197 within 1 s")
             && err.contains("no subscriber of /velodyne_points")
             && err.contains("no publisher of /cmd_vel"),
+        "{err}"
+    );
+    assert!(!d.path().join("r.json").exists());
+}
+
+#[test]
+fn a_started_stack_that_exits_ends_the_run_with_its_status_and_last_lines() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(d.path().join("short.toml"), SHORT).unwrap();
+    let (code, out, err) = taxi_sim_in(
+        d.path(),
+        &[
+            "run",
+            "short.toml",
+            "--stack",
+            "ros2",
+            "--ros-domain-id",
+            "198",
+            "--stack-command",
+            "echo stack on domain $ROS_DOMAIN_ID; echo 'ImportError: no module rclpy' >&2; exit 4",
+            "--stack-log",
+            "stack.log",
+            "--report",
+            "r.json",
+        ],
+    );
+    assert_eq!(code, 2, "{out}\n{err}");
+    assert!(
+        err.contains("started the stack (pid ")
+            && err.contains("exited with status 4 before it was discovered")
+            && err.contains("stack on domain 198")
+            && err.contains("ImportError: no module rclpy"),
         "{err}"
     );
     assert!(!d.path().join("r.json").exists());
