@@ -8,8 +8,9 @@
 # stack itself, --stack-command, and the stack floods ten junk commands a step: discarded); the
 # hostile peers: a stack that goes silent (strict: stack_timeout, the time and topic named), one
 # that commands NaN (stack_failed, the field named), one that stamps its commands with the
-# revolution before (stale, then stack_timeout), one that answers once 1.5 s late (--lenient:
-# held, counted, the run goes on), one that crashes (its status and last log line named), one
+# revolution before (stale, then stack_timeout), one that answers once 3 s late (--lenient:
+# held, counted, the run goes on; that run publishes /ground_truth/pose for tools, and a tool
+# gets it at every step, while the other runs have no such topic), one that crashes (its status and last log line named), one
 # that never subscribes, and no stack at all (the missing topics named); and a campaign of two
 # variants run two jobs at a time on two ROS domains, then one job: the same records.
 #   deploy/ros2/netns.sh .ci/ros2_live.sh
@@ -60,7 +61,7 @@ spawned again --flood 10
 live silent --stop-answering-at 3.0 -- --stack-timeout-s 2
 live nan --nan-at 2.0
 live wrong --wrong-stamp-from 3.0 -- --stack-timeout-s 2
-live late --late-at 3.0 --late-by 1.5 -- --stack-timeout-s 1 --lenient --time-limit-s 8
+live late --late-at 3.0 --late-by 3.0 --count-ground-truth -- --stack-timeout-s 2 --lenient --time-limit-s 8 --ros-ground-truth
 spawned crash --crash-at 3.0
 live deaf --no-subscribe -- --discovery-timeout-s 3
 # Your stack in a campaign (scenarios/campaigns/your_stack.toml, two variants): two jobs at a
@@ -120,7 +121,13 @@ check(r["end"] == "stack_timeout" and rc("wrong") == 1 and s["first_late"] == [3
 r = report("late"); s = r["stack"]
 check(r["end"] == "timed_out" and s["late"] == 1 and s["first_late"] == [3.0, "/cmd_vel"]
       and s["stale"] >= 1 and s["commands"] == s["steps"] - 1 and not r["contacts"],
-      f"late, lenient: one step late at 3.0 s held and counted ({s['late']} late, {s['stale']} stale), the run went on to its 8 s limit ({r['end']})")
+      f"late, lenient (3 s late, 2 s timeout): one step late at 3.0 s held and counted ({s['late']} late, {s['stale']} stale), the run went on to its 8 s limit ({r['end']})")
+seen = lambda n: next((l for l in (out / f"{n}.stack.log").read_text().splitlines() if "topics seen:" in l), "")  # noqa: E731
+count = [l for l in (out / "late.stack.log").read_text().splitlines() if "ground truth messages:" in l]
+check("/ground_truth/pose" in seen("late") and count and int(count[0].split()[-1]) >= 70,
+      f"ground truth: with --ros-ground-truth a tool gets /ground_truth/pose at every step ({count[0].split(': ', 1)[-1] if count else 'none'})")
+check("/velodyne_points" in seen("whole") and "/ground_truth/pose" not in seen("whole"),
+      "ground truth: without it the topic does not exist")
 r = report("crash"); s = r["stack"]; e = s.get("error", "")
 check(r["end"] == "stack_failed" and rc("crash") == 1 and "exited with status 3 at t = 3.000 s" in e
       and "crashing on purpose" in e, f"crash: stack_failed with its status, the time and its last log line ({e!r})")

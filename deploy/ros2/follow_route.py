@@ -26,7 +26,7 @@ import time
 
 import numpy as np
 import rclpy
-from geometry_msgs.msg import PoseWithCovarianceStamped, TwistStamped
+from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TwistStamped
 from nav_msgs.msg import Path
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -75,6 +75,12 @@ class FollowRoute(Node):
             self.create_subscription(PointCloud2, "/velodyne_points", self.on_cloud, qos(1))
         self.clouds, self.poses = {}, {}
         self.previous_stamp = None
+        self.ground_truth = 0
+        if args.count_ground_truth:  # a tool's view: the stack itself never steers by it
+            self.create_subscription(PoseStamped, "/ground_truth/pose", self.on_truth, qos(10))
+
+    def on_truth(self, _m):
+        self.ground_truth += 1
 
     def on_route(self, m):
         self.route = np.array([[p.pose.position.x, p.pose.position.y] for p in m.poses])
@@ -160,6 +166,9 @@ class FollowRoute(Node):
             self.pub.publish(junk)
         self.pub.publish(m)
         self.answered += 1
+        if self.answered == 1:  # the simulator's topics, as the graph shows them at the first step
+            topics = sorted(name for name, _ in self.get_topic_names_and_types())
+            self.get_logger().info(f"topics seen: {' '.join(topics)}")
 
 
 
@@ -182,6 +191,9 @@ def main():
     ap.add_argument("--crash-at", type=float, help="sim s: exit with status 3 (a test)")
     ap.add_argument("--flood", type=int, default=0, help="junk commands before each answer (a test)")
     ap.add_argument("--no-subscribe", action="store_true", help="never take the cloud (a test)")
+    ap.add_argument(
+        "--count-ground-truth", action="store_true", help="count /ground_truth/pose messages (a test)"
+    )
     ap.add_argument("--exit-after-s", type=float, default=600.0, help="wall s")
     args = ap.parse_args()
     rclpy.init()
@@ -193,6 +205,8 @@ def main():
     except KeyboardInterrupt:
         pass
     node.get_logger().info(f"answered {node.answered} revolutions")
+    if args.count_ground_truth:
+        node.get_logger().info(f"ground truth messages: {node.ground_truth}")
     node.destroy_node()
     rclpy.try_shutdown()
     return 0

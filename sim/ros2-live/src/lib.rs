@@ -13,6 +13,7 @@
 //! | `/odom` | nav_msgs/Odometry (the simulated wheels, not ground truth) | reliable, keep last 10 |
 //! | `/localization/pose` | geometry_msgs/PoseWithCovarianceStamped in `map` (the pose source's estimate) | reliable, keep last 10 |
 //! | `/route` | nav_msgs/Path in `map` | reliable, transient local |
+//! | `/ground_truth/pose` (only with `ground_truth`) | geometry_msgs/PoseStamped in `map`: the true pose, for tools | reliable, keep last 10 |
 //! | `/cmd_vel` (taken) | geometry_msgs/TwistStamped, stamped with the step it answers | reliable, keep last 10 |
 
 pub mod msgs;
@@ -58,6 +59,8 @@ pub struct LiveOptions {
     pub command: Option<String>,
     /// Where a started stack's output goes (default: the simulator's stderr).
     pub log: Option<std::path::PathBuf>,
+    /// Publish the true pose on `/ground_truth/pose`, for tools (off: the topic does not exist).
+    pub ground_truth: bool,
 }
 
 impl LiveOptions {
@@ -96,6 +99,7 @@ pub struct Ros2Stack {
     odom: Publisher<Odometry>,
     pose: Publisher<PoseWithCovarianceStamped>,
     route: Publisher<Path>,
+    truth: Option<Publisher<PoseStamped>>,
     cmd: Subscription<TwistStamped>,
     poll: Poll,
     events: Events,
@@ -169,6 +173,17 @@ impl Ros2Stack {
             false
         );
         let route = publisher!("/route", "nav_msgs", "Path", 1, true);
+        let truth = if options.ground_truth {
+            Some(publisher!(
+                "/ground_truth/pose",
+                "geometry_msgs",
+                "PoseStamped",
+                10,
+                false
+            ))
+        } else {
+            None
+        };
         let cmd_name = Name::parse("/cmd_vel").map_err(|e| dds("/cmd_vel", e))?;
         let cmd_topic = node
             .create_topic(
@@ -204,6 +219,7 @@ impl Ros2Stack {
             odom,
             pose,
             route,
+            truth,
             cmd,
             poll,
             events: Events::with_capacity(8),
@@ -367,6 +383,13 @@ impl ExternalStack for Ros2Stack {
                 },
             };
             publish(&self.pose, m, deadline, "/localization/pose")?;
+        }
+        if let Some(truth) = &self.truth {
+            let m = PoseStamped {
+                header: Header::new(t, "map"),
+                pose: pose2(&input.truth, 0.0),
+            };
+            publish(truth, m, deadline, "/ground_truth/pose")?;
         }
         if let Some(points) = input.cloud {
             let cloud = PointCloud2::velodyne(t, "velodyne", points);

@@ -53,6 +53,17 @@ impl Rig<'_> {
                 self.driver.on_walk_around();
                 observer.event(self.t_s, &Event::WalkAround)?;
             }
+            if !self.start_unseen_told
+                && let Some((cells, cell_m)) = self.driver.start_unseen_cells()
+            {
+                self.start_unseen_told = true;
+                let event = Event::StartUnseen {
+                    area_m2: cells.len() as f64 * cell_m * cell_m,
+                    cell_m,
+                    cells_m: cells.iter().map(|c| [c.x, c.y]).collect(),
+                };
+                observer.event(self.t_s, &event)?;
+            }
             let physics = Instant::now();
             self.move_obstacles();
             self.split.physics += physics.elapsed().as_secs_f64();
@@ -180,6 +191,7 @@ impl Rig<'_> {
             self.fault_counts.lost_revolutions += 1;
             return Ok(());
         }
+        // The fields, not `self.sensor()`: the scheduler and the driver are borrowed mutably below.
         let sensor = Sensor {
             world: &self.world,
             lidar: &self.lidar,
@@ -334,6 +346,18 @@ impl Rig<'_> {
 }
 
 impl Rig<'_> {
+    /// The vehicle's LiDAR in the world, with the run's faults.
+    fn sensor(&self) -> Sensor<'_> {
+        Sensor {
+            world: &self.world,
+            lidar: &self.lidar,
+            faults: &self.config.faults,
+            seed: self.seed,
+            dropped: &self.dropped_returns,
+            spurious: &self.spurious_returns,
+        }
+    }
+
     /// One control step of an external stack: the revolution taken (unless the faults lose it)
     /// and handed over with the odometry and the pose estimate; its answer checked and held.
     /// The run's end when the stack is late (strict), fails, or asks for the absurd.
@@ -347,14 +371,7 @@ impl Rig<'_> {
             self.fault_counts.lost_revolutions += 1;
             None
         } else {
-            let sensor = Sensor {
-                world: &self.world,
-                lidar: &self.lidar,
-                faults,
-                seed,
-                dropped: &self.dropped_returns,
-                spurious: &self.spurious_returns,
-            };
+            let sensor = self.sensor();
             let at = estimate.unwrap_or_else(|| autonomy::PoseEstimate::exact(t_s, *truth));
             Some(sensor.capture(truth, &at, index, t_s)?)
         };
@@ -375,6 +392,7 @@ impl Rig<'_> {
             odom_from_vehicle: external.odom_from_vehicle,
             odometry: external.odometry,
             estimate,
+            truth: *truth,
         };
         external.report.steps += 1;
         let answer = match external.stack.step(&input) {

@@ -50,6 +50,9 @@ pub struct StackInput<'a> {
     /// The pose source's estimate (the particle filter's, or the truth's), for a stack without
     /// its own localizer.
     pub estimate: Option<PoseEstimate>,
+    /// The vehicle's true pose in the world, for tools (a transport hands it to the stack only
+    /// where asked, and never as the stack's own input).
+    pub truth: Isometry2<f64>,
 }
 
 /// A velocity command as Nav2 publishes it (`geometry_msgs/Twist`).

@@ -219,6 +219,16 @@ pub enum Event {
     /// The crew's walk-around confirmed the ground round the vehicle that its LiDAR cannot see
     /// (`[vehicle] walk_around` at a time): the start-up rule lets it move off.
     WalkAround,
+    /// The start-up rule's first check: the ground the first plan would sweep that the LiDAR
+    /// cannot see from the start (none: `area_m2` 0 and no cells).
+    StartUnseen {
+        /// Its area, square metres.
+        area_m2: f64,
+        /// The cells' side, metres.
+        cell_m: f64,
+        /// The cells' centres in the world, metres.
+        cells_m: Vec<[f64; 2]>,
+    },
     /// The stack's watchdog stopped the vehicle (no fresh LiDAR revolution) or let it go again.
     Watchdog {
         /// True when it began holding the vehicle, false when revolutions returned.

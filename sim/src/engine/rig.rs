@@ -216,6 +216,8 @@ pub(super) struct Rig<'a> {
     pub(super) in_transit: std::collections::VecDeque<(f64, Captured)>,
     /// When the crew's walk-around is still to come (`[vehicle] walk_around` at a time), seconds.
     pub(super) walk_around_at_s: Option<f64>,
+    /// Whether the observer has been told of the ground the start-up rule found unseen.
+    pub(super) start_unseen_told: bool,
     /// A stack outside the process driving the vehicle instead of `driver`, if any.
     pub(super) external: Option<External<'a>>,
     /// The live map's scratch directory, removed with the rig.
@@ -336,6 +338,7 @@ impl<'a> Rig<'a> {
                 WalkAround::At(t) => Some(t),
                 _ => None,
             },
+            start_unseen_told: false,
             config,
             external: None,
             _live: live,

@@ -23,6 +23,17 @@ pub(super) fn event_line(event: &Event) -> (String, &'static str) {
             "walk-around: the crew confirms the ground the LiDAR cannot see".to_string(),
             TextLogLevel::INFO,
         ),
+        Event::StartUnseen { area_m2, .. } if *area_m2 > 0.0 => (
+            format!(
+                "start-up rule: {area_m2:.1} m2 of the ground the first plan sweeps is out of the LiDAR's sight (world/start/unseen): waiting for the walk-around"
+            ),
+            TextLogLevel::WARN,
+        ),
+        Event::StartUnseen { .. } => (
+            "start-up rule: the ground the first plan sweeps is all in the LiDAR's sight"
+                .to_string(),
+            TextLogLevel::INFO,
+        ),
         Event::Watchdog { holding: true } => (
             "watchdog: no fresh LiDAR revolution, stopping".to_string(),
             TextLogLevel::WARN,

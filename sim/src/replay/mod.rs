@@ -89,6 +89,10 @@ impl From<rerun::sink::SinkFlushError> for Error {
 /// The timeline every entity is logged on.
 pub const TIMELINE: &str = "sim_time";
 
+/// The ground the start-up rule found out of the LiDAR's sight at the start (orange squares on
+/// the ground), cleared by the walk-around.
+pub const START_UNSEEN: &str = "world/start/unseen";
+
 /// The Rerun version this module is built against (the viewer should match it).
 pub const RERUN_VERSION: &str = "0.36";
 
@@ -293,6 +297,24 @@ impl Observer for Replay {
         let (text, level) = events::event_line(event);
         self.rec
             .log("events", &rerun::TextLog::new(text).with_level(level))?;
+        match event {
+            Event::StartUnseen {
+                cell_m, cells_m, ..
+            } if !cells_m.is_empty() => {
+                let h = (*cell_m / 2.0) as f32;
+                self.rec.log(
+                    START_UNSEEN,
+                    &rerun::Boxes3D::from_centers_and_half_sizes(
+                        cells_m.iter().map(|c| [c[0] as f32, c[1] as f32, 0.02]),
+                        cells_m.iter().map(|_| [h, h, 0.01]),
+                    )
+                    .with_colors([rerun::Color::from_unmultiplied_rgba(255, 140, 0, 160)])
+                    .with_fill_mode(rerun::FillMode::Solid),
+                )?;
+            }
+            Event::WalkAround => self.rec.log(START_UNSEEN, &rerun::Clear::flat())?,
+            _ => {}
+        }
         Ok(())
     }
 

@@ -354,7 +354,16 @@ impl Observer for RosBag {
     }
 
     fn event(&mut self, t_s: f64, event: &Event) -> Result<()> {
-        let text = format!("{event:?}");
+        let text = match event {
+            // Its cells are the replay's picture, not a line of text.
+            Event::StartUnseen {
+                area_m2, cells_m, ..
+            } => format!(
+                "StartUnseen {{ area_m2: {area_m2:.2}, cells: {} }}",
+                cells_m.len()
+            ),
+            _ => format!("{event:?}"),
+        };
         let kind = text
             .split(|c: char| !c.is_alphanumeric())
             .next()

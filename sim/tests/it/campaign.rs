@@ -315,6 +315,7 @@ fn every_shipped_campaign_reads_and_its_first_variants_are_valid_scenarios() {
             "faults",
             "faults_aerodrome",
             "jet_wing_and_engine_paths",
+            "left_at_start",
             "low_debris_car",
             "parking_lot_random",
             "sensor_bias",

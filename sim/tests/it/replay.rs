@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use rerun::external::re_log_encoding::rrd::DecoderApp;
 use rerun::log::{Chunk, LogMsg};
-use sim::engine::{EndReason, RunHandles, RunSetup, run_with};
+use sim::engine::{EndReason, RunHandles, RunReport, RunSetup, run_with};
 use sim::replay::{Replay, ReplayOptions};
 use sim::scenario::{RunConfig, Scenario};
 
@@ -44,15 +44,15 @@ fn entity_paths(rrd: &Path) -> (BTreeSet<String>, bool) {
     (paths, footer)
 }
 
-#[test]
-fn a_short_run_is_recorded_completely_with_every_entity_path() {
-    let s = scenario("straight_cone_under_wing");
+/// Scenario `name` on a fresh map, recorded into `TMP/replay/run.rrd` until `until_s` of
+/// simulated time, then stopped as Ctrl-C would: the directory, the recording's path, the
+/// report and the replay.
+fn recorded(name: &str, until_s: f64) -> (tempfile::TempDir, PathBuf, RunReport, Replay) {
+    let s = scenario(name);
     let dir = tempfile::tempdir().unwrap();
     let map_dir = dir.path().join("map");
     sim::offline_map::map_drive(&s, &RunConfig::default(), &map_dir, &mut |_, _| {}).unwrap();
-    let out = dir.path().join("replay");
-    let rrd = out.join("run.rrd");
-    let setup = RunSetup::new(map_dir);
+    let rrd = dir.path().join("replay").join("run.rrd");
     let mut replay = Replay::new(
         &ReplayOptions {
             record: Some(rrd.clone()),
@@ -61,15 +61,14 @@ fn a_short_run_is_recorded_completely_with_every_entity_path() {
         &s.name,
     )
     .unwrap();
-    // 18 s of simulated time: past the cone (x = 60 m at 5 m/s), then Ctrl-C as a user would.
     let stop = AtomicBool::new(false);
     let report = run_with(
         &s,
-        &setup,
+        &RunSetup::new(map_dir),
         RunHandles {
             stop: Some(&stop),
             progress: &mut |p| {
-                if p.sim_time_s >= 18.0 {
+                if p.sim_time_s >= until_s {
                     stop.store(true, Ordering::Relaxed);
                 }
             },
@@ -77,6 +76,14 @@ fn a_short_run_is_recorded_completely_with_every_entity_path() {
         },
     )
     .unwrap();
+    (dir, rrd, report, replay)
+}
+
+#[test]
+fn a_short_run_is_recorded_completely_with_every_entity_path() {
+    // 18 s of simulated time: past the cone (x = 60 m at 5 m/s), then Ctrl-C as a user would.
+    let (dir, rrd, report, replay) = recorded("straight_cone_under_wing", 18.0);
+    let out = dir.path().join("replay");
     assert!(
         report.end == EndReason::Interrupted && report.sim_time_s >= 18.0,
         "{report:?}"
@@ -201,4 +208,21 @@ fn bad_replay_options_name_their_flag() {
         assert!(format!("{e:#}").contains(flag), "{flag}: {e:#}");
     }
     assert!(ReplayOptions::default().validate().is_ok());
+}
+
+/// The ground the start-up rule finds unseen at the stand (its area in the report) is drawn on
+/// the ground in the recording (`world/start/unseen`; the autonomy tests check its cells).
+#[test]
+fn the_ground_unseen_at_the_start_is_drawn_in_the_replay() {
+    // Past the walk-around at 8 s.
+    let (_dir, rrd, report, replay) = recorded("jet_moves_off_after_the_walk_around", 9.0);
+    let unseen = report.start_unseen_m2.expect("the start-up rule checked");
+    assert!(unseen > 10.0, "{unseen} m2");
+    drop(replay);
+    let (paths, _) = entity_paths(&rrd);
+    assert!(
+        paths.contains(sim::replay::START_UNSEEN),
+        "no {} in {paths:?}",
+        sim::replay::START_UNSEEN
+    );
 }

@@ -86,6 +86,8 @@ pub struct Driver {
     start: StartRule,
     /// The unseen ground the start-up rule's first check found, square metres.
     start_unseen_m2: Option<f64>,
+    /// Its cells (centres in the world) and their side, metres.
+    start_unseen_cells: Option<(Vec<Point2<f64>>, f64)>,
 }
 
 impl Driver {
@@ -123,6 +125,7 @@ impl Driver {
             traffic,
             start: StartRule::Done,
             start_unseen_m2: None,
+            start_unseen_cells: None,
         }
     }
 

@@ -39,6 +39,17 @@ impl BlindZone {
         here: &Isometry2<f64>,
         poses: &[Isometry2<f64>],
     ) -> f64 {
+        let cells = self.unseen_swept_cells(model, here, poses);
+        cells.len() as f64 * self.cell_m * self.cell_m
+    }
+
+    /// The cells of [`Self::unseen_swept_m2`]: their centres in the world, each `cell_m` square.
+    pub fn unseen_swept_cells(
+        &self,
+        model: &CollisionModel,
+        here: &Isometry2<f64>,
+        poses: &[Isometry2<f64>],
+    ) -> Vec<Point2<f64>> {
         let [nx, ny] = self.cells;
         let mut unseen = vec![false; nx * ny];
         let from_world = here.inverse();
@@ -72,7 +83,17 @@ impl BlindZone {
                 }
             }
         }
-        unseen.iter().filter(|u| **u).count() as f64 * self.cell_m * self.cell_m
+        let centre = |k: usize| {
+            let (i, j) = (k % nx, k / nx);
+            here * Point2::new(
+                self.min_m[0] + (i as f64 + 0.5) * self.cell_m,
+                self.min_m[1] + (j as f64 + 0.5) * self.cell_m,
+            )
+        };
+        (0..unseen.len())
+            .filter(|&k| unseen[k])
+            .map(centre)
+            .collect()
     }
 }
 
@@ -116,8 +137,12 @@ impl Driver {
         let StartRule::Awaiting(zone) = &self.start else {
             return None;
         };
-        let unseen_m2 = zone.unseen_swept_m2(&self.vehicle.collision, here, poses);
-        self.start_unseen_m2.get_or_insert(unseen_m2);
+        let cells = zone.unseen_swept_cells(&self.vehicle.collision, here, poses);
+        let unseen_m2 = cells.len() as f64 * zone.cell_m * zone.cell_m;
+        if self.start_unseen_m2.is_none() {
+            self.start_unseen_m2 = Some(unseen_m2);
+            self.start_unseen_cells = Some((cells, zone.cell_m));
+        }
         if unseen_m2 <= 0.0 {
             self.start = StartRule::Done;
             return None;
@@ -133,5 +158,13 @@ impl Driver {
     /// metres (`None`: no rule, or no plan yet).
     pub fn start_unseen_m2(&self) -> Option<f64> {
         self.start_unseen_m2
+    }
+
+    /// The cells of [`Self::start_unseen_m2`] (their centres in the world) and their side,
+    /// metres: the ground the first plan would have swept blind.
+    pub fn start_unseen_cells(&self) -> Option<(&[Point2<f64>], f64)> {
+        self.start_unseen_cells
+            .as_ref()
+            .map(|(c, side)| (c.as_slice(), *side))
     }
 }

@@ -318,6 +318,16 @@ fn blind_ground_ahead_holds_the_vehicle_until_the_walk_around() {
     // The two circles (x 0 and 2, radius 1) sweep a band 2 m wide along the 3 m of blind x.
     assert!((5.0..=7.0).contains(&unseen_m2), "{unseen_m2}");
     assert_eq!((since_s, d.start_unseen_m2()), (0.0, Some(unseen_m2)));
+    // Its cells, in the world: as many as the area says, each in the blind band ahead of the
+    // vehicle at (10, 0) and within the circles' reach of its path.
+    let (cells, side) = d.start_unseen_cells().unwrap();
+    assert_eq!(cells.len() as f64 * side * side, unseen_m2);
+    assert!(
+        cells
+            .iter()
+            .all(|c| (13.0..16.0).contains(&c.x) && c.y.abs() < 1.0),
+        "{cells:?}"
+    );
     let wait = AutonomyConfig::default().pilot_call_after_s;
     d.on_pose(at(wait - 0.1, 10.0, 0.0, 0.0));
     d.plan(&mut map).unwrap();

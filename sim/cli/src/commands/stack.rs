@@ -45,6 +45,10 @@ pub struct StackArgs {
     /// last lines are quoted if the stack exits during the run.
     #[arg(long, value_name = "FILE", requires = "stack_command")]
     pub stack_log: Option<std::path::PathBuf>,
+    /// `--stack ros2`: also publish the vehicle's true pose on `/ground_truth/pose`
+    /// (PoseStamped in `map`) for tools - a recorder, a visualiser; never the stack's input.
+    #[arg(long)]
+    pub ros_ground_truth: bool,
 }
 
 impl StackArgs {
@@ -68,6 +72,7 @@ impl StackArgs {
             stack_timeout_s: self.stack_timeout_s,
             command: self.stack_command.clone(),
             log: self.stack_log.clone(),
+            ground_truth: self.ros_ground_truth,
         })
     }
 
