@@ -128,6 +128,8 @@ check("/ground_truth/pose" in seen("late") and count and int(count[0].split()[-1
       f"ground truth: with --ros-ground-truth a tool gets /ground_truth/pose at every step ({count[0].split(': ', 1)[-1] if count else 'none'})")
 check("/velodyne_points" in seen("whole") and "/ground_truth/pose" not in seen("whole"),
       "ground truth: without it the topic does not exist")
+check(all(t in seen("whole") for t in ("/clock", "/tf", "/tf_static", "/odom", "/localization/pose", "/route", "/collision_model", "/map/level_0", "/map/level_1")),
+      "whole: the stack's graph shows every topic of the contract (the offline map's two levels, the collision model...) 2 s in")
 r = report("crash"); s = r["stack"]; e = s.get("error", "")
 check(r["end"] == "stack_failed" and rc("crash") == 1 and "exited with status 3 at t = 3.000 s" in e
       and "crashing on purpose" in e, f"crash: stack_failed with its status, the time and its last log line ({e!r})")

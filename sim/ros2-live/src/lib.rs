@@ -13,9 +13,12 @@
 //! | `/odom` | nav_msgs/Odometry (the simulated wheels, not ground truth) | reliable, keep last 10 |
 //! | `/localization/pose` | geometry_msgs/PoseWithCovarianceStamped in `map` (the pose source's estimate) | reliable, keep last 10 |
 //! | `/route` | nav_msgs/Path in `map` | reliable, transient local |
+//! | `/map/level_K` | nav_msgs/OccupancyGrid in `map`: the offline map's level K as `map_server` serves it | reliable, transient local |
+//! | `/collision_model` | visualization_msgs/MarkerArray in `base_link`: the bag's, a cylinder per circle at its level's height | reliable, transient local |
 //! | `/ground_truth/pose` (only with `ground_truth`) | geometry_msgs/PoseStamped in `map`: the true pose, for tools | reliable, keep last 10 |
 //! | `/cmd_vel` (taken) | geometry_msgs/TwistStamped, stamped with the step it answers | reliable, keep last 10 |
 
+mod maps;
 pub mod msgs;
 mod process;
 
@@ -35,7 +38,7 @@ use sim::{Error, Result};
 
 use msgs::{
     Clock, Covariance, Header, Odometry, Path, PointCloud2, Pose, PoseStamped, PoseWithCovariance,
-    PoseWithCovarianceStamped, TfMessage, Time, TransformStamped, TwistStamped,
+    PoseWithCovarianceStamped, RawCdr, TfMessage, Time, TransformStamped, TwistStamped,
     TwistWithCovariance, Vector3,
 };
 
@@ -61,6 +64,8 @@ pub struct LiveOptions {
     pub log: Option<std::path::PathBuf>,
     /// Publish the true pose on `/ground_truth/pose`, for tools (off: the topic does not exist).
     pub ground_truth: bool,
+    /// The offline map whose levels go out on `/map/level_K` (its map server files).
+    pub map_dir: Option<std::path::PathBuf>,
 }
 
 impl LiveOptions {
@@ -99,6 +104,9 @@ pub struct Ros2Stack {
     odom: Publisher<Odometry>,
     pose: Publisher<PoseWithCovarianceStamped>,
     route: Publisher<Path>,
+    model: Publisher<RawCdr>,
+    /// `/map/level_K`, made at the start from the offline map's files.
+    maps: Vec<MapWriter>,
     truth: Option<Publisher<PoseStamped>>,
     cmd: Subscription<TwistStamped>,
     poll: Poll,
@@ -173,6 +181,13 @@ impl Ros2Stack {
             false
         );
         let route = publisher!("/route", "nav_msgs", "Path", 1, true);
+        let model = publisher!(
+            "/collision_model",
+            "visualization_msgs",
+            "MarkerArray",
+            1,
+            true
+        );
         let truth = if options.ground_truth {
             Some(publisher!(
                 "/ground_truth/pose",
@@ -195,22 +210,19 @@ impl Ros2Stack {
         let cmd = node
             .create_subscription::<TwistStamped>(&cmd_topic, None)
             .map_err(|e| dds("/cmd_vel", e))?;
+        // Before the spinner: writers made after the node's first announcement do not show in a
+        // ROS 2 peer's graph (rmw's).
+        let maps = match &options.map_dir {
+            Some(dir) => offline_maps(&mut node, dir)?,
+            None => Vec::new(),
+        };
         // The matched counts are kept up by the node's spinner.
         let spinner = node.spinner().map_err(|e| dds("the node's spinner", e))?;
         std::thread::spawn(move || futures::executor::block_on(spinner.spin()));
         let poll = Poll::new().map_err(|e| dds("poll", e))?;
         poll.register(&cmd, Token(1), Ready::readable(), PollOpt::edge())
             .map_err(|e| dds("poll /cmd_vel", e))?;
-        // Started once the simulator's endpoints exist, so the stack finds them at once.
-        let process = match &options.command {
-            Some(c) => Some(StackProcess::spawn(
-                c,
-                options.domain_id,
-                options.log.as_deref(),
-            )?),
-            None => None,
-        };
-        Ok(Ros2Stack {
+        let mut stack = Ros2Stack {
             node,
             clock,
             cloud,
@@ -219,6 +231,8 @@ impl Ros2Stack {
             odom,
             pose,
             route,
+            model,
+            maps,
             truth,
             cmd,
             poll,
@@ -226,8 +240,14 @@ impl Ros2Stack {
             options,
             wheelbase_m: 1.0,
             stale: 0,
-            process,
-        })
+            process: None,
+        };
+        // Started once the simulator's endpoints exist, so the stack finds them at once.
+        if let Some(c) = &stack.options.command {
+            let log = stack.options.log.as_deref();
+            stack.process = Some(StackProcess::spawn(c, stack.options.domain_id, log)?);
+        }
+        Ok(stack)
     }
 
     /// The process id of the stack the simulator started.
@@ -271,6 +291,45 @@ impl Ros2Stack {
             std::thread::sleep(Duration::from_millis(20));
         }
     }
+}
+
+/// A map topic's name, its transient-local writer and the message it holds.
+type MapWriter = (String, Publisher<RawCdr>, RawCdr);
+
+/// A transient-local `/map/level_K` writer and its message per level of the offline map in
+/// `map_dir` (its map server files); a level too big to send is left out, and said.
+fn offline_maps(node: &mut Node, map_dir: &std::path::Path) -> Result<Vec<MapWriter>> {
+    let mut out = Vec::new();
+    for (k, yaml) in maps::level_files(map_dir).iter().enumerate() {
+        let grid = mapper::export::read_ros_map(yaml).map_err(|e| {
+            Error::Stack(format!("reading the offline map {}: {e}", yaml.display()))
+        })?;
+        let topic = format!("/map/level_{k}");
+        if grid.data().len() > maps::MAX_CELLS {
+            eprintln!(
+                "{topic} not published: {} x {} cells, over the {} a message may hold",
+                grid.geometry().width(),
+                grid.geometry().height(),
+                maps::MAX_CELLS
+            );
+            continue;
+        }
+        let name = Name::parse(&topic).map_err(|e| dds(&topic, e))?;
+        let ros_topic = node
+            .create_topic(
+                &name,
+                MessageTypeName::new("nav_msgs", "OccupancyGrid"),
+                &qos(1, true),
+            )
+            .map_err(|e| dds(&topic, e))?;
+        let publisher = node
+            .create_publisher(&ros_topic, None)
+            .map_err(|e| dds(&topic, e))?;
+        let t0 = ros2::msgs::Time::from_ns(sim::rosbag::stamp_ns(0.0));
+        let message = RawCdr::from_message(&maps::occupancy_message(&grid, t0));
+        out.push((topic, publisher, message));
+    }
+    Ok(out)
 }
 
 /// Publishes `m`, retrying while the reliable writer's window is full, until `deadline`.
@@ -334,7 +393,17 @@ impl ExternalStack for Ros2Stack {
             header: Header::new(t0, "map"),
             poses,
         };
-        publish(&self.route, route, deadline, "/route")
+        publish(&self.route, route, deadline, "/route")?;
+        for (topic, publisher, message) in &self.maps {
+            publish(publisher, message.clone(), deadline, topic)?;
+        }
+        let model = sim::rosbag::collision_model_message(start.model, start.level_heights_m, 0.0);
+        publish(
+            &self.model,
+            RawCdr::from_message(&model),
+            deadline,
+            "/collision_model",
+        )
     }
 
     fn step(&mut self, input: &StackInput<'_>) -> Result<Answer> {

@@ -297,6 +297,30 @@ pub struct TwistStamped {
     pub twist: Twist,
 }
 
+/// A message the `ros2` crate already encodes for the bags (its CDR payload, the encapsulation
+/// header dropped), sent as it is: its bytes go out one by one as a fixed-size array, which CDR
+/// writes with neither a length nor padding, so the wire holds the bag's message byte for byte.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RawCdr(pub Vec<u8>);
+
+impl RawCdr {
+    /// From a whole encoded message (with its 4-byte encapsulation header, as the bags hold it).
+    pub fn from_message(message: &[u8]) -> Self {
+        RawCdr(message.get(4..).unwrap_or_default().to_vec())
+    }
+}
+
+impl Serialize for RawCdr {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeTuple;
+        let mut t = s.serialize_tuple(self.0.len())?;
+        for b in &self.0 {
+            t.serialize_element(b)?;
+        }
+        t.end()
+    }
+}
+
 impl Message for Clock {}
 impl Message for TfMessage {}
 impl Message for PointCloud2 {}
@@ -319,6 +343,25 @@ mod tests {
 
     fn stamp() -> BagTime {
         BagTime::from_ns(1_704_067_212_300_000_000)
+    }
+
+    #[test]
+    fn a_raw_message_goes_out_as_the_bags_bytes() {
+        // A marker array: strings, arrays and doubles after odd lengths, so padding matters.
+        let circle = |x_m, y_m, radius_m, level| mapper::Circle {
+            x_m,
+            y_m,
+            radius_m,
+            level,
+        };
+        let model = mapper::CollisionModel::new(
+            vec![circle(0.5, 0.0, 1.25, 0), circle(-3.0, 2.0, 0.75, 1)],
+            vec![0.0, 1.1],
+        )
+        .unwrap();
+        let bag = sim::rosbag::collision_model_message(&model, &[0.0, 1.1], 1.5);
+        assert!(bag.len() > 200);
+        assert_eq!(cdr(&RawCdr::from_message(&bag)), bag);
     }
 
     #[test]

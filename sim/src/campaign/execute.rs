@@ -46,13 +46,16 @@ pub struct RunOptions<'a> {
     pub stack: Option<ExternalStacks<'a>>,
 }
 
+/// Makes a worker's external stack for a run over the offline map in a directory.
+pub type MakeStack<'a> = dyn Fn(usize, &Path) -> Result<Box<dyn ExternalStack>> + Sync + 'a;
+
 /// A stack outside the process for a campaign's runs: a fresh one per run, made for the worker
 /// that runs it (worker `w` of `jobs`: a transport isolates each worker's runs from the others',
 /// e.g. on ROS domain `base + w`).
 #[derive(Clone, Copy)]
 pub struct ExternalStacks<'a> {
-    /// Makes worker `w`'s stack for its next run.
-    pub make: &'a (dyn Fn(usize) -> Result<Box<dyn ExternalStack>> + Sync),
+    /// Makes worker `w`'s stack for its next run, over the offline map in the directory given.
+    pub make: &'a MakeStack<'a>,
     /// What a late answer costs.
     pub policy: LatePolicy,
 }
@@ -67,7 +70,7 @@ fn drive(
     match stack {
         None => run_with(scenario, setup, handles),
         Some((stacks, worker)) => {
-            let mut stack = (stacks.make)(worker)?;
+            let mut stack = (stacks.make)(worker, &setup.map_dir)?;
             run_external(scenario, setup, handles, stack.as_mut(), stacks.policy)
         }
     }

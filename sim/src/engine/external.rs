@@ -31,6 +31,8 @@ pub struct StackStart<'a> {
     pub route_m: &'a [Point2<f64>],
     /// The vehicle's collision model (height-tagged circles).
     pub model: &'a CollisionModel,
+    /// The heights of the map's levels, metres (a circle of level k is checked at the k-th).
+    pub level_heights_m: &'a [f64],
     /// The offline map's directory.
     pub map_dir: &'a Path,
 }

@@ -147,6 +147,7 @@ pub fn run_external<'a>(
 ) -> Result<RunReport> {
     let mut rig = Rig::new(scenario, setup)?;
     let route_m: Vec<Point2<f64>> = scenario.route.waypoints_m.clone();
+    let levels = crate::offline_map::levels_of(scenario, &setup.config)?;
     stack.start(&StackStart {
         scenario: &scenario.name,
         world_from_odom: scenario.vehicle.world_from_start,
@@ -154,6 +155,7 @@ pub fn run_external<'a>(
         wheelbase_m: rig.bicycle.limits().wheelbase_m,
         route_m: &route_m,
         model: &rig.model,
+        level_heights_m: levels.heights_m(),
         map_dir: &setup.map_dir,
     })?;
     rig.external = Some(External::new(stack, policy));

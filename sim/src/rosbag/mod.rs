@@ -27,6 +27,7 @@ mod markers;
 pub mod tf;
 
 pub use drive::DriveBag;
+
 pub use from_bag::{BagMapOptions, BagMapReport, PoseSource, map_from_bag};
 
 use std::path::{Path, PathBuf};
@@ -47,6 +48,19 @@ const STEP_EVERY: u64 = 5;
 /// Seconds between the level maps, and the half side of the square written, metres.
 const MAP_EVERY_S: f64 = 1.0;
 const MAP_HALF_M: f64 = 30.0;
+
+/// The collision model as the bag's `/collision_model` holds it (`visualization_msgs/MarkerArray`
+/// in `base_link`, a flat cylinder per circle at its level's height, frame-locked), stamped at
+/// simulated time `t_s`: CDR with its encapsulation header, for a live peer to send as it is.
+#[must_use]
+pub fn collision_model_message(
+    model: &mapper::CollisionModel,
+    heights_m: &[f64],
+    t_s: f64,
+) -> Vec<u8> {
+    let circles = markers::collision_model(model, heights_m);
+    msgs::marker_array(Time::from_ns(stamp_ns(t_s)), "base_link", false, &circles)
+}
 
 /// The stamp of simulated time `t_s`.
 #[must_use]

@@ -13,7 +13,8 @@ use sim::engine::ExternalStack;
 use super::stack::StackKind;
 
 /// Makes job `j`'s external stack for its next run.
-type MakeStack<'a> = dyn Fn(usize) -> sim::Result<Box<dyn ExternalStack>> + Sync + 'a;
+type MakeStack<'a> =
+    dyn Fn(usize, &std::path::Path) -> sim::Result<Box<dyn ExternalStack>> + Sync + 'a;
 
 /// `taxi-sim campaign ...`.
 #[derive(Debug, clap::Subcommand)]
@@ -262,18 +263,21 @@ fn external_stacks(
             " already running"
         }
     );
-    Ok(Some(Box::new(move |job: usize| {
-        let mut options = args
-            .stack
-            .live_options(base + job as u16)
-            .map_err(|e| sim::Error::Invalid(e.to_string()))?;
-        if options.command.is_some() {
-            // One log per job: the jobs' stacks run side by side.
-            options.log = Some(match &args.stack.stack_log {
-                Some(p) => p.with_extension(format!("job-{job}.log")),
-                None => args.out.join(format!("stack-job-{job}.log")),
-            });
-        }
-        Ok(Box::new(ros2_live::Ros2Stack::new(options)?) as Box<dyn ExternalStack>)
-    })))
+    Ok(Some(Box::new(
+        move |job: usize, map_dir: &std::path::Path| {
+            let mut options = args
+                .stack
+                .live_options(base + job as u16)
+                .map_err(|e| sim::Error::Invalid(e.to_string()))?;
+            options.map_dir = Some(map_dir.to_path_buf());
+            if options.command.is_some() {
+                // One log per job: the jobs' stacks run side by side.
+                options.log = Some(match &args.stack.stack_log {
+                    Some(p) => p.with_extension(format!("job-{job}.log")),
+                    None => args.out.join(format!("stack-job-{job}.log")),
+                });
+            }
+            Ok(Box::new(ros2_live::Ros2Stack::new(options)?) as Box<dyn ExternalStack>)
+        },
+    )))
 }

@@ -73,6 +73,7 @@ impl StackArgs {
             command: self.stack_command.clone(),
             log: self.stack_log.clone(),
             ground_truth: self.ros_ground_truth,
+            map_dir: None,
         })
     }
 
@@ -97,7 +98,11 @@ pub fn drive(
         StackKind::Shipped => run_with(scenario, setup, handles)?,
         StackKind::Ros2 => {
             let domain = ros2_live::LiveOptions::domain_id(args.ros_domain_id)?;
-            let mut stack = ros2_live::Ros2Stack::new(args.live_options(domain)?)?;
+            let options = ros2_live::LiveOptions {
+                map_dir: Some(setup.map_dir.clone()),
+                ..args.live_options(domain)?
+            };
+            let mut stack = ros2_live::Ros2Stack::new(options)?;
             let wait = format!(
                 "waiting up to {} s for it (a subscriber of /velodyne_points, a publisher of /cmd_vel)",
                 args.discovery_timeout_s
