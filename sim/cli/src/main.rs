@@ -31,6 +31,11 @@ enum Command {
     /// Run a scenario in closed loop (builds its offline map first when missing or stale).
     /// Exit code 0 when every expectation held, 1 when one did not, 2 on bad input.
     Run(commands::run::RunArgs),
+    /// The shipped stack as a ROS 2 node (`/taxi_stack`) for `run --stack ros2`: it takes the
+    /// run's flags as its parameters, answers each step's `/cmd_vel`, and ends when the simulator
+    /// leaves. `run --stack ros2 --stack-command "taxi-sim stack FILE"` gives the report of
+    /// `run FILE --stack node`.
+    Stack(commands::stack::NodeArgs),
     /// The mapping drive: build a scenario's offline multi-height map.
     Map(commands::map::MapArgs),
     /// Validate a scenario file and print a summary.
@@ -141,6 +146,7 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
         Command::CompareLidar(args) => commands::compare_lidar::run(&args),
         Command::Check(args) => commands::check::run(&args),
         Command::Map(args) => commands::map::run(&args),
+        Command::Stack(args) => commands::stack::serve(&args),
         Command::Run(_) | Command::Campaign(_) | Command::Tune(_) | Command::Regress(_) => {
             unreachable!("dispatched in run")
         }

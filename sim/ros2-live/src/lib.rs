@@ -20,8 +20,10 @@
 
 mod maps;
 pub mod msgs;
+mod node;
 mod process;
 
+pub use node::{NodeOptions, NodeSummary, serve, velodyne_points};
 pub use process::StackProcess;
 
 use std::time::{Duration, Instant};
@@ -29,8 +31,8 @@ use std::time::{Duration, Instant};
 use mio::{Events, Poll, PollOpt, Ready, Token};
 use ros2_client::ros2::{QosPolicies, QosPolicyBuilder, WriteError, policy};
 use ros2_client::{
-    Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher,
-    Subscription,
+    Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions as RosNodeOptions,
+    Publisher, Subscription,
 };
 use serde::Serialize;
 use sim::engine::{Answer, ExternalStack, StackInput, StackStart, Twist};
@@ -152,7 +154,7 @@ impl Ros2Stack {
             .map_err(|e| dds("joining the ROS domain", e))?;
         let name = NodeName::new("/", "taxi_sim").map_err(|e| dds("node name", e))?;
         let mut node = ctx
-            .new_node(name, NodeOptions::new().enable_rosout(false))
+            .new_node(name, RosNodeOptions::new().enable_rosout(false))
             .map_err(|e| dds("creating the node", e))?;
         macro_rules! publisher {
             ($topic:literal, $pkg:literal, $ty:literal, $depth:expr, $latched:expr) => {{
@@ -407,11 +409,13 @@ impl ExternalStack for Ros2Stack {
     }
 
     fn step(&mut self, input: &StackInput<'_>) -> Result<Answer> {
-        let t = stamp(input.t_s);
+        // The numbers as the shipped stack's node reads them back (`sim::engine::wire_step`).
+        let w = sim::engine::wire_step(input, self.wheelbase_m);
+        let t: Time = ros2::msgs::Time::from_ns(w.stamp_ns).into();
         let timeout = Duration::from_secs_f64(self.options.stack_timeout_s);
         let deadline = Instant::now() + timeout;
         publish(&self.clock, Clock { clock: t }, deadline, "/clock")?;
-        let base = pose2(&input.odom_from_vehicle, 0.0);
+        let base: Pose = w.odom_pose.into();
         let tf = TfMessage {
             transforms: vec![TransformStamped {
                 header: Header::new(t, "odom"),
@@ -420,7 +424,6 @@ impl ExternalStack for Ros2Stack {
             }],
         };
         publish(&self.tf, tf, deadline, "/tf")?;
-        let v = input.odometry.speed_m_s;
         let odom = Odometry {
             header: Header::new(t, "odom"),
             child_frame_id: "base_link".into(),
@@ -431,11 +434,11 @@ impl ExternalStack for Ros2Stack {
             twist: TwistWithCovariance {
                 twist: msgs::Twist {
                     linear: Vector3 {
-                        x: v,
+                        x: w.speed_m_s,
                         ..Vector3::default()
                     },
                     angular: Vector3 {
-                        z: v * input.odometry.steering_rad.tan() / self.wheelbase_m,
+                        z: w.yaw_rate_rad_s,
                         ..Vector3::default()
                     },
                 },
@@ -443,12 +446,12 @@ impl ExternalStack for Ros2Stack {
             },
         };
         publish(&self.odom, odom, deadline, "/odom")?;
-        if let Some(e) = &input.estimate {
+        if let Some((pose, covariance)) = &w.estimate {
             let m = PoseWithCovarianceStamped {
                 header: Header::new(t, "map"),
                 pose: PoseWithCovariance {
-                    pose: pose2(&e.world_from_vehicle, 0.0),
-                    covariance: Covariance(sim::rosbag::covariance6(&e.covariance)),
+                    pose: (*pose).into(),
+                    covariance: Covariance(*covariance),
                 },
             };
             publish(&self.pose, m, deadline, "/localization/pose")?;
@@ -460,7 +463,7 @@ impl ExternalStack for Ros2Stack {
             };
             publish(truth, m, deadline, "/ground_truth/pose")?;
         }
-        if let Some(points) = input.cloud {
+        if let Some(points) = &w.cloud {
             let cloud = PointCloud2::velodyne(t, "velodyne", points);
             publish(&self.cloud, cloud, deadline, "/velodyne_points")?;
         }

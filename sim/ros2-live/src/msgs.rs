@@ -103,6 +103,16 @@ impl From<BagPose> for Pose {
     }
 }
 
+impl From<Pose> for BagPose {
+    fn from(p: Pose) -> Self {
+        let Quaternion { x, y, z, w } = p.orientation;
+        BagPose {
+            position: [p.position.x, p.position.y, p.position.z],
+            orientation: [x, y, z, w],
+        }
+    }
+}
+
 /// A 6x6 covariance, row-major (`float64[36]`: the elements alone in CDR).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Covariance(pub [f64; 36]);

@@ -13,6 +13,7 @@ mod closed_loop;
 mod conflict;
 mod external;
 mod judge;
+mod node;
 mod observer;
 mod outcome;
 mod pose_error;
@@ -27,6 +28,9 @@ pub use external::{
     Twist, cloud_points, command_of_twist,
 };
 pub use judge::{DEVIATION_M, Judge, StepVerdict, Verdict};
+pub use node::{
+    InProcessNode, ShippedNode, WireStep, pose_off_wire, pose_on_wire, seconds_of_stamp, wire_step,
+};
 pub use observer::{NoObserver, Observer, Observers, RevolutionFrame, RunStart, StepFrame};
 pub use outcome::{
     AT_FAULT_SPEED_M_S, EndReason, Event, JudgedContact, ObstacleReport, Pass, PassOutcome, Stop,

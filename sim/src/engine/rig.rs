@@ -451,7 +451,7 @@ impl<'a> Rig<'a> {
 
 /// The stack's online map: the offline map's blocks in `setup.map_dir` under a live store in a
 /// scratch directory (removed with the returned guard), the self-hit filter, the forgetting rule.
-fn online_map(
+pub(super) fn online_map(
     scenario: &Scenario,
     config: &RunConfig,
     model: &CollisionModel,
@@ -488,7 +488,7 @@ fn online_map(
 /// The ground round `vehicle` that its LiDAR (`lidar`) cannot see, per level of `model` (the
 /// levels' heights as the model has them), on 0.2 m cells out to 20 m: what the stack knows of
 /// its own sensor layout for the start-up rule.
-fn blind_zone(
+pub(super) fn blind_zone(
     vehicle: &aircraft::Vehicle,
     lidar: &crate::world::LidarConfig,
     model: &CollisionModel,
@@ -509,7 +509,7 @@ fn blind_zone(
 }
 
 /// The stack under test's driver over `route`, with the vehicle's collision model and motion.
-fn driver(
+pub(super) fn driver(
     scenario: &Scenario,
     config: &RunConfig,
     model: &CollisionModel,

@@ -116,6 +116,21 @@ impl RunArgs {
     }
 }
 
+/// The scenario of `args` and what to run it with (its offline map built when missing).
+pub fn setup(args: &RunArgs) -> anyhow::Result<(Scenario, RunSetup)> {
+    let scenario = Scenario::from_file(&args.scenario)?;
+    let config = run_config(args, &scenario)?;
+    let dir = offline_map_dir(args, &scenario, &config)?;
+    let setup = RunSetup {
+        laps: args.laps,
+        seed: args.seed,
+        config,
+        time_limit_s: args.time_limit_s,
+        ..RunSetup::new(dir)
+    };
+    Ok((scenario, setup))
+}
+
 /// Runs `taxi-sim run`; returns whether every expectation held.
 pub fn run(args: &RunArgs) -> anyhow::Result<bool> {
     anyhow::ensure!(
@@ -128,19 +143,10 @@ pub fn run(args: &RunArgs) -> anyhow::Result<bool> {
             "--time-limit-s {t}: a positive number of seconds"
         );
     }
-    let scenario = Scenario::from_file(&args.scenario)?;
-    let config = run_config(args, &scenario)?;
     let replay_options = args.replay_options();
     replay_options.validate()?;
     let bag_path = bag_file(&args.record)?;
-    let dir = offline_map_dir(args, &scenario, &config)?;
-    let setup = RunSetup {
-        laps: args.laps,
-        seed: args.seed,
-        config,
-        time_limit_s: args.time_limit_s,
-        ..RunSetup::new(dir)
-    };
+    let (scenario, setup) = setup(args)?;
     let stop = Arc::new(AtomicBool::new(false));
     let stop_flag = stop.clone();
     // A second Ctrl-C falls through to the default handler only if this one could not be set.
