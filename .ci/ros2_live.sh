@@ -12,7 +12,9 @@
 # held, counted, the run goes on; that run publishes /ground_truth/pose for tools, and a tool
 # gets it at every step, while the other runs have no such topic), one that crashes (its status and last log line named), one
 # that never subscribes, and no stack at all (the missing topics named); and a campaign of two
-# variants run two jobs at a time on two ROS domains, then one job: the same records.
+# variants run two jobs at a time on two ROS domains, then one job: the same records; and our own
+# stack as a ROS 2 node (`taxi-sim stack`) giving the in-process report field for field on three
+# scenarios; and Cyclone DDS (another DDS implementation, no ROS) reading the clock and the clouds.
 #   deploy/ros2/netns.sh .ci/ros2_live.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -76,6 +78,35 @@ for jobs in 2 1; do
     echo "$rc" > "$out/campaign-$jobs.rc"
     echo "[ros2] campaign, $jobs jobs: taxi-sim exit $rc"; tail -n 2 "$out/campaign-$jobs.log" | sed 's/^/    /'
 done
+
+# Our own stack over ROS 2 (`taxi-sim stack`, the simulator starting it) against the same node
+# in the process (`run --stack node`): the straight road, the parking lot (one lap) and a traffic
+# scenario must give the same report, every field but wall times.
+for s in cone_in_path_jet parking_lot traffic_van_meets_nose; do
+    rc=0
+    timeout 600 "$bin" run "scenarios/$s.toml" --laps 1 --stack node --maps-dir "$maps" \
+        --report "$out/node-$s.json" > "$out/node-$s.log" 2>&1 || rc=$?
+    echo "$rc" > "$out/node-$s.rc"
+    timeout 600 "$bin" run "scenarios/$s.toml" --laps 1 --stack ros2 --ros-domain-id 64 --maps-dir "$maps" \
+        --report "$out/ours-$s.json" --stack-log "$out/ours-$s.stack.log" \
+        --stack-command "$bin stack scenarios/$s.toml --laps 1 --maps-dir $maps" \
+        > "$out/ours-$s.log" 2>&1 || rc=$?
+    echo "$rc" > "$out/ours-$s.rc"
+    echo "[ros2] our stack over ROS 2, $s: taxi-sim exit $rc"; tail -n 1 "$out/ours-$s.log" | sed 's/^/    /'
+done
+
+# A second DDS implementation, no ROS at all: Cyclone DDS (PyPI) reads the clock and every cloud
+# of a 10 s run of our stack over ROS 2.
+ROS_DOMAIN_ID=65 target/cyclone-venv/bin/python deploy/ros2/cyclone_listen.py --out "$out/cyclone.json" \
+    --quiet-s 3 > "$out/cyclone.log" 2>&1 &
+cyclone=$!
+sleep 2
+rc=0
+timeout 300 "$bin" run "$scenario" --stack ros2 --ros-domain-id 65 --maps-dir "$maps" --time-limit-s 10 \
+    --report "$out/cyclone-run.json" --stack-command "$bin stack $scenario --maps-dir $maps" \
+    > "$out/cyclone-run.log" 2>&1 || rc=$?
+wait "$cyclone" || true
+echo "[ros2] Cyclone DDS listening: taxi-sim exit $rc"; tail -n 1 "$out/cyclone.log" | sed 's/^/    /'
 
 # No stack: the run must not start, and say which topics had no peer.
 rc=0; timeout 60 "$bin" run "$scenario" --stack ros2 --maps-dir "$maps" \
@@ -147,6 +178,25 @@ check(all(r["contacts"] == 0 for r in two) and outcomes[0] != outcomes[1],
       f"campaign: the two variants differ (so crosstalk would show), no contact ({outcomes})")
 check(all((out / "campaign-2" / f"stack-job-{j}.log").exists() for j in (0, 1)),
       "campaign: each job's stack wrote its own log")
+WALL = {"wall_time_s", "real_time_factor", "time_split_s"}
+def differ(a, b, path=""):
+    if isinstance(a, dict) and isinstance(b, dict):
+        return [d for k in sorted(set(a) | set(b)) if k not in WALL and (path, k) != ("/stack", "name")
+                for d in differ(a.get(k), b.get(k), f"{path}/{k}")]
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        return [d for i, (x, y) in enumerate(zip(a, b)) for d in differ(x, y, f"{path}[{i}]")]
+    return [] if a == b else [f"{path}: {a!r} vs {b!r}"]
+for s in ("cone_in_path_jet", "parking_lot", "traffic_van_meets_nose"):
+    n, o = report(f"node-{s}"), report(f"ours-{s}")
+    d = differ(n, o)
+    check(rc(f"node-{s}") == 0 and rc(f"ours-{s}") == 0 and o["stack"]["steps"] > 300 and not d,
+          f"our stack over ROS 2, {s}: the in-process report field for field ({o['end']}, {o['stack']['steps']} steps, "
+          f"{len(o['contacts'])} contacts{'; differs: ' + '; '.join(d[:3]) if d else ''})")
+c, steps = json.loads((out / "cyclone.json").read_text()), report("cyclone-run")["stack"]["steps"]
+check(c["clocks"] == steps and c["clouds"] == steps and not c["bad"] and c["clock_steps_s"] == [0.1]
+      and c["stamps_agree"] == c["clouds"],
+      f"Cyclone DDS: read {c['clocks']} clocks and {c['clouds']} clouds ({c['points']} points) of {steps} steps, "
+      f"each cloud's layout and points as sent, stamped with a clock it heard ({c['bad'][:2]})")
 log = (out / "none.log").read_text()
 check(rc("none") != 0 and "no subscriber of /velodyne_points" in log and "no publisher of /cmd_vel" in log,
       "none: refused, naming both missing topics")

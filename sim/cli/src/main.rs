@@ -35,7 +35,7 @@ enum Command {
     /// run's flags as its parameters, answers each step's `/cmd_vel`, and ends when the simulator
     /// leaves. `run --stack ros2 --stack-command "taxi-sim stack FILE"` gives the report of
     /// `run FILE --stack node`.
-    Stack(commands::stack::NodeArgs),
+    Stack(commands::node::NodeArgs),
     /// The mapping drive: build a scenario's offline multi-height map.
     Map(commands::map::MapArgs),
     /// Validate a scenario file and print a summary.
@@ -146,7 +146,7 @@ fn run_unit(command: Command) -> anyhow::Result<()> {
         Command::CompareLidar(args) => commands::compare_lidar::run(&args),
         Command::Check(args) => commands::check::run(&args),
         Command::Map(args) => commands::map::run(&args),
-        Command::Stack(args) => commands::stack::serve(&args),
+        Command::Stack(args) => commands::node::serve(&args),
         Command::Run(_) | Command::Campaign(_) | Command::Tune(_) | Command::Regress(_) => {
             unreachable!("dispatched in run")
         }

@@ -18,6 +18,7 @@
 //! | `/ground_truth/pose` (only with `ground_truth`) | geometry_msgs/PoseStamped in `map`: the true pose, for tools | reliable, keep last 10 |
 //! | `/cmd_vel` (taken) | geometry_msgs/TwistStamped, stamped with the step it answers | reliable, keep last 10 |
 
+pub mod bench;
 mod maps;
 pub mod msgs;
 mod node;

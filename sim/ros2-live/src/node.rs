@@ -34,6 +34,8 @@ pub struct NodeOptions {
     pub wait_s: f64,
     /// Wall seconds to wait for the simulator to appear.
     pub discovery_timeout_s: f64,
+    /// Set from outside to end the node (it also ends when the simulator leaves).
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// What the node did.
@@ -125,7 +127,11 @@ pub fn serve(options: &NodeOptions, node: &mut ShippedNode) -> Result<NodeSummar
     let wait = Duration::from_secs_f64(options.wait_s);
     let appear_by = Instant::now() + Duration::from_secs_f64(options.discovery_timeout_s);
     let mut seen_simulator = false;
-    loop {
+    while !options
+        .stop
+        .as_ref()
+        .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
+    {
         drain(&odom, "/odom", &mut heard.odom, |m: Odometry| {
             Ok((ns(&m.header.stamp), (m, Instant::now())))
         })?;
@@ -167,6 +173,7 @@ pub fn serve(options: &NodeOptions, node: &mut ShippedNode) -> Result<NodeSummar
         poll.poll(&mut events, Some(Duration::from_millis(20)))
             .map_err(|e| dds("poll", e))?;
     }
+    Ok(summary)
 }
 
 /// The step stamped `t` (in nanoseconds) rebuilt from its messages and answered.

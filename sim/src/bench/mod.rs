@@ -18,4 +18,4 @@ mod timing;
 pub use closed_loop::loop_figures;
 pub use lidar::{lidar_figures, lidar_scene};
 pub use mapper::mapper_figures;
-pub use timing::{Figure, alternating, median, median_seconds};
+pub use timing::{Figure, against, alternating, figure, median, median_seconds};

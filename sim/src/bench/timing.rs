@@ -49,7 +49,8 @@ pub fn median_seconds(samples: usize, batch: usize, mut f: impl FnMut()) -> f64 
     median(&mut times)
 }
 
-pub(crate) fn figure(
+/// A figure of `seconds` in `unit` (`ms` or `ns`).
+pub fn figure(
     name: &str,
     seconds: f64,
     unit: &'static str,
@@ -66,7 +67,8 @@ pub(crate) fn figure(
     }
 }
 
-pub(crate) fn against(mut f: Figure, baseline: &Figure) -> Figure {
+/// `f` compared with `baseline` (the ratio: > 1 when `f` is faster).
+pub fn against(mut f: Figure, baseline: &Figure) -> Figure {
     f.baseline = Some(baseline.name.clone());
     f.ratio = Some(baseline.median / f.median);
     f

@@ -9,7 +9,7 @@ use autonomy::PilotCall;
 use nalgebra::Isometry2;
 
 use super::external::{Answer, LatePolicy, StackInput, command_of_twist};
-use super::observer::{Observer, RevolutionFrame, StepFrame};
+use super::observer::{Observer, RevolutionFrame, SensedFrame, StepFrame};
 use super::outcome::{EndReason, Event};
 use super::report::Progress;
 use super::rig::{Rig, start_state};
@@ -71,7 +71,7 @@ impl Rig<'_> {
             self.sense_pose(&truth);
             let command = if self.external.is_some() {
                 if self.step.is_multiple_of(self.steps_per_scan)
-                    && let Some(end) = self.exchange(&truth)?
+                    && let Some(end) = self.exchange(&truth, observer)?
                 {
                     return Ok(end);
                 }
@@ -361,7 +361,11 @@ impl Rig<'_> {
     /// One control step of an external stack: the revolution taken (unless the faults lose it)
     /// and handed over with the odometry and the pose estimate; its answer checked and held.
     /// The run's end when the stack is late (strict), fails, or asks for the absurd.
-    pub(super) fn exchange(&mut self, truth: &Isometry2<f64>) -> Result<Option<EndReason>> {
+    pub(super) fn exchange(
+        &mut self,
+        truth: &Isometry2<f64>,
+        observer: &mut (dyn Observer + Send),
+    ) -> Result<Option<EndReason>> {
         // The stamp from the step count, not the summed time: exact, as it goes on the wire.
         let t_s = self.step as f64 / self.config.physics_hz;
         let (index, seed) = (self.step / self.steps_per_scan, self.seed);
@@ -378,6 +382,14 @@ impl Rig<'_> {
         if let Some(c) = &captured {
             self.split.lidar += c.lidar_s;
             self.localize(c)?;
+            observer.sensed(&SensedFrame {
+                t_s,
+                truth: *truth,
+                estimate,
+                revolution: &c.revolution,
+                owners: &c.owners,
+                world: &self.world,
+            })?;
         }
         let points = captured
             .as_ref()

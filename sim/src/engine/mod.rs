@@ -29,9 +29,12 @@ pub use external::{
 };
 pub use judge::{DEVIATION_M, Judge, StepVerdict, Verdict};
 pub use node::{
-    InProcessNode, ShippedNode, WireStep, pose_off_wire, pose_on_wire, seconds_of_stamp, wire_step,
+    EPOCH_NS, InProcessNode, ShippedNode, WireStep, covariance6, pose_off_wire, pose_on_wire,
+    seconds_of_stamp, stamp_ns, wire_step,
 };
-pub use observer::{NoObserver, Observer, Observers, RevolutionFrame, RunStart, StepFrame};
+pub use observer::{
+    NoObserver, Observer, Observers, RevolutionFrame, RunStart, SensedFrame, StepFrame,
+};
 pub use outcome::{
     AT_FAULT_SPEED_M_S, EndReason, Event, JudgedContact, ObstacleReport, Pass, PassOutcome, Stop,
 };

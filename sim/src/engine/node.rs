@@ -21,9 +21,29 @@ use ros2::msgs::{Pose, VelodynePoint};
 use super::external::{Answer, ExternalStack, StackInput, StackStart, Twist};
 use super::rig::{RunSetup, driver, online_map};
 use crate::error::{Error, Result};
-use crate::rosbag::{EPOCH_NS, covariance6, stamp_ns};
 use crate::scenario::{Scenario, WalkAround};
 use crate::world::planar_to_3d;
+
+/// Stamps start here: 2024-01-01T00:00:00Z, nanoseconds (the bags' and the live peer's).
+pub const EPOCH_NS: u64 = 1_704_067_200_000_000_000;
+
+/// The stamp of simulated time `t_s`.
+#[must_use]
+pub fn stamp_ns(t_s: f64) -> u64 {
+    EPOCH_NS + (t_s.max(0.0) * 1e9).round() as u64
+}
+
+/// A planar covariance (x, y, yaw) as ROS's 6x6 over (x, y, z, roll, pitch, yaw).
+pub fn covariance6(c: &nalgebra::Matrix3<f64>) -> [f64; 36] {
+    let mut out = [0.0; 36];
+    let index = [0, 1, 5];
+    for (i, &r) in index.iter().enumerate() {
+        for (j, &k) in index.iter().enumerate() {
+            out[r * 6 + k] = c[(i, j)];
+        }
+    }
+    out
+}
 
 /// One control step as its ROS 2 messages carry it (what [`wire_step`] makes of a
 /// [`StackInput`], and what a ROS 2 node reads back from `/odom`, `/localization/pose` and

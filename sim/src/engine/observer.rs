@@ -23,6 +23,11 @@ pub trait Observer {
     fn revolution(&mut self, _frame: &RevolutionFrame<'_>) -> Result<()> {
         Ok(())
     }
+    /// A revolution handed to a stack outside the process (`run --stack ros2`, `--stack node`):
+    /// what it was sent - no map or plan of the shipped stack's to show.
+    fn sensed(&mut self, _frame: &SensedFrame<'_>) -> Result<()> {
+        Ok(())
+    }
     /// After every physics step (100 Hz).
     fn step(&mut self, _frame: &StepFrame<'_>) -> Result<()> {
         Ok(())
@@ -98,6 +103,22 @@ pub struct RevolutionFrame<'a> {
     pub conflict: Option<autonomy::Conflict>,
 }
 
+/// A revolution as a stack outside the process was sent it.
+pub struct SensedFrame<'a> {
+    /// Simulated time of the step, seconds.
+    pub t_s: f64,
+    /// The true pose it was taken at.
+    pub truth: Isometry2<f64>,
+    /// The pose estimate it went out with, if the pose source had made one.
+    pub estimate: Option<autonomy::PoseEstimate>,
+    /// The revolution (world frame, at the estimate).
+    pub revolution: &'a LidarRevolution,
+    /// What each return hit (ground truth, for pictures).
+    pub owners: &'a [Option<Owner>],
+    /// The world (the run-time obstacles where they are).
+    pub world: &'a World,
+}
+
 /// One physics step, given to [`Observer::step`].
 pub struct StepFrame<'a> {
     /// Simulated time, seconds.
@@ -123,6 +144,9 @@ impl Observer for Observers<'_> {
     }
     fn revolution(&mut self, frame: &RevolutionFrame<'_>) -> Result<()> {
         self.0.iter_mut().try_for_each(|o| o.revolution(frame))
+    }
+    fn sensed(&mut self, frame: &SensedFrame<'_>) -> Result<()> {
+        self.0.iter_mut().try_for_each(|o| o.sensed(frame))
     }
     fn step(&mut self, frame: &StepFrame<'_>) -> Result<()> {
         self.0.iter_mut().try_for_each(|o| o.step(frame))

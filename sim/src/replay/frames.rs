@@ -54,11 +54,14 @@ impl Replay {
     /// A revolution's returns, every `point_stride` columns, classed as the mapper classes
     /// them: ground, vehicle (self), beyond mapping range, obstacle at level k, above every
     /// level.
-    pub(super) fn log_lidar(&mut self, frame: &RevolutionFrame<'_>) -> Result<()> {
+    pub(super) fn log_lidar(
+        &mut self,
+        scan: &mapper::Scan,
+        owners: &[Option<Owner>],
+    ) -> Result<()> {
         let Some(levels) = &self.levels else {
             return Ok(());
         };
-        let scan = &frame.revolution.scan;
         let beams = scan.beams();
         let params = self.obstacle_test;
         let (mut positions, mut classes) = (Vec::new(), Vec::new());
@@ -74,7 +77,7 @@ impl Replay {
                 let Some(r) = r else { continue };
                 let p = r.point_in_world;
                 positions.push([p.x as f32, p.y as f32, p.z as f32]);
-                let owner = frame.owners.get(c * beams + b).copied().flatten();
+                let owner = owners.get(c * beams + b).copied().flatten();
                 let range_xy = (p.x - sensor.x).hypot(p.y - sensor.y);
                 let class = if matches!(owner, Some(Owner::VehiclePart(_))) {
                     CLASS_VEHICLE

@@ -32,7 +32,9 @@ use nalgebra::Point2;
 use rerun::RecordingStream;
 use rerun::components::TextLogLevel;
 
-use crate::engine::{Event, Observer, RevolutionFrame, RunReport, RunStart, StepFrame};
+use crate::engine::{
+    Event, Observer, RevolutionFrame, RunReport, RunStart, SensedFrame, StepFrame,
+};
 use crate::error::Error;
 use style::{path_part, yaw_quat};
 
@@ -238,7 +240,7 @@ impl Observer for Replay {
             .is_multiple_of(u64::from(self.options.scan_every));
         self.scans_seen += 1;
         if full {
-            self.log_lidar(frame)?;
+            self.log_lidar(&frame.revolution.scan, frame.owners)?;
             self.summary.scans_logged += 1;
         }
         self.log_localization(frame, full)?;
@@ -251,6 +253,19 @@ impl Observer for Replay {
         if self.options.maps_hz > 0.0 && frame.t_s + 1e-9 >= self.next_map_t {
             self.next_map_t = frame.t_s + 1.0 / self.options.maps_hz;
             self.log_maps(frame.map, Point2::from(frame.estimate.translation.vector))?;
+        }
+        Ok(())
+    }
+
+    fn sensed(&mut self, frame: &SensedFrame<'_>) -> Result<()> {
+        self.time(frame.t_s);
+        let full = self
+            .scans_seen
+            .is_multiple_of(u64::from(self.options.scan_every));
+        self.scans_seen += 1;
+        if full {
+            self.log_lidar(&frame.revolution.scan, frame.owners)?;
+            self.summary.scans_logged += 1;
         }
         Ok(())
     }

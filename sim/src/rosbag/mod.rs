@@ -36,11 +36,12 @@ use nalgebra::{Isometry2, Isometry3, UnitQuaternion};
 use ros2::msgs::{self, Pose, Time, Transform};
 use ros2::{BagThread, BagWriter, Qos, TopicId};
 
-use crate::engine::{Event, Observer, RevolutionFrame, RunReport, RunStart, StepFrame};
+use crate::engine::{
+    Event, Observer, RevolutionFrame, RunReport, RunStart, SensedFrame, StepFrame,
+};
 use crate::error::{Error, Result};
 
-/// Stamps start here: 2024-01-01T00:00:00Z, nanoseconds.
-pub const EPOCH_NS: u64 = 1_704_067_200_000_000_000;
+pub use crate::engine::{EPOCH_NS, covariance6, stamp_ns};
 
 /// Steps between `/clock`, `/ground_truth/odom` and `/cmd_drive` messages (100 Hz physics).
 const STEP_EVERY: u64 = 5;
@@ -60,12 +61,6 @@ pub fn collision_model_message(
 ) -> Vec<u8> {
     let circles = markers::collision_model(model, heights_m);
     msgs::marker_array(Time::from_ns(stamp_ns(t_s)), "base_link", false, &circles)
-}
-
-/// The stamp of simulated time `t_s`.
-#[must_use]
-pub fn stamp_ns(t_s: f64) -> u64 {
-    EPOCH_NS + (t_s.max(0.0) * 1e9).round() as u64
 }
 
 struct Topics {
@@ -115,6 +110,55 @@ pub(crate) fn bag_error(e: ros2::BagError) -> Error {
 }
 
 impl RosBag {
+    /// A revolution's tf (the estimate and the truth), its cloud in the sensor frame and the
+    /// pose estimate it went out with, stamped `t`.
+    fn write_sensors(
+        &mut self,
+        t: f64,
+        revolution: &autonomy::LidarRevolution,
+        truth: &nalgebra::Isometry2<f64>,
+        estimate: Option<&autonomy::PoseEstimate>,
+    ) -> Result<()> {
+        let tf = msgs::tf_message(&[
+            transform(
+                t,
+                "odom",
+                "base_link",
+                planar(&revolution.world_from_vehicle_estimate, 0.0),
+            ),
+            transform(t, "map", "ground_truth/base_link", planar(truth, 0.0)),
+        ]);
+        self.write(|t| t.tf, t, tf)?;
+        let stamp = Time::from_ns(stamp_ns(t));
+        let cloud = msgs::velodyne_cloud(
+            stamp,
+            "velodyne",
+            &crate::engine::cloud_points(&revolution.scan),
+        );
+        self.write(|t| t.cloud, t, cloud)?;
+        if let Some(e) = estimate {
+            let pose = msgs::pose_with_covariance(
+                stamp,
+                "map",
+                &planar(&e.world_from_vehicle, 0.0),
+                &covariance6(&e.covariance),
+            );
+            self.write(|t| t.pose, t, pose)?;
+        }
+        Ok(())
+    }
+
+    /// The run-time obstacles where they are (ground truth) at `t`: what was drawn before goes.
+    fn write_obstacles(&mut self, t: f64, world: &crate::world::World) -> Result<()> {
+        let obstacles: Vec<msgs::Marker> = (self.first_obstacle..world.scene().solids.len())
+            .filter(|&i| world.object_active(i))
+            .map(|i| markers::solid(&world.scene().solids[i], i, "obstacles"))
+            .collect();
+        let stamp = Time::from_ns(stamp_ns(t));
+        let array = msgs::marker_array(stamp, "map", true, &obstacles);
+        self.write(|t| t.obstacles, t, array)
+    }
+
     /// A bag to be written at `file` (a `.mcap`).
     ///
     /// # Errors
@@ -190,18 +234,6 @@ pub(crate) fn transform(t_s: f64, parent: &str, child: &str, pose: Pose) -> Tran
         child: child.to_string(),
         pose,
     }
-}
-
-/// A planar covariance (x, y, yaw) as ROS's 6x6 over (x, y, z, roll, pitch, yaw).
-pub fn covariance6(c: &nalgebra::Matrix3<f64>) -> [f64; 36] {
-    let mut out = [0.0; 36];
-    let index = [0, 1, 5];
-    for (i, &r) in index.iter().enumerate() {
-        for (j, &k) in index.iter().enumerate() {
-            out[r * 6 + k] = c[(i, j)];
-        }
-    }
-    out
 }
 
 impl RosBag {
@@ -288,32 +320,13 @@ impl Observer for RosBag {
         // Stamped when it was taken (the stack sees it a revolution later when it plans while
         // the next is taken).
         let t = frame.revolution.t_s;
-        let tf = msgs::tf_message(&[
-            transform(t, "odom", "base_link", planar(&frame.estimate, 0.0)),
-            transform(
-                t,
-                "map",
-                "ground_truth/base_link",
-                planar(&frame.truth, 0.0),
-            ),
-        ]);
-        self.write(|t| t.tf, t, tf)?;
+        self.write_sensors(
+            t,
+            frame.revolution,
+            &frame.truth,
+            frame.pose_estimate.as_ref(),
+        )?;
         let stamp = Time::from_ns(stamp_ns(t));
-        let cloud = msgs::velodyne_cloud(
-            stamp,
-            "velodyne",
-            &crate::engine::cloud_points(&frame.revolution.scan),
-        );
-        self.write(|t| t.cloud, t, cloud)?;
-        if let Some(e) = &frame.pose_estimate {
-            let pose = msgs::pose_with_covariance(
-                stamp,
-                "map",
-                &planar(&e.world_from_vehicle, 0.0),
-                &covariance6(&e.covariance),
-            );
-            self.write(|t| t.pose, t, pose)?;
-        }
         let poses: Vec<(f64, f64, f64)> = frame
             .plan
             .chosen()
@@ -322,14 +335,7 @@ impl Observer for RosBag {
             .map(|p| (p.translation.x, p.translation.y, p.rotation.angle()))
             .collect();
         self.write(|t| t.path, t, msgs::path(stamp, "map", &poses))?;
-        // The run-time obstacles where they are (ground truth): what was drawn before goes.
-        let world = frame.world;
-        let obstacles: Vec<msgs::Marker> = (self.first_obstacle..world.scene().solids.len())
-            .filter(|&i| world.object_active(i))
-            .map(|i| markers::solid(&world.scene().solids[i], i, "obstacles"))
-            .collect();
-        let array = msgs::marker_array(stamp, "map", true, &obstacles);
-        self.write(|t| t.obstacles, t, array)?;
+        self.write_obstacles(t, frame.world)?;
         if self
             .last_map_s
             .is_none_or(|last| t - last >= MAP_EVERY_S - 1e-9)
@@ -338,6 +344,12 @@ impl Observer for RosBag {
             self.write_maps(frame.map, &frame.estimate, t)?;
         }
         Ok(())
+    }
+
+    fn sensed(&mut self, frame: &SensedFrame<'_>) -> Result<()> {
+        let t = frame.revolution.t_s;
+        self.write_sensors(t, frame.revolution, &frame.truth, frame.estimate.as_ref())?;
+        self.write_obstacles(t, frame.world)
     }
 
     fn step(&mut self, frame: &StepFrame<'_>) -> Result<()> {

@@ -91,16 +91,22 @@ impl<F: FnMut(u64, Twist) -> Answer + Send> ExternalStack for Naive<F> {
     }
 }
 
+/// The cone scenario written in `dir` and its offline map built there.
+fn cone_world(dir: &std::path::Path) -> (Scenario, std::path::PathBuf) {
+    let path = dir.join("cone.toml");
+    std::fs::write(&path, CONE).unwrap();
+    let s = Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"));
+    let map_dir = dir.join("map");
+    sim::offline_map::map_drive(&s, &RunConfig::default(), &map_dir, &mut |_, _| {}).unwrap();
+    (s, map_dir)
+}
+
 fn run(
     answer: impl FnMut(u64, Twist) -> Answer + Send,
     policy: LatePolicy,
 ) -> (RunReport, Vec<Seen>) {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("cone.toml");
-    std::fs::write(&path, CONE).unwrap();
-    let s = Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"));
-    let map_dir = dir.path().join("map");
-    sim::offline_map::map_drive(&s, &RunConfig::default(), &map_dir, &mut |_, _| {}).unwrap();
+    let (s, map_dir) = cone_world(dir.path());
     let mut stack = Naive {
         seen: Vec::new(),
         started: false,
@@ -206,4 +212,44 @@ fn a_command_that_is_not_a_number_ends_the_run_naming_the_field() {
         "{error}"
     );
     assert_eq!(r.contacts.len(), 0);
+}
+
+#[test]
+fn the_shipped_stack_as_a_node_keeps_off_the_cone_and_its_bag_holds_what_it_was_sent() {
+    let dir = tempfile::tempdir().unwrap();
+    let (s, map_dir) = cone_world(dir.path());
+    let setup = RunSetup::new(map_dir);
+    let mut node = sim::engine::InProcessNode::new(&s, &setup).unwrap();
+    let file = dir.path().join("bag").join("run.mcap");
+    std::fs::create_dir_all(file.parent().unwrap()).unwrap();
+    let mut bag = sim::rosbag::RosBag::create(&file).unwrap();
+    let r = run_external(
+        &s,
+        &setup,
+        RunHandles {
+            stop: None,
+            progress: &mut |_| {},
+            observer: &mut bag,
+        },
+        &mut node,
+        LatePolicy::Strict,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    // Where the naive stack ran the cone over, the shipped one, fed only what the wire
+    // carries, does not.
+    assert_eq!(r.end, sim::engine::EndReason::Completed, "{r:?}");
+    assert_eq!(r.contacts_at_fault, 0, "{:?}", r.contacts_judged);
+    let stack = r.stack.as_ref().unwrap();
+    assert_eq!((stack.commands, stack.late), (stack.steps, 0));
+    // Nothing of an external run is lost: the bag holds every revolution the stack was sent,
+    // the estimate it went out with, and the commands the vehicle followed.
+    let bytes = std::fs::read(&file).unwrap();
+    let mut topics = std::collections::BTreeMap::<String, u64>::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        *topics.entry(m.unwrap().channel.topic.clone()).or_default() += 1;
+    }
+    let count = |t: &str| topics.get(t).copied().unwrap_or(0);
+    assert_eq!(count("/velodyne_points"), stack.steps, "{topics:?}");
+    assert_eq!(count("/localization/pose"), stack.steps, "{topics:?}");
+    assert!(count("/cmd_drive") >= 2 * stack.steps - 2, "{topics:?}");
 }

@@ -86,6 +86,11 @@ pub enum BenchTarget {
     /// when installed) and a 2.5D map on the same revolutions: memory, time, wrong answers
     /// against the exact collision (`--out DIR`: tables, JSON and pictures).
     Representations,
+    /// The ROS 2 boundary: a 70,000-point revolution and its command over DDS against in the
+    /// process, and our stack's real-time factor over ROS 2 against in the process on
+    /// `--scenario`, in alternation (`--samples` rounds, default 1). Both peers in this process on
+    /// `ROS_DOMAIN_ID` (else 0): run it where DDS can multicast (`deploy/ros2/netns.sh`).
+    Bridge,
     /// The README's deterministic figures of a first and a later run (offline map on disk,
     /// blocks, occupied cells, peak memory), from `taxi-sim run` child processes on the
     /// aerodrome and the parking lot; run from the repository's root (a few minutes).
@@ -153,6 +158,7 @@ fn bench(
         BenchTarget::Localization => {
             sim::bench::localization::figures_for(scenario, samples.unwrap_or(15), &mut report)?
         }
+        BenchTarget::Bridge => bridge(scenario, laps, samples.unwrap_or(1), &mut report)?,
         BenchTarget::Figures | BenchTarget::Representations => {
             unreachable!("dispatched in run")
         }
@@ -186,4 +192,35 @@ fn bench(
         )?;
     }
     emit(&t)
+}
+
+/// `bench bridge`: the revolution's cost, then the stack's real-time factor both ways.
+fn bridge(
+    scenario: &std::path::Path,
+    laps: u32,
+    rounds: usize,
+    progress: &mut dyn FnMut(&str),
+) -> anyhow::Result<Vec<sim::bench::Figure>> {
+    let domain = ros2_live::LiveOptions::domain_id(None)?;
+    progress("a revolution over DDS and in the process");
+    let mut figures = ros2_live::bench::revolution_figures(domain, 15)?;
+    let scenario = sim::scenario::Scenario::from_file(scenario)?;
+    let config = sim::scenario::RunConfig::default();
+    let map_dir = sim::offline_map::default_map_dir(&scenario, &config);
+    sim::offline_map::ensure(
+        &scenario,
+        &config,
+        &map_dir,
+        &mut || progress("mapping drive"),
+        &mut |_, _| {},
+    )?;
+    let setup = sim::engine::RunSetup {
+        laps: (laps > 0).then_some(laps),
+        config,
+        ..sim::engine::RunSetup::new(map_dir)
+    };
+    figures.extend(ros2_live::bench::stack_figures(
+        &scenario, &setup, domain, rounds, progress,
+    )?);
+    Ok(figures)
 }

@@ -11,6 +11,7 @@ pub mod demo;
 pub mod figures;
 pub mod map;
 pub mod model;
+pub mod node;
 pub mod regress;
 pub mod representations;
 pub mod run;
