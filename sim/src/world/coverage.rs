@@ -102,13 +102,36 @@ pub struct LevelCoverage {
     pub own: Vec<bool>,
 }
 
+/// A LiDAR on the vehicle: its model and where it is mounted.
+#[derive(Clone, Debug)]
+pub struct Mounted {
+    /// What it is called (`sidecar`, `vlp-16 under the nose`).
+    pub name: String,
+    /// Its beams.
+    pub config: LidarConfig,
+    /// Its mount on the vehicle.
+    pub vehicle_from_sensor: nalgebra::Isometry3<f64>,
+}
+
+/// One sensor of several: where it is, and what each level would leave blind with it alone.
+#[derive(Clone, Debug, Serialize)]
+pub struct SensorCoverage {
+    /// [`Mounted::name`].
+    pub name: String,
+    /// Its position in the vehicle frame, metres.
+    pub position_m: [f64; 3],
+    /// Per level: the blind ground with this sensor alone, square metres.
+    pub alone_blind_area_m2: Vec<f64>,
+}
+
 /// A vehicle's blind zones, level by level.
 #[derive(Clone, Debug, Serialize)]
 pub struct Coverage {
     /// The vehicle's name.
     pub vehicle: String,
-    /// The sensor's position in the vehicle frame, metres.
-    pub sensor_m: [f64; 3],
+    /// The sensors, each with what it would leave blind alone (the levels below are all of
+    /// them together).
+    pub sensors: Vec<SensorCoverage>,
     /// The ground examined.
     pub grid: GroundGrid,
     /// Level by level.
@@ -138,11 +161,29 @@ pub fn coverage(
     lidar: &LidarConfig,
     options: &CoverageOptions,
 ) -> Result<Coverage> {
+    let sidecar = Mounted {
+        name: "sidecar".into(),
+        config: lidar.clone(),
+        vehicle_from_sensor: vehicle.vehicle_from_lidar(),
+    };
+    coverage_of(vehicle, &[sidecar], options)
+}
+
+/// The blind zones of `vehicle` carrying `sensors`: ground is seen when any of them sees it
+/// (each cast against the airframe, as the LiDAR casts it); each sensor's own figures beside.
+pub fn coverage_of(
+    vehicle: &aircraft::Vehicle,
+    sensors: &[Mounted],
+    options: &CoverageOptions,
+) -> Result<Coverage> {
     if !(options.cell_m > 0.0 && options.margin_m >= 0.0 && options.low_object_m > 0.0) {
         return Err(Error::Invalid(format!(
             "coverage: cell {} m, margin {} m, low object {} m: the cell and the object must be > 0, the margin >= 0",
             options.cell_m, options.margin_m, options.low_object_m
         )));
+    }
+    if sensors.is_empty() {
+        return Err(Error::Invalid("coverage: no sensor".into()));
     }
     // The vehicle's origin inside too.
     let origin = Point2::new(0.0, 0.0);
@@ -162,32 +203,57 @@ pub fn coverage(
         ..Scene::default()
     };
     let world = World::with_obstacles(&scene, vehicle, &Isometry2::identity());
-    let sensor = Lidar::new(lidar.clone(), vehicle.vehicle_from_lidar()).map_err(Error::Invalid)?;
-    let origin = sensor.vehicle_from_sensor().translation.vector;
-    let rays = sensor.rays_in_vehicle(&world);
     let heights = &vehicle.spec.heights_of_interest_m;
-    let levels = heights
+    let objects: Vec<f64> = heights
         .iter()
         .enumerate()
         .map(|(level, &h)| {
-            let object = if level == 0 {
+            if level == 0 {
                 h.max(options.low_object_m)
             } else {
                 h
-            };
-            let seen = seen_cells(
-                &grid,
-                [origin.x, origin.y, origin.z],
-                &rays,
-                object,
-                lidar.range_m,
-            );
+            }
+        })
+        .collect();
+    // Per sensor, per level: the cells it sees.
+    let mut seen_by: Vec<Vec<Vec<bool>>> = Vec::new();
+    let mut out = Vec::new();
+    for m in sensors {
+        let sensor = Lidar::new(m.config.clone(), m.vehicle_from_sensor)
+            .map_err(|e| Error::Invalid(format!("sensor `{}`: {e}", m.name)))?;
+        let at = sensor.vehicle_from_sensor().translation.vector;
+        let rays = sensor.rays_in_vehicle(&world);
+        let seen: Vec<Vec<bool>> = objects
+            .iter()
+            .map(|&object| seen_cells(&grid, [at.x, at.y, at.z], &rays, object, m.config.range_m))
+            .collect();
+        let alone = objects
+            .iter()
+            .enumerate()
+            .map(|(level, &object)| {
+                level_coverage(vehicle, &grid, level, object, &seen[level]).blind_area_m2
+            })
+            .collect();
+        out.push(SensorCoverage {
+            name: m.name.clone(),
+            position_m: [at.x, at.y, at.z],
+            alone_blind_area_m2: alone,
+        });
+        seen_by.push(seen);
+    }
+    let levels = objects
+        .iter()
+        .enumerate()
+        .map(|(level, &object)| {
+            let seen: Vec<bool> = (0..grid.cells[0] * grid.cells[1])
+                .map(|k| seen_by.iter().any(|s| s[level][k]))
+                .collect();
             level_coverage(vehicle, &grid, level, object, &seen)
         })
         .collect();
     Ok(Coverage {
         vehicle: vehicle.spec.name.clone(),
-        sensor_m: [origin.x, origin.y, origin.z],
+        sensors: out,
         grid,
         levels,
     })
@@ -426,10 +492,12 @@ fn draw_on<DB: plotters::prelude::DrawingBackend>(
                 .map(|(a, b, y)| Rectangle::new([(a, y), (b, y + g.cell_m)], colour.filled()));
             chart.draw_series(rects).map_err(|e| e.to_string())?;
         }
-        let s = coverage.sensor_m;
-        chart
-            .draw_series(std::iter::once(Circle::new((s[0], s[1]), 3, BLUE.filled())))
-            .map_err(|e| e.to_string())?;
+        for s in &coverage.sensors {
+            let p = s.position_m;
+            chart
+                .draw_series(std::iter::once(Circle::new((p[0], p[1]), 3, BLUE.filled())))
+                .map_err(|e| e.to_string())?;
+        }
     }
     root.present().map_err(|e| e.to_string())
 }
@@ -519,6 +587,52 @@ mod tests {
         assert_eq!(
             froms,
             ["beside the left wing tip", "beside the right wing tip"]
+        );
+    }
+
+    #[test]
+    fn a_low_vlp16_under_the_nose_pod_sees_the_cone_the_sidecar_cannot() {
+        let jet = aircraft::Vehicle::load("praetor600").unwrap();
+        let options = CoverageOptions {
+            cell_m: 0.1,
+            margin_m: 8.0,
+            low_object_m: 0.7,
+        };
+        let one = coverage(&jet, &LidarConfig::default(), &options).unwrap();
+        let sidecar = Mounted {
+            name: "sidecar".into(),
+            config: LidarConfig::default(),
+            vehicle_from_sensor: jet.vehicle_from_lidar(),
+        };
+        let low = Mounted {
+            name: "vlp-16".into(),
+            config: LidarConfig::vlp16(),
+            vehicle_from_sensor: nalgebra::Isometry3::translation(11.85, 0.0, 0.5),
+        };
+        let two = coverage_of(&jet, &[sidecar, low], &options).unwrap();
+        // The sidecar's own figures are the one-sensor run's.
+        let alone: Vec<f64> = one.levels.iter().map(|l| l.blind_area_m2).collect();
+        assert_eq!(two.sensors[0].alone_blind_area_m2, alone);
+        assert_eq!(two.sensors[1].position_m, [11.85, 0.0, 0.5]);
+        // Together: blind only where both are, so no more than either alone on every level.
+        for (k, l) in two.levels.iter().enumerate() {
+            let least = two
+                .sensors
+                .iter()
+                .map(|s| s.alone_blind_area_m2[k])
+                .fold(f64::MAX, f64::min);
+            assert!(l.blind_area_m2 <= least + 1e-9, "level {k}");
+        }
+        // The cone 1.15 m ahead of the sidecar, blind to it, is seen; nothing ahead of a gear
+        // or of the parts is blind any more.
+        let level0 = &two.levels[0];
+        assert!(one.levels[0].blind[one.grid.cell(13.0, 0.0).unwrap()]);
+        assert!(!level0.blind[two.grid.cell(13.0, 0.0).unwrap()]);
+        assert_eq!(level0.blind_ahead_m, 0.0);
+        assert!(
+            level0.nearest.iter().all(|n| n.distance_m.is_none()),
+            "{:?}",
+            level0.nearest
         );
     }
 }

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use anyhow::Context as _;
-use sim::world::coverage::{CoverageOptions, coverage, draw};
+use sim::world::coverage::{CoverageOptions, draw};
 
 /// Arguments of `taxi-sim model coverage`.
 #[derive(Debug, Clone, clap::Args)]
@@ -28,6 +28,41 @@ pub struct ModelCoverageArgs {
     /// One JSON object on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Another LiDAR on the vehicle, beside the sidecar's: `MODEL@X,Y,Z` (model `hdl-32e` or
+    /// `vlp-16`, mounted level at X, Y, Z metres in the vehicle frame); repeatable. Ground any of
+    /// them sees is seen; each one's own blind area is reported too.
+    #[arg(long, value_name = "MODEL@X,Y,Z")]
+    pub sensor: Vec<String>,
+}
+
+/// A `--sensor MODEL@X,Y,Z` parsed.
+fn mounted(spec: &str) -> anyhow::Result<sim::world::coverage::Mounted> {
+    let bad = |why: &str| {
+        anyhow::anyhow!("--sensor {spec:?}: {why} (expected MODEL@X,Y,Z, e.g. vlp-16@9.5,0,0.6)")
+    };
+    let (model, at) = spec.split_once('@').ok_or_else(|| bad("no `@`"))?;
+    let config = sim::world::LidarConfig::model(model)
+        .ok_or_else(|| bad(&format!("unknown model `{model}` (hdl-32e, vlp-16)")))?;
+    let xyz: Vec<f64> = at
+        .split(',')
+        .map(|v| {
+            v.trim()
+                .parse::<f64>()
+                .map_err(|_| bad(&format!("`{v}` is not a number")))
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let [x, y, z] = xyz[..] else {
+        return Err(bad(&format!("{} numbers, not 3", xyz.len())));
+    };
+    anyhow::ensure!(
+        [x, y, z].iter().all(|v| v.is_finite()),
+        bad("a coordinate is not finite")
+    );
+    Ok(sim::world::coverage::Mounted {
+        name: spec.to_string(),
+        config,
+        vehicle_from_sensor: nalgebra::Isometry3::translation(x, y, z),
+    })
 }
 
 /// Runs `taxi-sim model coverage`.
@@ -39,8 +74,15 @@ pub fn run(args: &ModelCoverageArgs) -> anyhow::Result<()> {
         margin_m: args.margin_m,
         low_object_m: args.low_object_m,
     };
-    let lidar = sim::scenario::RunConfig::default().lidar;
-    let c = coverage(&vehicle, &lidar, &options)?;
+    let mut sensors = vec![sim::world::coverage::Mounted {
+        name: "sidecar".into(),
+        config: sim::scenario::RunConfig::default().lidar,
+        vehicle_from_sensor: vehicle.vehicle_from_lidar(),
+    }];
+    for spec in &args.sensor {
+        sensors.push(mounted(spec)?);
+    }
+    let c = sim::world::coverage::coverage_of(&vehicle, &sensors, &options)?;
     if let Some(dir) = &args.picture {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         let stem = format!("coverage-{}", vehicle.spec.name);
@@ -50,13 +92,26 @@ pub fn run(args: &ModelCoverageArgs) -> anyhow::Result<()> {
     if args.json {
         return crate::emit(&format!("{}\n", serde_json::to_string(&c)?));
     }
-    let s = &c.sensor_m;
-    let mut out = format!(
-        "{}: LiDAR at ({:.2}, {:.2}, {:.2}) m; ground examined {:.0} x {:.0} m in {} m cells\n",
+    let mut out = String::new();
+    for s in &c.sensors {
+        let p = s.position_m;
+        let alone: Vec<String> = s
+            .alone_blind_area_m2
+            .iter()
+            .map(|a| format!("{a:.1}"))
+            .collect();
+        out += &format!(
+            "LiDAR {} at ({:.2}, {:.2}, {:.2}) m: blind alone {} m2 by level\n",
+            s.name,
+            p[0],
+            p[1],
+            p[2],
+            alone.join(" / ")
+        );
+    }
+    out += &format!(
+        "{}, all sensors together; ground examined {:.0} x {:.0} m in {} m cells\n",
         c.vehicle,
-        s[0],
-        s[1],
-        s[2],
         c.grid.cells[0] as f64 * c.grid.cell_m,
         c.grid.cells[1] as f64 * c.grid.cell_m,
         c.grid.cell_m
