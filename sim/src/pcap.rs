@@ -28,6 +28,8 @@ pub struct Recording {
     pub frames: Vec<Frame>,
     /// Position packets read.
     pub positions: usize,
+    /// The sensor's packets skipped (unreadable whole, or of another length), by why.
+    pub skipped: velodyne::Skipped,
 }
 
 /// Reads the capture at `path` (its sensor from its packets), with the VeloView calibration
@@ -51,10 +53,23 @@ pub fn read(path: &Path, calibration: Option<&Path>) -> Result<Recording> {
         frames: velodyne::frames(&packets, &calibration),
         calibration,
         positions: capture.positions.len(),
+        skipped: capture.skipped,
     })
 }
 
 impl Recording {
+    /// A line saying what was skipped, if anything was (for a command to print).
+    pub fn skipped_line(&self, path: &Path) -> Option<String> {
+        (self.skipped.total() > 0).then(|| {
+            format!(
+                "{}: skipped {} of the sensor's packets, read on past them as VeloView does: {}",
+                path.display(),
+                self.skipped.total(),
+                self.skipped
+            )
+        })
+    }
+
     /// The full revolutions (all but the first and last).
     pub fn full(&self) -> &[Frame] {
         let n = self.frames.len();
@@ -128,6 +143,8 @@ pub struct PcapMapReport {
     pub ground: Ground,
     /// The sensor on the vehicle as mapped: its height and attitude.
     pub vehicle_from_sensor: Isometry3<f64>,
+    /// [`Recording::skipped_line`] of the capture.
+    pub skipped: Option<String>,
 }
 
 /// Builds the offline map of `levels` from the capture at `pcap` (its full revolutions, the
@@ -194,6 +211,7 @@ pub fn map_from_pcap(
         revolutions: full.len(),
         ground,
         vehicle_from_sensor,
+        skipped: recording.skipped_line(pcap),
     })
 }
 

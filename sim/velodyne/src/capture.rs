@@ -1,10 +1,10 @@
 //! The UDP datagrams of a capture: a pcap or pcapng file read with `pcap-parser`, each packet's
 //! link layer (Ethernet with or without an 802.1Q tag, Linux cooked capture v1 or v2, raw IPv4),
 //! IPv4 header (its own length, not assumed 20 bytes) and UDP header parsed. Packets that are
-//! not IPv4 UDP (ARP, IPv6, TCP) are skipped; one for the sensor's ports (2368, 8308) that is a
-//! fragment, cut short by the capture's snap length or with a length field past its end is an
-//! error naming the packet - anyone else's such packet is skipped. An unsupported link type is
-//! an error.
+//! not IPv4 UDP (ARP, IPv6, TCP) are skipped; so is, as VeloView and Wireshark read on past it,
+//! one that cannot be read whole - a fragment, cut short by the capture's snap length, a length
+//! field past its end - counted by why when it was for the sensor's ports (2368, 8308)
+//! ([`Skipped`]). An unsupported link type is an error.
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -28,8 +28,37 @@ pub struct Datagram {
     pub payload: Vec<u8>,
 }
 
-/// Every IPv4 UDP datagram of the capture at `path`, in capture order.
-pub fn read_datagrams(path: &Path) -> Result<Vec<Datagram>, VelodyneError> {
+/// Packets for the sensor's ports skipped because they could not be read whole: how many, the
+/// first's record index, by why.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Skipped(pub std::collections::BTreeMap<String, (u64, usize)>);
+
+impl Skipped {
+    /// Counts packet `index`, skipped for `why`.
+    pub fn add(&mut self, why: String, index: usize) {
+        self.0.entry(why).or_insert((0, index)).0 += 1;
+    }
+
+    /// Packets skipped in all.
+    pub fn total(&self) -> u64 {
+        self.0.values().map(|(n, _)| n).sum()
+    }
+}
+
+impl std::fmt::Display for Skipped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let parts: Vec<String> = self
+            .0
+            .iter()
+            .map(|(why, (n, first))| format!("{n} {why} (the first packet {first})"))
+            .collect();
+        write!(f, "{}", parts.join("; "))
+    }
+}
+
+/// Every IPv4 UDP datagram of the capture at `path`, in capture order, and the sensor's packets
+/// skipped.
+pub fn read_datagrams(path: &Path) -> Result<(Vec<Datagram>, Skipped), VelodyneError> {
     let file = File::open(path).map_err(|source| VelodyneError::Io {
         file: path.to_path_buf(),
         source,
@@ -41,6 +70,7 @@ pub fn read_datagrams(path: &Path) -> Result<Vec<Datagram>, VelodyneError> {
     let mut reader = create_reader(1 << 20, file)
         .map_err(|e| whole(format!("not a pcap or pcapng capture ({e:?})")))?;
     let mut out = Vec::new();
+    let mut skipped = Skipped::default();
     // The legacy header's link type and time unit; pcapng's per interface.
     let mut legacy: Option<(Linktype, f64)> = None;
     let mut interfaces: Vec<(Linktype, f64)> = Vec::new();
@@ -103,7 +133,7 @@ pub fn read_datagrams(path: &Path) -> Result<Vec<Datagram>, VelodyneError> {
                         caplen,
                         origlen,
                     };
-                    if let Some(d) = datagram_of(path, &record, &data)? {
+                    if let Some(d) = datagram_of(path, &record, &data, &mut skipped)? {
                         out.push(d);
                     }
                     index += 1;
@@ -132,7 +162,7 @@ pub fn read_datagrams(path: &Path) -> Result<Vec<Datagram>, VelodyneError> {
     if index == 0 {
         return Err(whole("no packets".into()));
     }
-    Ok(out)
+    Ok((out, skipped))
 }
 
 /// A packet record's fields beside its data.
@@ -144,9 +174,14 @@ struct Record {
     origlen: u32,
 }
 
-/// The UDP datagram of one packet record; `None` for what is skipped (not IPv4 UDP, or someone
-/// else's packet that cannot be read whole).
-fn datagram_of(path: &Path, r: &Record, data: &[u8]) -> Result<Option<Datagram>, VelodyneError> {
+/// The UDP datagram of one packet record; `None` for what is skipped (not IPv4 UDP, or a packet
+/// that cannot be read whole: counted in `skipped` when it was for the sensor's ports).
+fn datagram_of(
+    path: &Path,
+    r: &Record,
+    data: &[u8],
+    skipped: &mut Skipped,
+) -> Result<Option<Datagram>, VelodyneError> {
     if !supported(r.link) {
         return Err(packet_error(
             path,
@@ -158,8 +193,7 @@ fn datagram_of(path: &Path, r: &Record, data: &[u8]) -> Result<Option<Datagram>,
             ),
         ));
     }
-    // A packet that cannot be read whole is an error if it was for the sensor's ports, and
-    // skipped if it was not (a fragment of someone else's traffic).
+    // A packet that cannot be read whole is skipped; counted if it was for the sensor's ports.
     let velodyne = |port: Option<u16>| {
         port.is_some_and(|p| p == crate::packet::DATA_PORT || p == crate::packet::POSITION_PORT)
     };
@@ -171,14 +205,7 @@ fn datagram_of(path: &Path, r: &Record, data: &[u8]) -> Result<Option<Datagram>,
             Err((port, _)) => *port,
         };
         if velodyne(port) {
-            return Err(packet_error(
-                path,
-                r.index,
-                format!(
-                    "cut short by the capture: {} of {} bytes kept",
-                    r.caplen, r.origlen
-                ),
-            ));
+            skipped.add("cut short by the capture's snap length".into(), r.index);
         }
         return Ok(None);
     }
@@ -190,8 +217,13 @@ fn datagram_of(path: &Path, r: &Record, data: &[u8]) -> Result<Option<Datagram>,
             dst_port: d.1,
             payload: d.2.to_vec(),
         })),
-        Err((port, what)) if velodyne(port) => Err(packet_error(path, r.index, what)),
-        Ok(None) | Err(_) => Ok(None),
+        Err((port, what)) => {
+            if velodyne(port) {
+                skipped.add(what, r.index);
+            }
+            Ok(None)
+        }
+        Ok(None) => Ok(None),
     }
 }
 
@@ -263,16 +295,13 @@ pub fn udp(link: Linktype, data: &[u8]) -> Result<Option<Udp<'_>>, (Option<u16>,
     if flags_offset & 0x2000 != 0 || flags_offset & 0x1fff != 0 {
         return Err((
             port,
-            "an IPv4 fragment (Velodyne packets are never fragmented)".into(),
+            "IPv4 fragments (Velodyne packets are never fragmented)".into(),
         ));
     }
     if total < ihl + 8 || total > ip.len() {
         return Err((
             port,
-            format!(
-                "IPv4 total length {total} outside the packet's {} bytes",
-                ip.len()
-            ),
+            "with an IPv4 total length outside the packet".to_string(),
         ));
     }
     let u = &ip[ihl..total];
@@ -284,7 +313,7 @@ pub fn udp(link: Linktype, data: &[u8]) -> Result<Option<Udp<'_>>, (Option<u16>,
     if len < 8 || len > u.len() {
         return Err((
             Some(dst),
-            format!("UDP length {len} outside the datagram's {} bytes", u.len()),
+            "with a UDP length outside the datagram".to_string(),
         ));
     }
     Ok(Some((src, dst, &u[8..len])))

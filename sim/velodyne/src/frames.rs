@@ -47,12 +47,16 @@ pub struct Capture {
     pub data: Vec<(usize, DataPacket)>,
     /// Position packets, with the record index of each.
     pub positions: Vec<(usize, PositionPacket)>,
+    /// The sensor's packets skipped, by why: unreadable whole, or of a length neither a data nor
+    /// a position packet has.
+    pub skipped: crate::capture::Skipped,
 }
 
 impl Capture {
     /// Reads the Velodyne packets of the capture at `path`: UDP datagrams to port 2368 of 1206
-    /// bytes and to port 8308 of 512 bytes; others are skipped. Data packets from more than one
-    /// kind of sensor are an error.
+    /// bytes and to port 8308 of 512 bytes; others are skipped, and counted when they were for
+    /// those ports ([`Capture::skipped`]). Data packets from more than one kind of sensor are an
+    /// error; so is a capture with no data packet.
     pub fn read(path: &Path) -> Result<Capture, VelodyneError> {
         let mut capture = Capture::default();
         let located = |index: usize, what: String| VelodyneError::Packet {
@@ -60,7 +64,9 @@ impl Capture {
             index,
             what,
         };
-        for d in read_datagrams(path)? {
+        let (datagrams, skipped) = read_datagrams(path)?;
+        capture.skipped = skipped;
+        for d in datagrams {
             if d.dst_port == DATA_PORT && d.payload.len() == DATA_LEN {
                 let p = DataPacket::decode(&d.payload).map_err(|w| located(d.index, w))?;
                 if let Some((first, q)) = capture.data.first()
@@ -79,12 +85,25 @@ impl Capture {
             } else if d.dst_port == POSITION_PORT && d.payload.len() == POSITION_LEN {
                 let p = PositionPacket::decode(&d.payload).map_err(|w| located(d.index, w))?;
                 capture.positions.push((d.index, p));
+            } else if d.dst_port == DATA_PORT || d.dst_port == POSITION_PORT {
+                let why = format!(
+                    "to port {} of neither {DATA_LEN} nor {POSITION_LEN} bytes",
+                    d.dst_port
+                );
+                capture.skipped.add(why, d.index);
             }
         }
         if capture.data.is_empty() {
+            let skipped = if capture.skipped.total() > 0 {
+                format!("; skipped: {}", capture.skipped)
+            } else {
+                String::new()
+            };
             return Err(VelodyneError::File {
                 file: path.to_path_buf(),
-                what: format!("no Velodyne data packets (UDP port {DATA_PORT}, {DATA_LEN} bytes)"),
+                what: format!(
+                    "no Velodyne data packets (UDP port {DATA_PORT}, {DATA_LEN} bytes){skipped}"
+                ),
             });
         }
         Ok(capture)

@@ -22,7 +22,7 @@ pub mod packet;
 pub mod scan;
 
 pub use calibration::Calibration;
-pub use capture::{Datagram, pcap_bytes, read_datagrams};
+pub use capture::{Datagram, Skipped, pcap_bytes, read_datagrams};
 pub use error::VelodyneError;
 pub use frames::{Capture, Frame, Point, frames};
 pub use packet::{DataPacket, PositionPacket, Product, ReturnMode};

@@ -47,6 +47,9 @@ pub fn run(args: &CompareLidarArgs) -> anyhow::Result<()> {
     };
     let test = config.mapping.map.obstacle_test;
     let recording = sim::pcap::read(&args.pcap, args.calibration.as_deref())?;
+    if let Some(line) = recording.skipped_line(&args.pcap) {
+        eprintln!("{line}");
+    }
     let label = format!("real ({})", args.pcap.display());
     let real = real(&recording, &label, test).with_context(|| args.pcap.display().to_string())?;
     let revolutions = args.revolutions.unwrap_or(real.revolutions).max(1);

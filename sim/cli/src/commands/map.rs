@@ -153,6 +153,9 @@ fn from_pcap(
     )
     .with_context(|| format!("taxi-sim map --pcap {}", pcap.display()))?;
     progress.finish_and_clear();
+    if let Some(line) = &report.skipped {
+        eprintln!("{line}");
+    }
     let m = &report.manifest;
     let [pitch, roll] = report.ground.pitch_roll_deg();
     let h = report.vehicle_from_sensor.translation.vector.z;

@@ -9,7 +9,7 @@ pub struct NodeArgs {
     pub run: super::run::RunArgs,
     /// Wall seconds to wait after a step's odometry for its revolution and estimate before going
     /// on without them (a revolution the faults lost).
-    #[arg(long, value_name = "S", default_value_t = 0.5)]
+    #[arg(long, value_name = "S", default_value_t = 2.0)]
     pub wait_s: f64,
 }
 
@@ -22,11 +22,16 @@ pub fn serve(args: &NodeArgs) -> anyhow::Result<()> {
     );
     let (scenario, setup) = super::run::setup(&args.run)?;
     let mut node = sim::engine::ShippedNode::new(&scenario, &setup)?;
+    // SIGINT (Ctrl-C, or the simulator ending a run it started the node for) ends the node as
+    // the simulator leaving does: its summary said.
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let flag = stop.clone();
+    let _ = ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::Relaxed));
     let options = ros2_live::NodeOptions {
         domain_id: ros2_live::LiveOptions::domain_id(args.run.stack.ros_domain_id)?,
         wait_s: args.wait_s,
         discovery_timeout_s: args.run.stack.discovery_timeout_s,
-        stop: None,
+        stop: Some(stop.clone()),
     };
     eprintln!(
         "the shipped stack as ROS 2 node /taxi_stack on domain {} ({})",
@@ -34,7 +39,7 @@ pub fn serve(args: &NodeArgs) -> anyhow::Result<()> {
     );
     let summary = ros2_live::serve(&options, &mut node)?;
     eprintln!(
-        "the simulator left: {} steps answered ({} without their revolution, {} without an estimate)",
+        "the node ends: {} steps answered ({} without their revolution, {} without an estimate)",
         summary.steps, summary.without_cloud, summary.without_estimate
     );
     Ok(())

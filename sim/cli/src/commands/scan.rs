@@ -144,6 +144,9 @@ fn pose_along(scenario: &Scenario, s: f64) -> anyhow::Result<Isometry2<f64>> {
 /// `--pcap`: one revolution of a capture.
 fn from_pcap(args: &ScanArgs, pcap: &std::path::Path) -> anyhow::Result<()> {
     let recording = sim::pcap::read(pcap, args.calibration.as_deref())?;
+    if let Some(line) = recording.skipped_line(pcap) {
+        eprintln!("{line}");
+    }
     let n = recording.frames.len();
     let frame = recording.frames.get(args.revolution).ok_or_else(|| {
         anyhow::anyhow!(

@@ -63,17 +63,71 @@ fn hostile_captures_are_located_errors() {
         e.contains("packet 1") && e.contains("another sensor"),
         "{e}"
     );
-    // A packet cut by the capture's snap length.
+    // Only a packet cut by the capture's snap length: skipped, so no data, and the error says
+    // what was skipped.
     let mut snapped = pcap(1, &[ethernet_udp(2368, &good)[..200].to_vec()]);
     snapped[24 + 12..24 + 16].copy_from_slice(&1248u32.to_le_bytes());
     let e = error_of(&snapped);
     assert!(
-        e.contains("packet 0") && e.contains("cut short by the capture"),
+        e.contains("no Velodyne data packets")
+            && e.contains("1 cut short by the capture's snap length (the first packet 0)"),
         "{e}"
     );
     // No data packets at all.
     let e = error_of(&pcap(1, &[ethernet_udp(53, b"dns")]));
     assert!(e.contains("no Velodyne data packets"), "{e}");
+}
+
+/// Odd packets among good ones are skipped and counted by why, as VeloView reads on past them:
+/// a position packet whose IPv4 header claims more bytes than it has (a recording tool's quirk
+/// seen in a real VLP-16 capture), a data packet cut by the snap length, an IPv4 fragment to the
+/// data port, a datagram to the data port of another length; the good packets decode as they do
+/// without them.
+#[test]
+fn odd_packets_among_good_ones_are_skipped_and_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let good: Vec<Vec<u8>> = (0..3u16)
+        .map(|k| ethernet_udp(2368, &packet([100 * k; 12], u32::from(k)).encode()))
+        .collect();
+    let clean = Capture::read(&write(dir.path(), "clean.pcap", &pcap(1, &good))).unwrap();
+    assert_eq!(clean.skipped.total(), 0);
+    let mut position = ethernet_udp(8308, &[0u8; 512]);
+    position[14 + 2..14 + 4].copy_from_slice(&1234u16.to_be_bytes()); // IPv4 total length
+    let mut fragment = good[0].clone();
+    fragment[14 + 6] = 0x20; // more fragments
+    let other_length = ethernet_udp(2368, &[0u8; 100]);
+    let snapped = good[1][..300].to_vec();
+    let records = [
+        good[0].clone(),
+        position,
+        good[1].clone(),
+        fragment,
+        snapped.clone(),
+        other_length,
+        good[2].clone(),
+    ];
+    let mut bytes = pcap(1, &records);
+    // The snapped record (the fifth) says 300 of its whole length kept.
+    let at = 24 + records[..4].iter().map(|r| 16 + r.len()).sum::<usize>();
+    bytes[at + 12..at + 16].copy_from_slice(&(good[1].len() as u32).to_le_bytes());
+    let c = Capture::read(&write(dir.path(), "odd.pcap", &bytes)).unwrap();
+    let decoded: Vec<_> = c.data.iter().map(|(_, p)| p.clone()).collect();
+    let expected: Vec<_> = clean.data.iter().map(|(_, p)| p.clone()).collect();
+    assert_eq!(decoded, expected);
+    assert_eq!(
+        c.data.iter().map(|(i, _)| *i).collect::<Vec<_>>(),
+        [0, 2, 6]
+    );
+    assert_eq!(c.skipped.total(), 4, "{}", c.skipped);
+    let text = c.skipped.to_string();
+    for why in [
+        "1 with an IPv4 total length outside the packet (the first packet 1)",
+        "1 IPv4 fragments (Velodyne packets are never fragmented) (the first packet 3)",
+        "1 cut short by the capture's snap length (the first packet 4)",
+        "1 to port 2368 of neither 1206 nor 512 bytes (the first packet 5)",
+    ] {
+        assert!(text.contains(why), "{why}: {text}");
+    }
 }
 
 /// Other traffic in a capture is skipped, even when it could not be read whole (a fragment, a
