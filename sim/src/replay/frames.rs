@@ -51,6 +51,26 @@ impl Replay {
         Ok(())
     }
 
+    /// A revolution at `t_s`: its points logged if it is one of every `scan_every`; whether it
+    /// was.
+    pub(super) fn log_revolution_points(
+        &mut self,
+        t_s: f64,
+        scan: &mapper::Scan,
+        owners: &[Option<Owner>],
+    ) -> Result<bool> {
+        self.time(t_s);
+        let full = self
+            .scans_seen
+            .is_multiple_of(u64::from(self.options.scan_every));
+        self.scans_seen += 1;
+        if full {
+            self.log_lidar(scan, owners)?;
+            self.summary.scans_logged += 1;
+        }
+        Ok(full)
+    }
+
     /// A revolution's returns, every `point_stride` columns, classed as the mapper classes
     /// them: ground, vehicle (self), beyond mapping range, obstacle at level k, above every
     /// level.

@@ -234,15 +234,7 @@ impl Observer for Replay {
     }
 
     fn revolution(&mut self, frame: &RevolutionFrame<'_>) -> Result<()> {
-        self.time(frame.t_s);
-        let full = self
-            .scans_seen
-            .is_multiple_of(u64::from(self.options.scan_every));
-        self.scans_seen += 1;
-        if full {
-            self.log_lidar(&frame.revolution.scan, frame.owners)?;
-            self.summary.scans_logged += 1;
-        }
+        let full = self.log_revolution_points(frame.t_s, &frame.revolution.scan, frame.owners)?;
         self.log_localization(frame, full)?;
         self.log_plan(frame, full)?;
         self.log_traffic(frame)?;
@@ -258,15 +250,7 @@ impl Observer for Replay {
     }
 
     fn sensed(&mut self, frame: &SensedFrame<'_>) -> Result<()> {
-        self.time(frame.t_s);
-        let full = self
-            .scans_seen
-            .is_multiple_of(u64::from(self.options.scan_every));
-        self.scans_seen += 1;
-        if full {
-            self.log_lidar(&frame.revolution.scan, frame.owners)?;
-            self.summary.scans_logged += 1;
-        }
+        self.log_revolution_points(frame.t_s, &frame.revolution.scan, frame.owners)?;
         Ok(())
     }
 
