@@ -23,6 +23,12 @@
 //! xyz_m = [0.57, 0.0, 2.15]         # sensor origin in the vehicle frame, m
 //! rpy_rad = [0.0, 0.0, 0.0]         # roll, pitch, yaw (fixed X, Y, Z axes), rad; default 0
 //!
+//! [[extra_lidars]]                  # optional, any number: more LiDARs on the vehicle
+//! name = "nose_low"                 # its frame and topic name: a-z, 0-9, _; unique
+//! model = "vlp-16"                  # its beam table: "hdl-32e" or "vlp-16"
+//! xyz_m = [11.85, 0.0, 0.5]         # as [lidar]
+//! rpy_rad = [0.0, 0.0, 0.0]
+//!
 //! [fit]                             # optional; see `FitOptions`
 //! max_overshoot_m = 0.15
 //! ```
@@ -81,6 +87,60 @@ pub struct LidarMount {
     pub rpy_rad: [f64; 3],
 }
 
+/// A LiDAR besides the main one (`[lidar]`, the one the run configuration's `lidar` describes):
+/// its name, its model's beam table and its mount. It turns at the main one's rate, in step.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExtraLidar {
+    /// Its frame and topic name (`a-z`, `0-9`, `_`; not `velodyne`, the main one's frame).
+    pub name: String,
+    /// Its model, by name (`hdl-32e`, `vlp-16`): the simulator knows the beam tables.
+    pub model: String,
+    /// Sensor origin in the vehicle frame, metres.
+    pub xyz_m: [f64; 3],
+    /// Sensor orientation (as [`LidarMount::rpy_rad`]), radians. Default 0.
+    #[serde(default)]
+    pub rpy_rad: [f64; 3],
+}
+
+impl ExtraLidar {
+    /// The sensor's pose in the vehicle frame.
+    pub fn vehicle_from_lidar(&self) -> Isometry3<f64> {
+        LidarMount {
+            xyz_m: self.xyz_m,
+            rpy_rad: self.rpy_rad,
+        }
+        .vehicle_from_lidar()
+    }
+}
+
+/// Checks the extra LiDARs: finite mounts, names fit for a ROS frame, each once.
+fn check_extra_lidars(lidars: &[ExtraLidar]) -> std::result::Result<(), (String, String)> {
+    for (k, l) in lidars.iter().enumerate() {
+        let at = |f: &str| format!("extra_lidars[{k}].{f}");
+        let good = |c: char| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_';
+        if l.name.is_empty() || !l.name.chars().all(good) || l.name == "velodyne" {
+            return Err((
+                at("name"),
+                format!(
+                    "{:?}: a frame name of a-z, 0-9 and _ (not \"velodyne\", the main LiDAR's)",
+                    l.name
+                ),
+            ));
+        }
+        if lidars[..k].iter().any(|o| o.name == l.name) {
+            return Err((at("name"), format!("{:?} names two LiDARs", l.name)));
+        }
+        if l.model.trim().is_empty() {
+            return Err((at("model"), "empty: say which model (hdl-32e, vlp-16)".into()));
+        }
+        if l.xyz_m.iter().chain(&l.rpy_rad).any(|v| !v.is_finite()) {
+            return Err((at("xyz_m"), "every value must be finite".into()));
+        }
+    }
+    Ok(())
+}
+
 impl LidarMount {
     /// The sensor's pose in the vehicle frame.
     pub fn vehicle_from_lidar(&self) -> Isometry3<f64> {
@@ -134,6 +194,9 @@ pub struct VehicleSpec {
     pub motion: MotionLimits,
     /// LiDAR mount pose.
     pub lidar: LidarMount,
+    /// More LiDARs on the vehicle (default none), each cast, mapped and recorded on its own.
+    #[serde(default)]
+    pub extra_lidars: Vec<ExtraLidar>,
     /// Default fit options for this vehicle (all optional).
     #[serde(default)]
     pub fit: FitOptions,
@@ -197,6 +260,7 @@ impl VehicleSpec {
         if l.xyz_m.iter().chain(&l.rpy_rad).any(|v| !v.is_finite()) {
             return Err(field("lidar", "every value must be finite".into()));
         }
+        check_extra_lidars(&spec.extra_lidars).map_err(|(f, m)| field(&f, m))?;
         if spec.fit.max_circles == Some(0) {
             return Err(field("fit.max_circles", "must be at least 1".into()));
         }

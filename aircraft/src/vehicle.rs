@@ -9,26 +9,37 @@ use crate::shapes::Part;
 use crate::spec::VehicleSpec;
 
 /// Names of the vehicles shipped in `aircraft/vehicles/`.
-pub const SHIPPED_VEHICLES: [&str; 4] = ["praetor600", "iara_car", "iara_car_fake_wing", "a320"];
+pub const SHIPPED_VEHICLES: [&str; 5] = [
+    "praetor600",
+    "iara_car",
+    "iara_car_fake_wing",
+    "a320",
+    "praetor600_two_lidars",
+];
 
 macro_rules! shipped {
     ($name:literal) => {
+        shipped!($name, $name)
+    };
+    ($name:literal, $urdf:literal) => {
         (
             $name,
             concat!(env!("CARGO_MANIFEST_DIR"), "/vehicles/", $name, ".toml"),
             include_str!(concat!("../vehicles/", $name, ".toml")),
-            concat!(env!("CARGO_MANIFEST_DIR"), "/vehicles/", $name, ".urdf"),
-            include_str!(concat!("../vehicles/", $name, ".urdf")),
+            concat!(env!("CARGO_MANIFEST_DIR"), "/vehicles/", $urdf, ".urdf"),
+            include_str!(concat!("../vehicles/", $urdf, ".urdf")),
         )
     };
 }
 
 /// (name, sidecar path, sidecar text, URDF path, URDF text) of each shipped vehicle.
-const SHIPPED: [(&str, &str, &str, &str, &str); 4] = [
+const SHIPPED: [(&str, &str, &str, &str, &str); 5] = [
     shipped!("praetor600"),
     shipped!("iara_car"),
     shipped!("iara_car_fake_wing"),
     shipped!("a320"),
+    // The same airframe with a second, low LiDAR under the nose.
+    shipped!("praetor600_two_lidars", "praetor600"),
 ];
 
 /// A described vehicle.

@@ -40,6 +40,7 @@ use crate::levels::{HeightClass, Levels};
 use crate::occupancy::ObstacleTest;
 use crate::scan::Scan;
 use crate::self_hits::SelfHitFilter;
+use crate::self_mask::SelfMask;
 
 /// What one scan insertion did.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -100,12 +101,26 @@ impl MultiHeightMap {
         scan: &Scan,
         vehicle: Option<&CollisionModel>,
     ) -> Result<InsertStats> {
+        self.insert_scan_masked(scan, vehicle, None)
+    }
+
+    /// [`Self::insert_scan`] with the sensor's self mask too (`mask`, which must fit the scan):
+    /// a return is dropped as the vehicle's own when either filter says it is.
+    pub fn insert_scan_masked(
+        &mut self,
+        scan: &Scan,
+        vehicle: Option<&CollisionModel>,
+        mask: Option<&SelfMask>,
+    ) -> Result<InsertStats> {
+        if let Some(mask) = mask {
+            mask.fits(scan)?;
+        }
         let mut stats = InsertStats {
             hits: vec![0; self.levels.count()],
             free_cells: vec![0; self.levels.count()],
             ..Default::default()
         };
-        self.classify(scan, vehicle, &mut stats);
+        self.classify(scan, vehicle, mask, &mut stats);
 
         let config = self.config;
         let cell0 = self.window_cell0();
@@ -168,12 +183,8 @@ impl MultiHeightMap {
         Ok(stats)
     }
 
-    /// Step 1 of the insertion: drop and classify every return once (self-hits, returns out of
-    /// range or at or above the ceiling are dropped).
-    fn classify(&mut self, scan: &Scan, vehicle: Option<&CollisionModel>, stats: &mut InsertStats) {
-        let beams = scan.beams();
-        let params = self.config.obstacle_test;
-        let test = ObstacleTest::new(params);
+    /// The circles' self-hit filter for `vehicle` at the map's margin, made when it changes.
+    fn prepare_self_filter(&mut self, vehicle: Option<&CollisionModel>) {
         let margin = self.config.self_hit_margin_m;
         if let Some(model) = vehicle
             && !self
@@ -183,6 +194,21 @@ impl MultiHeightMap {
         {
             self.self_hits = Some(SelfHitFilter::new(model, margin));
         }
+    }
+
+    /// Step 1 of the insertion: drop and classify every return once (self-hits, returns out of
+    /// range or at or above the ceiling are dropped).
+    fn classify(
+        &mut self,
+        scan: &Scan,
+        vehicle: Option<&CollisionModel>,
+        mask: Option<&SelfMask>,
+        stats: &mut InsertStats,
+    ) {
+        let beams = scan.beams();
+        let params = self.config.obstacle_test;
+        let test = ObstacleTest::new(params);
+        self.prepare_self_filter(vehicle);
         let self_filter = vehicle.and(self.self_hits.as_ref());
         let geometry = self.geometry;
         // Returns at or above the ceiling belong to no level (CARMEN drops points above the
@@ -209,7 +235,8 @@ impl MultiHeightMap {
             .zip(self.column_levels.par_chunks_mut(n_levels))
             .zip(scan.returns().par_chunks(beams))
             .zip(scan.columns().par_iter())
-            .map(|(((out, summary), returns), column)| {
+            .enumerate()
+            .map(|(c, (((out, summary), returns), column))| {
                 let sensor = Point2::from(column.world_from_sensor.translation.vector.xy());
                 let sensor3 = nalgebra::Point3::from(column.world_from_sensor.translation.vector);
                 let vehicle_from_world = column.world_from_vehicle.inverse();
@@ -246,8 +273,13 @@ impl MultiHeightMap {
                         far += 1;
                         continue;
                     };
-                    if let Some(filter) = self_filter
-                        && filter.is_self_hit(&(vehicle_from_world * xy), height)
+                    let masked = mask.is_some_and(|m| {
+                        m.is_self_hit(c, b, (p - sensor3).norm())
+                    });
+                    if masked
+                        || self_filter.is_some_and(|filter| {
+                            filter.is_self_hit(&(vehicle_from_world * xy), height)
+                        })
                     {
                         self_hits += 1;
                         continue;
@@ -268,20 +300,7 @@ impl MultiHeightMap {
                         open_top_m: NO_CLAIM,
                     };
                     out[b] = c;
-                    // Per level: the farthest return considered (the last of equals) and the
-                    // nearest obstacle hit (the first of equals).
-                    for (&(lo, hi), sum) in bands.iter().zip(summary.iter_mut()) {
-                        let class = height_class(c.height_m, lo, hi);
-                        if class != HeightClass::Above && c.range_xy_m >= sum.far_m {
-                            (sum.far, sum.far_m) = (b as u16, c.range_xy_m);
-                        }
-                        if c.obstacle
-                            && class == HeightClass::Inside
-                            && c.range_xy_m < sum.nearest_hit_m
-                        {
-                            (sum.nearest_hit, sum.nearest_hit_m) = (b as u16, c.range_xy_m);
-                        }
-                    }
+                    summarise(&bands, summary, &c, b);
                 }
                 claim_open_tops(out, returns, column, &elevations, params.ground_height_m);
                 (n, self_hits, far, above)
@@ -294,6 +313,20 @@ impl MultiHeightMap {
         stats.self_hits = counts.1;
         stats.out_of_range = counts.2;
         stats.above_ceiling = counts.3;
+    }
+}
+
+/// A return kept (`c`, beam `b`) in its column's per-level summary: the farthest return
+/// considered (the last of equals) and the nearest obstacle hit (the first of equals).
+fn summarise(bands: &[(f32, f32)], summary: &mut [ColumnLevel], c: &Classified, b: usize) {
+    for (&(lo, hi), sum) in bands.iter().zip(summary.iter_mut()) {
+        let class = height_class(c.height_m, lo, hi);
+        if class != HeightClass::Above && c.range_xy_m >= sum.far_m {
+            (sum.far, sum.far_m) = (b as u16, c.range_xy_m);
+        }
+        if c.obstacle && class == HeightClass::Inside && c.range_xy_m < sum.nearest_hit_m {
+            (sum.nearest_hit, sum.nearest_hit_m) = (b as u16, c.range_xy_m);
+        }
     }
 }
 

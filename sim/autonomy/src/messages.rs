@@ -10,13 +10,24 @@ use nalgebra::{Isometry2, Matrix3, Vector2};
 pub struct LidarRevolution {
     /// When the revolution was taken, seconds.
     pub t_s: f64,
-    /// The returns, columns x beams (`mapper::Scan`), in the estimate's world frame.
+    /// The main LiDAR's returns, columns x beams (`mapper::Scan`), in the estimate's world frame.
     pub scan: mapper::Scan,
+    /// The vehicle's other LiDARs' returns of the same revolution, one scan each, in the order
+    /// of the sidecar's `extra_lidars`, each column with its own sensor's origin. Empty for a
+    /// vehicle with one LiDAR.
+    pub more_scans: Vec<mapper::Scan>,
     /// The pose estimate the revolution was taken at.
     pub world_from_vehicle_estimate: Isometry2<f64>,
     /// That estimate's covariance (x, y in metres, heading in radians; zero for an exact pose):
     /// how far the returns may be from where they are placed.
     pub estimate_covariance: Matrix3<f64>,
+}
+
+impl LidarRevolution {
+    /// Every sensor's scan: the main LiDAR's, then the others'.
+    pub fn scans(&self) -> impl Iterator<Item = &mapper::Scan> {
+        std::iter::once(&self.scan).chain(&self.more_scans)
+    }
 }
 
 /// A pose estimate from the localizer (or the simulator's stand-in for one).

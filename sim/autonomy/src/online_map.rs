@@ -56,6 +56,8 @@ impl Default for ForgettingConfig {
 pub struct OnlineMap {
     map: MultiHeightMap,
     self_filter: CollisionModel,
+    /// The other LiDARs' self masks, in the order of `LidarRevolution::more_scans`.
+    more_masks: Vec<mapper::SelfMask>,
     forgetting: ForgettingConfig,
     scan_period_s: f64,
     max_return_error_m: f64,
@@ -107,6 +109,7 @@ impl OnlineMap {
         OnlineMap {
             map,
             self_filter,
+            more_masks: Vec::new(),
             forgetting,
             scan_period_s,
             max_return_error_m,
@@ -114,6 +117,15 @@ impl OnlineMap {
             revolutions: 0,
             started: false,
         }
+    }
+
+    /// The vehicle's other LiDARs' self masks, one per scan of `LidarRevolution::more_scans`
+    /// in order: their returns are filtered by their masks alone (the rays that meet the
+    /// airframe, at the range they do), not by the circles and their margin, which would hide
+    /// the ground beside the gears a low sensor is there to see.
+    pub fn with_more_masks(mut self, masks: Vec<mapper::SelfMask>) -> Self {
+        self.more_masks = masks;
+        self
     }
 
     /// Takes in one revolution: the window re-centred on the pose it was taken at, (under
@@ -142,9 +154,7 @@ impl OnlineMap {
             }
             self.started = true;
         }
-        self.map
-            .insert_scan(&revolution.scan, Some(&self.self_filter))?;
-        let hits = self.map.last_scan_hits_by_level();
+        let (hits, tops) = self.insert_every_sensor(revolution)?;
         // Hits on or beside (one cell: the estimate's error) an offline-map obstacle are no
         // mover's: a lamp post is not tracked, and a truck passing one is tracked on its own.
         let (map, levels) = (&self.map, self.map.levels().count());
@@ -153,7 +163,6 @@ impl OnlineMap {
                 (y - 1..=y + 1).any(|y| (0..levels).any(|l| map.is_prior_obstacle(l, (x, y))))
             })
         };
-        let tops = self.map.last_scan_open_tops();
         let clear = self
             .tracker
             .update_except(revolution.t_s, &hits, &tops, is_static);
@@ -166,6 +175,47 @@ impl OnlineMap {
             self.tracker.prune(&at, half);
         }
         Ok(())
+    }
+
+    /// Each sensor's scan inserted from its own origin (the obstacle test compares beams of one
+    /// sensor; the main one's self-hits filtered by the circles, the others' by their masks); the cells they hit, by level, and their open
+    /// tops, merged as one scan's are (levels joined, the highest top kept).
+    fn insert_every_sensor(
+        &mut self,
+        revolution: &LidarRevolution,
+    ) -> Result<(Vec<(WorldCell, u32)>, Vec<(WorldCell, f32)>), mapper::MapError> {
+        self.map
+            .insert_scan(&revolution.scan, Some(&self.self_filter))?;
+        let mut hits = self.map.last_scan_hits_by_level();
+        let mut tops = self.map.last_scan_open_tops();
+        if revolution.more_scans.is_empty() {
+            return Ok((hits, tops));
+        }
+        for (k, scan) in revolution.more_scans.iter().enumerate() {
+            match self.more_masks.get(k) {
+                Some(mask) => self.map.insert_scan_masked(scan, None, Some(mask))?,
+                None => self.map.insert_scan(scan, Some(&self.self_filter))?,
+            };
+            hits.extend(self.map.last_scan_hits_by_level());
+            tops.extend(self.map.last_scan_open_tops());
+        }
+        hits.sort_unstable_by_key(|h| h.0);
+        hits.dedup_by(|later, first| {
+            let same = later.0 == first.0;
+            if same {
+                first.1 |= later.1;
+            }
+            same
+        });
+        tops.sort_unstable_by_key(|t| t.0);
+        tops.dedup_by(|later, first| {
+            let same = later.0 == first.0;
+            if same {
+                first.1 = first.1.max(later.1);
+            }
+            same
+        });
+        Ok((hits, tops))
     }
 
     /// Whether mapping has started: a revolution's estimate has been trusted out to the obstacle

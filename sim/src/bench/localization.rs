@@ -45,6 +45,7 @@ pub fn figures_for(
     let revolution = LidarRevolution {
         t_s: 0.0,
         scan,
+        more_scans: Vec::new(),
         world_from_vehicle_estimate: start,
         estimate_covariance: nalgebra::Matrix3::zeros(),
     };

@@ -195,6 +195,7 @@ impl Rig<'_> {
         let sensor = Sensor {
             world: &self.world,
             lidar: &self.lidar,
+            more: &self.more_lidars,
             faults,
             seed,
             dropped: &self.dropped_returns,
@@ -288,6 +289,7 @@ impl Rig<'_> {
             estimate: planned.captured.revolution.world_from_vehicle_estimate,
             revolution: &planned.captured.revolution,
             owners: &planned.captured.owners,
+            more_owners: &planned.captured.more_owners,
             map: map.map(),
             plan,
             speed_cmd_m_s: v,
@@ -351,6 +353,7 @@ impl Rig<'_> {
         Sensor {
             world: &self.world,
             lidar: &self.lidar,
+            more: &self.more_lidars,
             faults: &self.config.faults,
             seed: self.seed,
             dropped: &self.dropped_returns,
@@ -388,6 +391,7 @@ impl Rig<'_> {
                 estimate,
                 revolution: &c.revolution,
                 owners: &c.owners,
+                more_owners: &c.more_owners,
                 world: &self.world,
             })?;
         }

@@ -135,6 +135,7 @@ impl ShippedNode {
             message,
         })?;
         let vehicle = &scenario.vehicle.vehicle;
+        super::rig::one_lidar_on_the_wire(vehicle)?;
         let model = config.collision_model(vehicle)?;
         let route = RoutePath::new(&scenario.route.waypoints_m, scenario.route.closed)
             .with_speed_limits(scenario.route.speed_limits_m_s.clone());
@@ -245,6 +246,7 @@ impl ShippedNode {
         Ok(autonomy::LidarRevolution {
             t_s,
             scan,
+            more_scans: Vec::new(),
             world_from_vehicle_estimate: world_from_vehicle,
             estimate_covariance: estimate.covariance,
         })

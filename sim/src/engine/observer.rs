@@ -61,8 +61,10 @@ pub struct RunStart<'a> {
     pub model: &'a CollisionModel,
     /// The level of each vehicle part (`scenario.vehicle.vehicle.parts`).
     pub part_levels: &'a [usize],
-    /// The LiDAR.
+    /// The LiDAR (the main one, frame `velodyne`).
     pub lidar: &'a Lidar,
+    /// The vehicle's other LiDARs, each with its frame name.
+    pub more_lidars: &'a [crate::world::NamedLidar],
     /// Laps asked for.
     pub laps: u32,
     /// Seed used.
@@ -83,6 +85,8 @@ pub struct RevolutionFrame<'a> {
     pub revolution: &'a LidarRevolution,
     /// What each return of the revolution hit (ground truth, for pictures).
     pub owners: &'a [Option<Owner>],
+    /// The same for each of the other LiDARs' scans.
+    pub more_owners: &'a [Vec<Option<Owner>>],
     /// The map after the update (occupancy and distance maps per level).
     pub map: &'a MultiHeightMap,
     /// The planner's candidates and its choice.
@@ -115,6 +119,8 @@ pub struct SensedFrame<'a> {
     pub revolution: &'a LidarRevolution,
     /// What each return hit (ground truth, for pictures).
     pub owners: &'a [Option<Owner>],
+    /// The same for each of the other LiDARs' scans.
+    pub more_owners: &'a [Vec<Option<Owner>>],
     /// The world (the run-time obstacles where they are).
     pub world: &'a World,
 }

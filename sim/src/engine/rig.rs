@@ -145,6 +145,7 @@ pub fn run_external<'a>(
     stack: &'a mut dyn ExternalStack,
     policy: LatePolicy,
 ) -> Result<RunReport> {
+    one_lidar_on_the_wire(&scenario.vehicle.vehicle)?;
     let mut rig = Rig::new(scenario, setup)?;
     let route_m: Vec<Point2<f64>> = scenario.route.waypoints_m.clone();
     let levels = crate::offline_map::levels_of(scenario, &setup.config)?;
@@ -185,6 +186,8 @@ pub(super) struct Rig<'a> {
     pub(super) scene: crate::world::Scene,
     pub(super) world: World,
     pub(super) lidar: Lidar,
+    /// The vehicle's other LiDARs (its sidecar's `extra_lidars`).
+    pub(super) more_lidars: Vec<crate::world::NamedLidar>,
     pub(super) bicycle: Bicycle,
     pub(super) model: CollisionModel,
     pub(super) part_levels: Vec<usize>,
@@ -264,14 +267,9 @@ impl<'a> Rig<'a> {
         let start = scenario.vehicle.world_from_start;
         let scene = scenario.full_scene();
         let mut world = World::with_obstacles(&scene, vehicle, &start);
-        let lidar =
-            Lidar::new(config.lidar.clone(), vehicle.vehicle_from_lidar()).map_err(|e| {
-                Error::Config {
-                    origin: "lidar".into(),
-                    message: e.to_string(),
-                }
-            })?;
+        let (lidar, more_lidars) = lidars(vehicle, &config)?;
         let (online, live) = online_map(scenario, &config, &model, setup, &start)?;
+        let online = online.with_more_masks(self_masks(&more_lidars, &world)?);
         let mut driver = driver(scenario, &config, &model, &route);
         let walk_around = scenario.vehicle.walk_around;
         if walk_around != WalkAround::BeforeStart {
@@ -310,6 +308,7 @@ impl<'a> Rig<'a> {
             scene,
             world,
             lidar,
+            more_lidars,
             bicycle: Bicycle::new(vehicle.spec.motion.clone()),
             model,
             part_levels,
@@ -357,6 +356,7 @@ impl<'a> Rig<'a> {
             model: &self.model,
             part_levels: &self.part_levels,
             lidar: &self.lidar,
+            more_lidars: &self.more_lidars,
             laps: self.laps,
             seed: self.seed,
             config: &self.config,
@@ -485,7 +485,70 @@ pub(super) fn online_map(
     Ok((online, live))
 }
 
-/// The ground round `vehicle` that its LiDAR (`lidar`) cannot see, per level of `model` (the
+/// Refuses a vehicle with more than one LiDAR for a stack behind the wire: the messages carry
+/// one cloud (`/velodyne_points`), and a stack told of ground only the others see would be
+/// judged on what it was never sent.
+pub(super) fn one_lidar_on_the_wire(vehicle: &aircraft::Vehicle) -> Result<()> {
+    match vehicle.spec.extra_lidars.len() {
+        0 => Ok(()),
+        n => Err(Error::Invalid(format!(
+            "vehicle {} carries {} LiDARs ({n} in extra_lidars); a stack over the wire is sent \
+             the main one's cloud only: run it with the shipped stack in the process, or use a \
+             vehicle with one LiDAR",
+            vehicle.spec.name,
+            n + 1
+        ))),
+    }
+}
+
+/// How far a return may fall short of where its ray meets the airframe and still be the
+/// airframe's (range noise, 4 mm; a laser's bias, a few cm at most), metres.
+pub const SELF_MASK_TOLERANCE_M: f64 = 0.1;
+
+/// Each of `lidars`' self mask: the rays that meet the vehicle in `world`, at the range they do.
+pub(super) fn self_masks(
+    lidars: &[crate::world::NamedLidar],
+    world: &World,
+) -> Result<Vec<mapper::SelfMask>> {
+    lidars
+        .iter()
+        .map(|l| {
+            let ranges: Vec<Option<f64>> = l
+                .lidar
+                .rays_in_vehicle(world)
+                .into_iter()
+                .map(|(_, t)| t)
+                .collect();
+            let beams = l.lidar.elevations_rad().len();
+            Ok(mapper::SelfMask::new(beams, &ranges, SELF_MASK_TOLERANCE_M)?)
+        })
+        .collect()
+}
+
+/// The vehicle's LiDARs: the main one as the run configuration describes it, and the others
+/// its sidecar lists ([`crate::world::coverage::vehicle_lidars`]).
+pub(super) fn lidars(
+    vehicle: &aircraft::Vehicle,
+    config: &RunConfig,
+) -> Result<(Lidar, Vec<crate::world::NamedLidar>)> {
+    let mut all = Vec::new();
+    for m in crate::world::coverage::vehicle_lidars(vehicle, &config.lidar)? {
+        let lidar = Lidar::new(m.config, m.vehicle_from_sensor).map_err(|message| {
+            Error::Config {
+                origin: format!("lidar {}", m.name),
+                message,
+            }
+        })?;
+        all.push(crate::world::NamedLidar {
+            name: m.name,
+            lidar,
+        });
+    }
+    let main = all.remove(0).lidar;
+    Ok((main, all))
+}
+
+/// The ground round `vehicle` that its LiDARs (the main one as `lidar`) cannot see, per level of `model` (the
 /// levels' heights as the model has them), on 0.2 m cells out to 20 m: what the stack knows of
 /// its own sensor layout for the start-up rule.
 pub(super) fn blind_zone(

@@ -51,13 +51,14 @@ impl Replay {
         Ok(())
     }
 
-    /// A revolution at `t_s`: its points logged if it is one of every `scan_every`; whether it
-    /// was.
+    /// A revolution at `t_s`: its points (every sensor's, each at its own entity) logged if it
+    /// is one of every `scan_every`; whether it was.
     pub(super) fn log_revolution_points(
         &mut self,
         t_s: f64,
-        scan: &mapper::Scan,
+        revolution: &autonomy::LidarRevolution,
         owners: &[Option<Owner>],
+        more_owners: &[Vec<Option<Owner>>],
     ) -> Result<bool> {
         self.time(t_s);
         let full = self
@@ -65,7 +66,15 @@ impl Replay {
             .is_multiple_of(u64::from(self.options.scan_every));
         self.scans_seen += 1;
         if full {
-            self.log_lidar(scan, owners)?;
+            self.log_lidar("world/lidar", &revolution.scan, owners)?;
+            for (k, scan) in revolution.more_scans.iter().enumerate() {
+                let path = self.more_lidar_paths.get(k).cloned().unwrap_or_else(|| {
+                    // A stack's revolution names no sensors: numbered.
+                    format!("world/lidar/{}", k + 1)
+                });
+                let owners = more_owners.get(k).map_or(&[][..], Vec::as_slice);
+                self.log_lidar(&path, scan, owners)?;
+            }
             self.summary.scans_logged += 1;
         }
         Ok(full)
@@ -76,6 +85,7 @@ impl Replay {
     /// level.
     pub(super) fn log_lidar(
         &mut self,
+        path: &str,
         scan: &mapper::Scan,
         owners: &[Option<Owner>],
     ) -> Result<()> {
@@ -131,7 +141,7 @@ impl Replay {
             }
         }
         self.rec.log(
-            "world/lidar",
+            path,
             &rerun::Points3D::new(positions)
                 .with_class_ids(classes)
                 .with_radii([0.04]),

@@ -13,6 +13,7 @@
 //! | `world/vehicle/parts/<link>/<k>` | the URDF collision primitives | once (static) |
 //! | `world/vehicle/circles/level_<k>` | the circle model, at the level's height, coloured by level | once (static) |
 //! | `world/lidar` | a revolution's returns, classed ground / level k / vehicle / unmapped | every `scan_every` revolutions |
+//! | `world/lidar/<name>` | the same for each of the vehicle's other LiDARs (`extra_lidars`) | with `world/lidar` |
 //! | `world/maps/level_<k>/occupancy` | the level's merged occupancy (`GridMap`, ROS values) at its height | `maps_hz` |
 //! | `maps/level_<k>/distance` | the level's obstacle distance map (`DepthImage`, metres) | `maps_hz` |
 //! | `world/planner/candidates` | the planner's candidates (red: colliding) | every `scan_every` revolutions |
@@ -130,6 +131,8 @@ pub struct Replay {
     /// Last logged (active, x, y, yaw) of each run-time obstacle.
     obstacles: Vec<Option<(f64, f64, f64)>>,
     obstacle_paths: Vec<String>,
+    /// `world/lidar/<name>`: where each of the vehicle's other LiDARs' points go.
+    more_lidar_paths: Vec<String>,
     scans_seen: u64,
     next_step_t: f64,
     next_map_t: f64,
@@ -165,6 +168,7 @@ impl Replay {
             first_obstacle: 0,
             obstacles: Vec::new(),
             obstacle_paths: Vec::new(),
+            more_lidar_paths: Vec::new(),
             scans_seen: 0,
             next_step_t: 0.0,
             next_map_t: 0.0,
@@ -209,6 +213,11 @@ impl Observer for Replay {
         self.first_obstacle = run.first_obstacle;
         let obstacles = run.scene.solids.len().saturating_sub(run.first_obstacle);
         self.obstacles = vec![None; obstacles];
+        self.more_lidar_paths = run
+            .more_lidars
+            .iter()
+            .map(|l| format!("world/lidar/{}", path_part(&l.name)))
+            .collect();
         self.obstacle_paths = run.scene.solids[run.first_obstacle..]
             .iter()
             .map(|s| format!("world/obstacles/{}", path_part(&s.id)))
@@ -234,7 +243,12 @@ impl Observer for Replay {
     }
 
     fn revolution(&mut self, frame: &RevolutionFrame<'_>) -> Result<()> {
-        let full = self.log_revolution_points(frame.t_s, &frame.revolution.scan, frame.owners)?;
+        let full = self.log_revolution_points(
+            frame.t_s,
+            frame.revolution,
+            frame.owners,
+            frame.more_owners,
+        )?;
         self.log_localization(frame, full)?;
         self.log_plan(frame, full)?;
         self.log_traffic(frame)?;
@@ -250,7 +264,12 @@ impl Observer for Replay {
     }
 
     fn sensed(&mut self, frame: &SensedFrame<'_>) -> Result<()> {
-        self.log_revolution_points(frame.t_s, &frame.revolution.scan, frame.owners)?;
+        self.log_revolution_points(
+            frame.t_s,
+            frame.revolution,
+            frame.owners,
+            frame.more_owners,
+        )?;
         Ok(())
     }
 

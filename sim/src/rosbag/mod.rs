@@ -10,6 +10,7 @@
 //! | `/tf` | `odom` -> `base_link` (the stack's estimate) and `map` -> `ground_truth/base_link` (the truth), kept apart | every revolution |
 //! | `/clock` | `rosgraph_msgs/msg/Clock` | 20 Hz |
 //! | `/velodyne_points` | `sensor_msgs/msg/PointCloud2`, frame `velodyne`, the ROS Velodyne driver's fields (x, y, z, intensity 0-255, ring, time 0: the loop takes a revolution at one instant) | every revolution, stamped when taken |
+//! | `/<name>/velodyne_points` | the same for each of the vehicle's other LiDARs (the sidecar's `extra_lidars`), frame `<name>` (in `/tf_static` from `base_link`) | with `/velodyne_points` |
 //! | `/localization/pose` | `geometry_msgs/msg/PoseWithCovarianceStamped` in `map` (x, y, yaw covariance) | every revolution |
 //! | `/ground_truth/odom` | `nav_msgs/msg/Odometry`: the true pose and speed | 20 Hz |
 //! | `/cmd_drive` | `ackermann_msgs/msg/AckermannDriveStamped`: the command followed | 20 Hz |
@@ -89,6 +90,8 @@ pub struct RosBag {
     maps: Vec<(TopicId, TopicId)>,
     last_map_s: Option<f64>,
     written: Option<ros2::BagSummary>,
+    /// `/<name>/velodyne_points` of each of the vehicle's other LiDARs, with its frame.
+    more_clouds: Vec<(TopicId, String)>,
     /// Index of the first run-time obstacle among the scene's solids.
     first_obstacle: usize,
 }
@@ -136,6 +139,15 @@ impl RosBag {
             &crate::engine::cloud_points(&revolution.scan),
         );
         self.write(|t| t.cloud, t, cloud)?;
+        for (k, scan) in revolution.more_scans.iter().enumerate() {
+            let Some((topic, frame)) = self.more_clouds.get(k) else {
+                break;
+            };
+            let cloud = msgs::velodyne_cloud(stamp, frame, &crate::engine::cloud_points(scan));
+            if let Some(bag) = self.bag.as_mut() {
+                bag.write(*topic, stamp_ns(t), cloud).map_err(bag_error)?;
+            }
+        }
         if let Some(e) = estimate {
             let pose = msgs::pose_with_covariance(
                 stamp,
@@ -193,6 +205,7 @@ impl RosBag {
             maps: Vec::new(),
             last_map_s: None,
             written: None,
+            more_clouds: Vec::new(),
             first_obstacle: 0,
         })
     }
@@ -293,11 +306,22 @@ impl RosBag {
 impl Observer for RosBag {
     fn start(&mut self, run: &RunStart<'_>) -> Result<()> {
         let mount = run.lidar.vehicle_from_sensor();
-        let tf = msgs::tf_message(&[
+        let mut mounts = vec![
             transform(0.0, "map", "odom", Pose::planar(0.0, 0.0, 0.0, 0.0)),
             transform(0.0, "base_link", "velodyne", pose3(&mount)),
-        ]);
-        self.write(|t| t.tf_static, 0.0, tf)?;
+        ];
+        for l in run.more_lidars {
+            let mount = pose3(&l.lidar.vehicle_from_sensor());
+            mounts.push(transform(0.0, "base_link", &l.name, mount));
+            if let Some(bag) = self.bag.as_mut() {
+                let name = format!("/{}/velodyne_points", l.name);
+                let topic = bag
+                    .add_topic(&name, msgs::POINT_CLOUD2, Qos::Stream)
+                    .map_err(bag_error)?;
+                self.more_clouds.push((topic, l.name.clone()));
+            }
+        }
+        self.write(|t| t.tf_static, 0.0, msgs::tf_message(&mounts))?;
         let stamp = Time::from_ns(stamp_ns(0.0));
         let heights = crate::offline_map::levels_of(run.scenario, run.config)?;
         let circles = markers::collision_model(run.model, heights.heights_m());

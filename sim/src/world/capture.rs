@@ -19,10 +19,21 @@ pub struct Captured {
     pub revolution: LidarRevolution,
     /// What each return hit (ground truth, for pictures).
     pub owners: Vec<Option<Owner>>,
+    /// The same for each of the other LiDARs' scans (`revolution.more_scans`).
+    pub more_owners: Vec<Vec<Option<Owner>>>,
     /// The true pose it was taken at.
     pub truth: Isometry2<f64>,
     /// Wall time of the casts, seconds.
     pub lidar_s: f64,
+}
+
+/// One of a vehicle's other LiDARs (the sidecar's `extra_lidars`): its name (its frame) and
+/// the sensor.
+pub struct NamedLidar {
+    /// Its frame and topic name.
+    pub name: String,
+    /// The sensor (its mount, beams and noise).
+    pub lidar: Lidar,
 }
 
 /// A scan's points moved from the true pose to the estimated one: where a mapper with a wrong
@@ -43,6 +54,8 @@ pub struct Sensor<'r> {
     pub world: &'r World,
     /// The LiDAR (its mount, beams and noise).
     pub lidar: &'r Lidar,
+    /// The vehicle's other LiDARs, cast in the same world at the same time.
+    pub more: &'r [NamedLidar],
     /// The faults between the sensor and the stack.
     pub faults: &'r FaultsConfig,
     /// The run's seed (the casts' noise and the faults are drawn from it and the index).
@@ -64,34 +77,57 @@ impl Sensor<'_> {
         t_s: f64,
     ) -> Result<Captured> {
         let t0 = Instant::now();
-        let mut taken = self
-            .lidar
-            .scan(self.world, &SweepPoses::still(*truth), index, self.seed);
+        let (scan, owners) = self.take(self.lidar, self.seed, truth, estimate, index)?;
+        let (mut more_scans, mut more_owners) = (Vec::new(), Vec::new());
+        for (k, NamedLidar { lidar, .. }) in self.more.iter().enumerate() {
+            // Each sensor its own noise and faults, reproducible from the run's seed.
+            let seed = self.seed ^ (k as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            let (scan, owners) = self.take(lidar, seed, truth, estimate, index)?;
+            more_scans.push(scan);
+            more_owners.push(owners);
+        }
+        let (covariance, estimate) = (estimate.covariance, &estimate.world_from_vehicle);
+        Ok(Captured {
+            revolution: LidarRevolution {
+                t_s,
+                scan,
+                more_scans,
+                world_from_vehicle_estimate: *estimate,
+                estimate_covariance: covariance,
+            },
+            owners,
+            more_owners,
+            truth: *truth,
+            lidar_s: t0.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// One sensor's scan of revolution `index`, degraded by the faults, where a mapper at
+    /// `estimate` would put it; what each return hit.
+    fn take(
+        &self,
+        lidar: &Lidar,
+        seed: u64,
+        truth: &Isometry2<f64>,
+        estimate: &PoseEstimate,
+        index: u64,
+    ) -> Result<(mapper::Scan, Vec<Option<Owner>>)> {
+        let mut taken = lidar.scan(self.world, &SweepPoses::still(*truth), index, seed);
         if self.faults.any() {
             let mut counts = FaultCounts::default();
-            taken.scan = degrade(&taken.scan, self.faults, self.seed, index, &mut counts)?;
+            taken.scan = degrade(&taken.scan, self.faults, seed, index, &mut counts)?;
             taken.owners.truncate(0);
             self.dropped
                 .fetch_add(counts.dropped_returns, Ordering::Relaxed);
             self.spurious
                 .fetch_add(counts.spurious_returns, Ordering::Relaxed);
         }
-        let (covariance, estimate) = (estimate.covariance, &estimate.world_from_vehicle);
+        let estimate = &estimate.world_from_vehicle;
         let scan = if estimate == truth {
             taken.scan
         } else {
             reexpress(taken.scan, truth, estimate)?
         };
-        Ok(Captured {
-            revolution: LidarRevolution {
-                t_s,
-                scan,
-                world_from_vehicle_estimate: *estimate,
-                estimate_covariance: covariance,
-            },
-            owners: taken.owners,
-            truth: *truth,
-            lidar_s: t0.elapsed().as_secs_f64(),
-        })
+        Ok((scan, taken.owners))
     }
 }

@@ -154,19 +154,41 @@ pub fn low_interval(z0: f64, dz: f64, h: f64, stop: f64) -> Option<(f64, f64)> {
     (z0 >= 0.0 && to >= from).then_some((from, to))
 }
 
-/// The blind zones of `vehicle` with its sidecar's LiDAR under `lidar` (noise and drop-outs are
-/// irrelevant here: only the beams' geometry counts).
+/// The LiDARs `vehicle` carries: its main one (`[lidar]` in the sidecar, frame `velodyne`) as
+/// `main` describes it, then each of the sidecar's `extra_lidars`, `main`'s settings with its
+/// model's beam table, its own sensor unit (range biases).
+pub fn vehicle_lidars(vehicle: &aircraft::Vehicle, main: &LidarConfig) -> Result<Vec<Mounted>> {
+    let mut all = vec![Mounted {
+        name: "velodyne".into(),
+        config: main.clone(),
+        vehicle_from_sensor: vehicle.vehicle_from_lidar(),
+    }];
+    for (k, extra) in vehicle.spec.extra_lidars.iter().enumerate() {
+        let mut config = main.with_model(&extra.model).ok_or_else(|| {
+            Error::Invalid(format!(
+                "vehicle {}: extra_lidars[{k}].model {:?} is not a model the simulator has \
+                 (hdl-32e, vlp-16)",
+                vehicle.spec.name, extra.model
+            ))
+        })?;
+        config.range_bias_unit = main.range_bias_unit.wrapping_add(k as u64 + 1);
+        all.push(Mounted {
+            name: extra.name.clone(),
+            config,
+            vehicle_from_sensor: extra.vehicle_from_lidar(),
+        });
+    }
+    Ok(all)
+}
+
+/// The blind zones of `vehicle` with its sidecar's LiDARs ([`vehicle_lidars`]), the main one
+/// under `lidar` (noise and drop-outs are irrelevant here: only the beams' geometry counts).
 pub fn coverage(
     vehicle: &aircraft::Vehicle,
     lidar: &LidarConfig,
     options: &CoverageOptions,
 ) -> Result<Coverage> {
-    let sidecar = Mounted {
-        name: "sidecar".into(),
-        config: lidar.clone(),
-        vehicle_from_sensor: vehicle.vehicle_from_lidar(),
-    };
-    coverage_of(vehicle, &[sidecar], options)
+    coverage_of(vehicle, &vehicle_lidars(vehicle, lidar)?, options)
 }
 
 /// The blind zones of `vehicle` carrying `sensors`: ground is seen when any of them sees it
@@ -634,5 +656,38 @@ mod tests {
             "{:?}",
             level0.nearest
         );
+    }
+
+    #[test]
+    fn the_two_lidar_praetor_is_the_praetor_with_that_vlp16_and_a_bad_model_is_named() {
+        let options = CoverageOptions {
+            cell_m: 0.2,
+            margin_m: 8.0,
+            low_object_m: 0.7,
+        };
+        let jet = aircraft::Vehicle::load("praetor600").unwrap();
+        let two = aircraft::Vehicle::load("praetor600_two_lidars").unwrap();
+        let sensors = vehicle_lidars(&two, &LidarConfig::default()).unwrap();
+        let names: Vec<&str> = sensors.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(names, ["velodyne", "nose_low"]);
+        assert_eq!(sensors[1].config.channels, 16);
+        // Its own unit: the two sensors' range biases are drawn apart.
+        assert_ne!(sensors[0].config.range_bias_unit, sensors[1].config.range_bias_unit);
+        let low = Mounted {
+            name: "vlp-16".into(),
+            config: LidarConfig::vlp16(),
+            vehicle_from_sensor: nalgebra::Isometry3::translation(11.85, 0.0, 0.5),
+        };
+        let by_hand =
+            coverage_of(&jet, &[vehicle_lidars(&jet, &LidarConfig::default()).unwrap()[0].clone(), low], &options)
+                .unwrap();
+        let shipped = coverage(&two, &LidarConfig::default(), &options).unwrap();
+        for (a, b) in shipped.levels.iter().zip(&by_hand.levels) {
+            assert_eq!(a.blind, b.blind);
+        }
+        let mut odd = two.clone();
+        odd.spec.extra_lidars[0].model = "os1-64".into();
+        let e = vehicle_lidars(&odd, &LidarConfig::default()).unwrap_err().to_string();
+        assert!(e.contains("extra_lidars[0].model") && e.contains("os1-64"), "{e}");
     }
 }

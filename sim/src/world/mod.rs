@@ -15,7 +15,7 @@ mod physics;
 pub mod ply;
 mod scene;
 
-pub use capture::{Captured, Sensor};
+pub use capture::{Captured, NamedLidar, Sensor};
 pub use faults::{FaultCounts, FaultsConfig, LostRevolutions, StaleMap, degrade, stale_scene};
 pub use lidar::{Lidar, LidarConfig, LidarScan, SweepPoses};
 pub use motion::{Bicycle, Command, VehicleState, wrap_angle};

@@ -61,6 +61,7 @@ fn started(mut map: OnlineMap, x_m: f64) -> OnlineMap {
     map.update(&crate::LidarRevolution {
         t_s: 0.0,
         scan: mapper::Scan::new(1, Vec::new(), Vec::new()).unwrap(),
+        more_scans: Vec::new(),
         world_from_vehicle_estimate: nalgebra::Isometry2::translation(x_m, 0.0),
         estimate_covariance: nalgebra::Matrix3::zeros(),
     })
@@ -79,6 +80,7 @@ fn the_vehicle_is_held_until_mapping_has_started() {
     let revolution = |t_s: f64, sigma_rad: f64| crate::LidarRevolution {
         t_s,
         scan: mapper::Scan::new(1, Vec::new(), Vec::new()).unwrap(),
+        more_scans: Vec::new(),
         world_from_vehicle_estimate: nalgebra::Isometry2::translation(10.0, 0.0),
         estimate_covariance: nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(
             0.0025,

@@ -92,6 +92,7 @@ fn revolution(scene: &Scene, truth: &Isometry2<f64>, painted: bool, t_s: f64) ->
     LidarRevolution {
         t_s,
         scan: scan(scene, truth, painted),
+        more_scans: Vec::new(),
         world_from_vehicle_estimate: *truth,
         estimate_covariance: nalgebra::Matrix3::zeros(),
     }

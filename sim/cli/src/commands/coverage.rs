@@ -74,11 +74,8 @@ pub fn run(args: &ModelCoverageArgs) -> anyhow::Result<()> {
         margin_m: args.margin_m,
         low_object_m: args.low_object_m,
     };
-    let mut sensors = vec![sim::world::coverage::Mounted {
-        name: "sidecar".into(),
-        config: sim::scenario::RunConfig::default().lidar,
-        vehicle_from_sensor: vehicle.vehicle_from_lidar(),
-    }];
+    let mut sensors =
+        sim::world::coverage::vehicle_lidars(&vehicle, &sim::scenario::RunConfig::default().lidar)?;
     for spec in &args.sensor {
         sensors.push(mounted(spec)?);
     }

@@ -90,6 +90,19 @@ impl LidarConfig {
         }
     }
 
+    /// This configuration (the run's: its rate, range, noise, drop-outs) with model `name`'s beam
+    /// table and firings instead of its own; `None` for a model not known.
+    pub fn with_model(&self, name: &str) -> Option<Self> {
+        let m = LidarConfig::model(name)?;
+        Some(LidarConfig {
+            channels: m.channels,
+            lower_fov_deg: m.lower_fov_deg,
+            upper_fov_deg: m.upper_fov_deg,
+            columns: m.columns,
+            ..self.clone()
+        })
+    }
+
     /// Checks every field, naming the first wrong one.
     pub fn validate(&self) -> Result<(), String> {
         let bad = |f: &str, why: &str| Err(format!("lidar.{f}: {why}"));
