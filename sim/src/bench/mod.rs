@@ -13,9 +13,11 @@ mod closed_loop;
 mod lidar;
 pub mod localization;
 mod mapper;
+mod sensors;
 mod timing;
 
 pub use closed_loop::loop_figures;
 pub use lidar::{lidar_figures, lidar_scene};
 pub use mapper::mapper_figures;
+pub use sensors::vehicle_figures;
 pub use timing::{Figure, against, alternating, figure, median, median_seconds};

@@ -83,8 +83,8 @@ pub struct ExpectationsSpec {
     /// vehicle calls for a pilot rather than guess it has gone), `waiting_for_walk_around` (it
     /// never moved off: ground it would sweep first is ground its LiDAR cannot see, and no
     /// walk-around confirmed it) or `stopped_for_good` (stopped
-    /// before an obstacle that never goes, timed out or calling for a pilot: waiting for a
-    /// hidden obstacle, or blocked) or `any` (only
+    /// before an obstacle that never goes, or never moved off for one, timed out or calling for
+    /// a pilot: waiting for a hidden obstacle, or blocked) or `any` (only
     /// contacts and the obstacles' expectations count, and an obstacle never passed counts for
     /// nothing: a campaign's randomized obstacles, which may block the way or appear late).
     pub end: Option<ExpectedEnd>,
@@ -185,7 +185,8 @@ pub enum ExpectedEnd {
     /// Never moved off, waiting for a walk-around, calling for a pilot.
     WaitingForWalkAround,
     /// Stopped for good before an obstacle that never goes: the run ends timed out or calling
-    /// for a pilot (waiting for a hidden obstacle, or blocked), the vehicle still standing.
+    /// for a pilot (waiting for a hidden obstacle, or blocked), the vehicle still standing - or
+    /// never having moved off.
     StoppedForGood,
     /// However it ends: only contacts and the obstacles' expectations count.
     Any,

@@ -20,4 +20,5 @@ mod smoke_campaign;
 mod taxi_plan;
 mod traffic;
 mod traffic_judge;
+mod two_lidars;
 mod world_lidar;

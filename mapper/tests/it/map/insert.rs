@@ -325,3 +325,66 @@ fn ret(point: [f64; 3], range_m: f32, intensity: f32) -> mapper::Return {
         intensity,
     }
 }
+
+/// A sensor's self mask drops the returns of the rays that meet the vehicle, at the range they
+/// meet it, and keeps what stands nearer along them: the cone under a "wing" board is mapped, the
+/// board is not - where the circles' test with a margin wide enough for the board hides the
+/// cone with it.
+#[test]
+fn a_self_mask_drops_the_airframe_and_keeps_the_cone_in_front_of_it() {
+    let wing = Solid::Box {
+        min: [4.0, 1.0, 0.9].into(),
+        max: [5.0, 2.0, 1.0].into(),
+    };
+    let on_wing = |p: &nalgebra::Point3<f64>| {
+        (3.95..=5.05).contains(&p.x) && (0.95..=2.05).contains(&p.y) && (0.85..=1.05).contains(&p.z)
+    };
+    // The mask: where each ray of the sensor meets the vehicle alone (the board).
+    let vehicle_only = scan_from(&scene(vec![wing.clone()]), 0.0, 0.0);
+    let ranges: Vec<Option<f64>> = vehicle_only
+        .returns()
+        .iter()
+        .map(|r| r.filter(|r| on_wing(&r.point_in_world)).map(|r| f64::from(r.range_m)))
+        .collect();
+    let mask = mapper::SelfMask::new(vehicle_only.beams(), &ranges, 0.1).unwrap();
+    assert!(mask.rays_on_the_vehicle() > 50, "{}", mask.rays_on_the_vehicle());
+    // Beside the board, 1.5 m from its middle: within the margin below.
+    let cone = Solid::post(4.5, 0.0, 0.1, 0.45);
+    let scan = scan_from(&scene(vec![wing, cone]), 0.0, 0.0);
+    let levels = || Levels::cumulative(vec![0.0, 0.7]).unwrap();
+    let mut masked = MultiHeightMap::new(MapConfig::default(), levels(), Point2::origin()).unwrap();
+    let stats = masked.insert_scan_masked(&scan, None, Some(&mask)).unwrap();
+    assert!(stats.self_hits > 50, "{}", stats.self_hits);
+    assert!(p(&masked, 0, 4.5, 0.0).unwrap() > 0.5, "the cone is mapped");
+    for (x, y) in [(4.1, 1.1), (4.9, 1.9), (4.5, 1.5)] {
+        assert!(
+            p(&masked, 1, x, y).is_none_or(|v| v < 0.5),
+            "the board is not an obstacle at ({x}, {y})"
+        );
+    }
+    // The circles' test (a circle of the ground level, as a gear's) with a margin that covers
+    // the board hides the cone too.
+    let model = CollisionModel::new(
+        vec![Circle {
+            x_m: 4.5,
+            y_m: 1.5,
+            radius_m: 0.5,
+            level: 0,
+        }],
+        vec![0.0, 0.7],
+    )
+    .unwrap();
+    let config = MapConfig {
+        self_hit_margin_m: 1.5,
+        ..Default::default()
+    };
+    let mut circles = MultiHeightMap::new(config, levels(), Point2::origin()).unwrap();
+    circles.insert_scan(&scan, Some(&model)).unwrap();
+    let mut unfiltered = MultiHeightMap::new(MapConfig::default(), levels(), Point2::origin()).unwrap();
+    unfiltered.insert_scan(&scan, None).unwrap();
+    assert!(p(&unfiltered, 1, 4.5, 1.5).unwrap() > 0.5, "unfiltered, the board is an obstacle");
+    assert!(p(&circles, 0, 4.5, 0.0).is_none_or(|v| v < 0.5), "hidden by the margin");
+    // A mask made for another sensor is refused.
+    let other = mapper::SelfMask::new(16, &vec![None; 16 * 10], 0.1).unwrap();
+    assert!(masked.insert_scan_masked(&scan, None, Some(&other)).is_err());
+}

@@ -26,6 +26,12 @@ pub struct BenchArgs {
     /// the parking lot, the aerodrome, the low bridge, the footbridge and the parked jet).
     #[arg(long)]
     pub scenario: Vec<PathBuf>,
+    /// `bench loop`: the scenario with this vehicle (a shipped name or a sidecar) against its
+    /// own, in alternation, instead of the two schedules - what another sensor layout costs
+    /// (e.g. `--scenario scenarios/jet_moves_off_after_the_walk_around.toml --vehicle
+    /// praetor600_two_lidars`).
+    #[arg(long, value_name = "NAME|SIDECAR")]
+    pub vehicle: Option<String>,
     /// Laps of `bench loop` (default 1; 0: the scenario's own).
     #[arg(long, default_value_t = 1)]
     pub laps: u32,
@@ -133,7 +139,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         args.what,
         args.json,
         args.samples,
-        (&scenario, args.laps),
+        (&scenario, args.laps, args.vehicle.as_deref()),
         &campaign,
     )
 }
@@ -142,7 +148,7 @@ fn bench(
     what: BenchTarget,
     json: bool,
     samples: Option<usize>,
-    (scenario, laps): (&std::path::Path, u32),
+    (scenario, laps, vehicle): (&std::path::Path, u32, Option<&str>),
     campaign: &sim::bench::campaign::CampaignBench<'_>,
 ) -> anyhow::Result<()> {
     let progress = ProgressBar::new_spinner();
@@ -150,9 +156,12 @@ fn bench(
     let figures = match what {
         BenchTarget::Mapper => sim::bench::mapper_figures(samples.unwrap_or(15), &mut report),
         BenchTarget::Lidar => sim::bench::lidar_figures(samples.unwrap_or(15), &mut report)?,
-        BenchTarget::Loop => {
-            sim::bench::loop_figures(scenario, laps, samples.unwrap_or(1), &mut report)?
-        }
+        BenchTarget::Loop => match vehicle {
+            Some(v) => {
+                sim::bench::vehicle_figures(scenario, v, laps, samples.unwrap_or(1), &mut report)?
+            }
+            None => sim::bench::loop_figures(scenario, laps, samples.unwrap_or(1), &mut report)?,
+        },
         BenchTarget::Campaign => sim::bench::campaign::campaign_figures(campaign, &mut report)?,
         BenchTarget::Blocks => sim::bench::blocks::figures_for(scenario, &mut report)?,
         BenchTarget::Localization => {

@@ -350,7 +350,7 @@ impl Judge {
                 matches!(
                     end,
                     EndReason::TimedOut | EndReason::WaitingForHiddenObstacle | EndReason::Blocked
-                ) && self.stops.last().is_some_and(|s| s.end_s.is_none())
+                ) && (self.stops.last().is_some_and(|s| s.end_s.is_none()) || !self.started)
             }
         };
         let contacts_at_fault = self.contacts.iter().filter(|c| c.at_fault).count();
