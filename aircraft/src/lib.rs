@@ -30,5 +30,7 @@ pub use error::{Error, Result};
 pub use fit::{DEFAULT_MAX_OVERSHOOT_M, FitOptions, FittedModel, LevelFootprint, fit_parts};
 pub use report::{LevelReport, evaluate};
 pub use shapes::{Part, Shape};
-pub use spec::{DEFAULT_OVERHEAD_CLEARANCE_M, ExtraLidar, LidarMount, MotionLimits, Steering, VehicleSpec};
+pub use spec::{
+    DEFAULT_OVERHEAD_CLEARANCE_M, ExtraLidar, LidarMount, MotionLimits, Steering, VehicleSpec,
+};
 pub use vehicle::{SHIPPED_VEHICLES, Vehicle};

@@ -132,7 +132,10 @@ fn check_extra_lidars(lidars: &[ExtraLidar]) -> std::result::Result<(), (String,
             return Err((at("name"), format!("{:?} names two LiDARs", l.name)));
         }
         if l.model.trim().is_empty() {
-            return Err((at("model"), "empty: say which model (hdl-32e, vlp-16)".into()));
+            return Err((
+                at("model"),
+                "empty: say which model (hdl-32e, vlp-16)".into(),
+            ));
         }
         if l.xyz_m.iter().chain(&l.rpy_rad).any(|v| !v.is_finite()) {
             return Err((at("xyz_m"), "every value must be finite".into()));

@@ -31,7 +31,10 @@ impl SelfMask {
         if beams == 0 || !ranges_m.len().is_multiple_of(beams) {
             return Err(MapError::invalid(
                 "self mask",
-                format!("{} rays are not whole columns of {beams} beams", ranges_m.len()),
+                format!(
+                    "{} rays are not whole columns of {beams} beams",
+                    ranges_m.len()
+                ),
             ));
         }
         if !(tolerance_m.is_finite() && tolerance_m >= 0.0) {
@@ -101,10 +104,16 @@ mod tests {
         // Two columns of two beams: ray 1 meets the vehicle at 3 m, ray 2 at 1.5 m.
         let mask = SelfMask::new(2, &[None, Some(3.0), Some(1.5), None], 0.1).unwrap();
         assert_eq!(mask.rays_on_the_vehicle(), 2);
-        assert!(!mask.is_self_hit(0, 0, 50.0), "a ray that misses the vehicle");
+        assert!(
+            !mask.is_self_hit(0, 0, 50.0),
+            "a ray that misses the vehicle"
+        );
         assert!(mask.is_self_hit(0, 1, 3.0));
         assert!(mask.is_self_hit(0, 1, 2.95), "within the tolerance");
-        assert!(!mask.is_self_hit(0, 1, 2.85), "a cone 0.15 m short of the airframe");
+        assert!(
+            !mask.is_self_hit(0, 1, 2.85),
+            "a cone 0.15 m short of the airframe"
+        );
         assert!(mask.is_self_hit(1, 0, 1.6), "beyond it (noise)");
         assert!(!mask.is_self_hit(1, 0, 0.9));
         assert!(!mask.is_self_hit(5, 0, 1.0), "a ray it does not know");

@@ -273,9 +273,7 @@ impl MultiHeightMap {
                         far += 1;
                         continue;
                     };
-                    let masked = mask.is_some_and(|m| {
-                        m.is_self_hit(c, b, (p - sensor3).norm())
-                    });
+                    let masked = mask.is_some_and(|m| m.is_self_hit(c, b, (p - sensor3).norm()));
                     if masked
                         || self_filter.is_some_and(|filter| {
                             filter.is_self_hit(&(vehicle_from_world * xy), height)

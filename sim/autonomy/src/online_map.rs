@@ -67,6 +67,11 @@ pub struct OnlineMap {
     started: bool,
 }
 
+/// The cells a revolution hit, each with the levels it was hit in (bit `l`: level `l`).
+type LevelHits = Vec<(WorldCell, u32)>;
+/// The cells a revolution hit with an open top, and how high it may reach unseen, metres.
+type OpenTops = Vec<(WorldCell, f32)>;
+
 /// How far from the sensor the returns of a revolution taken at an estimate of covariance `c`
 /// (x, y, heading) are placed within `max_error_m`: out to where the estimate's 2-sigma error -
 /// its position's (largest axis) and its heading's times the range, added in quadrature -
@@ -183,7 +188,7 @@ impl OnlineMap {
     fn insert_every_sensor(
         &mut self,
         revolution: &LidarRevolution,
-    ) -> Result<(Vec<(WorldCell, u32)>, Vec<(WorldCell, f32)>), mapper::MapError> {
+    ) -> Result<(LevelHits, OpenTops), mapper::MapError> {
         self.map
             .insert_scan(&revolution.scan, Some(&self.self_filter))?;
         let mut hits = self.map.last_scan_hits_by_level();

@@ -25,7 +25,9 @@ pub fn vehicle_figures(
         let mut map_dir = crate::offline_map::default_map_dir(s, &config);
         if k == 1 {
             // Its own directory: a map's manifest names the vehicle it was built for.
-            let name = map_dir.file_name().map(|n| n.to_string_lossy().into_owned());
+            let name = map_dir
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned());
             map_dir.set_file_name(format!(
                 "{}-{}",
                 name.unwrap_or_default(),
@@ -47,7 +49,10 @@ pub fn vehicle_figures(
     let samples = samples.max(1);
     let (mut a, mut b) = (Vec::new(), Vec::new());
     for k in 0..samples {
-        progress(&format!("closed loop {} of {samples}, its own vehicle", k + 1));
+        progress(&format!(
+            "closed loop {} of {samples}, its own vehicle",
+            k + 1
+        ));
         a.push(crate::engine::run(&own, &setups[0])?);
         progress(&format!("closed loop {} of {samples}, {vehicle}", k + 1));
         b.push(crate::engine::run(&other, &setups[1])?);
@@ -93,7 +98,12 @@ pub fn vehicle_figures(
             ("lidar_per_scan", r.time_split_s.lidar),
             ("mapping_per_scan", r.time_split_s.mapping),
         ] {
-            out.push(super::timing::figure(&name(who, what), seconds / scans, "ms", None));
+            out.push(super::timing::figure(
+                &name(who, what),
+                seconds / scans,
+                "ms",
+                None,
+            ));
         }
     }
     Ok(out)

@@ -520,7 +520,11 @@ pub(super) fn self_masks(
                 .map(|(_, t)| t)
                 .collect();
             let beams = l.lidar.elevations_rad().len();
-            Ok(mapper::SelfMask::new(beams, &ranges, SELF_MASK_TOLERANCE_M)?)
+            Ok(mapper::SelfMask::new(
+                beams,
+                &ranges,
+                SELF_MASK_TOLERANCE_M,
+            )?)
         })
         .collect()
 }
@@ -533,12 +537,11 @@ pub(super) fn lidars(
 ) -> Result<(Lidar, Vec<crate::world::NamedLidar>)> {
     let mut all = Vec::new();
     for m in crate::world::coverage::vehicle_lidars(vehicle, &config.lidar)? {
-        let lidar = Lidar::new(m.config, m.vehicle_from_sensor).map_err(|message| {
-            Error::Config {
+        let lidar =
+            Lidar::new(m.config, m.vehicle_from_sensor).map_err(|message| Error::Config {
                 origin: format!("lidar {}", m.name),
                 message,
-            }
-        })?;
+            })?;
         all.push(crate::world::NamedLidar {
             name: m.name,
             lidar,

@@ -264,12 +264,7 @@ impl Observer for Replay {
     }
 
     fn sensed(&mut self, frame: &SensedFrame<'_>) -> Result<()> {
-        self.log_revolution_points(
-            frame.t_s,
-            frame.revolution,
-            frame.owners,
-            frame.more_owners,
-        )?;
+        self.log_revolution_points(frame.t_s, frame.revolution, frame.owners, frame.more_owners)?;
         Ok(())
     }
 

@@ -672,22 +672,36 @@ mod tests {
         assert_eq!(names, ["velodyne", "nose_low"]);
         assert_eq!(sensors[1].config.channels, 16);
         // Its own unit: the two sensors' range biases are drawn apart.
-        assert_ne!(sensors[0].config.range_bias_unit, sensors[1].config.range_bias_unit);
+        assert_ne!(
+            sensors[0].config.range_bias_unit,
+            sensors[1].config.range_bias_unit
+        );
         let low = Mounted {
             name: "vlp-16".into(),
             config: LidarConfig::vlp16(),
             vehicle_from_sensor: nalgebra::Isometry3::translation(11.85, 0.0, 0.5),
         };
-        let by_hand =
-            coverage_of(&jet, &[vehicle_lidars(&jet, &LidarConfig::default()).unwrap()[0].clone(), low], &options)
-                .unwrap();
+        let by_hand = coverage_of(
+            &jet,
+            &[
+                vehicle_lidars(&jet, &LidarConfig::default()).unwrap()[0].clone(),
+                low,
+            ],
+            &options,
+        )
+        .unwrap();
         let shipped = coverage(&two, &LidarConfig::default(), &options).unwrap();
         for (a, b) in shipped.levels.iter().zip(&by_hand.levels) {
             assert_eq!(a.blind, b.blind);
         }
         let mut odd = two.clone();
         odd.spec.extra_lidars[0].model = "os1-64".into();
-        let e = vehicle_lidars(&odd, &LidarConfig::default()).unwrap_err().to_string();
-        assert!(e.contains("extra_lidars[0].model") && e.contains("os1-64"), "{e}");
+        let e = vehicle_lidars(&odd, &LidarConfig::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("extra_lidars[0].model") && e.contains("os1-64"),
+            "{e}"
+        );
     }
 }

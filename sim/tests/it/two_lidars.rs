@@ -22,8 +22,12 @@ struct Seen {
 
 impl Observer for Seen {
     fn revolution(&mut self, frame: &RevolutionFrame<'_>) -> sim::error::Result<()> {
-        let on_cone =
-            |owners: &[Option<Owner>]| owners.iter().filter(|o| **o == Some(Owner::Object(self.cone))).count();
+        let on_cone = |owners: &[Option<Owner>]| {
+            owners
+                .iter()
+                .filter(|o| **o == Some(Owner::Object(self.cone)))
+                .count()
+        };
         let low = &frame.revolution.more_scans[0];
         self.revolutions.push((
             frame.revolution.scans().count(),
@@ -79,7 +83,10 @@ fn a_second_lidar_is_cast_mapped_and_recorded_in_its_own_frame() {
         // The cone 1.15 m ahead of both sensors: under every beam of the nose one, in front of
         // the low one.
         assert_eq!(main_on_cone, 0);
-        assert!(low_on_cone > 20, "{low_on_cone} returns of the low LiDAR on the cone");
+        assert!(
+            low_on_cone > 20,
+            "{low_on_cone} returns of the low LiDAR on the cone"
+        );
     }
     // The bag: each sensor's cloud on its own topic, as many as revolutions, in its own frame.
     let bytes = std::fs::read(&file).unwrap();
@@ -111,5 +118,8 @@ fn a_second_lidar_is_cast_mapped_and_recorded_in_its_own_frame() {
         .err()
         .expect("refused")
         .to_string();
-    assert!(e.contains("praetor600_two_lidars") && e.contains("2 LiDARs"), "{e}");
+    assert!(
+        e.contains("praetor600_two_lidars") && e.contains("2 LiDARs"),
+        "{e}"
+    );
 }

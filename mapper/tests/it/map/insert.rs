@@ -340,14 +340,21 @@ fn a_self_mask_drops_the_airframe_and_keeps_the_cone_in_front_of_it() {
         (3.95..=5.05).contains(&p.x) && (0.95..=2.05).contains(&p.y) && (0.85..=1.05).contains(&p.z)
     };
     // The mask: where each ray of the sensor meets the vehicle alone (the board).
-    let vehicle_only = scan_from(&scene(vec![wing.clone()]), 0.0, 0.0);
+    let vehicle_only = scan_from(&scene(vec![wing]), 0.0, 0.0);
     let ranges: Vec<Option<f64>> = vehicle_only
         .returns()
         .iter()
-        .map(|r| r.filter(|r| on_wing(&r.point_in_world)).map(|r| f64::from(r.range_m)))
+        .map(|r| {
+            r.filter(|r| on_wing(&r.point_in_world))
+                .map(|r| f64::from(r.range_m))
+        })
         .collect();
     let mask = mapper::SelfMask::new(vehicle_only.beams(), &ranges, 0.1).unwrap();
-    assert!(mask.rays_on_the_vehicle() > 50, "{}", mask.rays_on_the_vehicle());
+    assert!(
+        mask.rays_on_the_vehicle() > 50,
+        "{}",
+        mask.rays_on_the_vehicle()
+    );
     // Beside the board, 1.5 m from its middle: within the margin below.
     let cone = Solid::post(4.5, 0.0, 0.1, 0.45);
     let scan = scan_from(&scene(vec![wing, cone]), 0.0, 0.0);
@@ -380,11 +387,22 @@ fn a_self_mask_drops_the_airframe_and_keeps_the_cone_in_front_of_it() {
     };
     let mut circles = MultiHeightMap::new(config, levels(), Point2::origin()).unwrap();
     circles.insert_scan(&scan, Some(&model)).unwrap();
-    let mut unfiltered = MultiHeightMap::new(MapConfig::default(), levels(), Point2::origin()).unwrap();
+    let mut unfiltered =
+        MultiHeightMap::new(MapConfig::default(), levels(), Point2::origin()).unwrap();
     unfiltered.insert_scan(&scan, None).unwrap();
-    assert!(p(&unfiltered, 1, 4.5, 1.5).unwrap() > 0.5, "unfiltered, the board is an obstacle");
-    assert!(p(&circles, 0, 4.5, 0.0).is_none_or(|v| v < 0.5), "hidden by the margin");
+    assert!(
+        p(&unfiltered, 1, 4.5, 1.5).unwrap() > 0.5,
+        "unfiltered, the board is an obstacle"
+    );
+    assert!(
+        p(&circles, 0, 4.5, 0.0).is_none_or(|v| v < 0.5),
+        "hidden by the margin"
+    );
     // A mask made for another sensor is refused.
     let other = mapper::SelfMask::new(16, &vec![None; 16 * 10], 0.1).unwrap();
-    assert!(masked.insert_scan_masked(&scan, None, Some(&other)).is_err());
+    assert!(
+        masked
+            .insert_scan_masked(&scan, None, Some(&other))
+            .is_err()
+    );
 }
