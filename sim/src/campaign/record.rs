@@ -117,6 +117,14 @@ pub struct RunRecord {
     /// What injected faults did (`[faults]` of the run configuration).
     #[serde(default)]
     pub faults: crate::world::FaultCounts,
+    /// The pilot call that ended the run, as `call/hold` (`blocked/mover`,
+    /// `hidden_obstacle/lost_obstacle`, `walk_around/unseen_ground`, ...; see
+    /// `engine::PilotCallReport`).
+    #[serde(default)]
+    pub pilot_call: Option<String>,
+    /// That call was needless: ground truth had no object near what held the vehicle.
+    #[serde(default)]
+    pub needless_pilot_call: bool,
 }
 
 impl RunRecord {
@@ -320,6 +328,14 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
         score,
         failure_file: failed.then(|| format!("failures/{}.toml", v.index)),
         faults: r.faults,
+        pilot_call: r.pilot_call.as_ref().map(|c| {
+            format!(
+                "{}/{}",
+                c.call,
+                c.hold.as_ref().map_or("none", |h| h.name())
+            )
+        }),
+        needless_pilot_call: r.pilot_call.as_ref().is_some_and(|c| c.needless),
     }
 }
 
@@ -362,6 +378,8 @@ pub(super) fn invalid(campaign: &Campaign, v: &Variant, why: &str) -> RunRecord 
         score: 10.0,
         failure_file: None,
         faults: Default::default(),
+        pilot_call: None,
+        needless_pilot_call: false,
     }
 }
 

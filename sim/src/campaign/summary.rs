@@ -118,6 +118,7 @@ pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
             m(laps.last().copied()),
         );
     }
+    s += &pilot_calls(records);
     if get("sampler") == "falsify" {
         s += &generations(meta, records);
     }
@@ -241,4 +242,32 @@ pub fn chart(dir: &Path, title: &str, records: &[RunRecord]) -> Result<()> {
         path,
         source,
     })
+}
+
+/// The pilot calls by cause (the rule that called / what held the vehicle), with the needless
+/// ones: those where ground truth had no object near what held it.
+fn pilot_calls(records: &[RunRecord]) -> String {
+    let mut by_cause: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
+    for r in records {
+        if let Some(cause) = &r.pilot_call {
+            let e = by_cause.entry(cause.as_str()).or_default();
+            e.0 += 1;
+            e.1 += usize::from(r.needless_pilot_call);
+        }
+    }
+    let calls: usize = by_cause.values().map(|c| c.0).sum();
+    let needless: usize = by_cause.values().map(|c| c.1).sum();
+    let mut s = format!(
+        "\n## Pilot calls\n\n{calls} of {} runs ended with a pilot call, {needless} of them needless (no object within {} m of what held the vehicle in the last {} s).\n",
+        records.len(),
+        crate::engine::REAL_WITHIN_M,
+        crate::engine::NEEDLESS_WINDOW_S
+    );
+    if calls > 0 {
+        s += "\n| call / what held it | calls | needless |\n|---|---|---|\n";
+        for (cause, (n, k)) in by_cause {
+            let _ = writeln!(s, "| {cause} | {n} | {k} |");
+        }
+    }
+    s
 }

@@ -36,15 +36,10 @@ impl Rig<'_> {
             if self.t_s > self.timeout_s {
                 return Ok(EndReason::TimedOut);
             }
-            if self.external.is_none() {
-                match self.driver.calls_for_pilot(self.t_s) {
-                    Some(PilotCall::HiddenObstacle) => {
-                        return Ok(EndReason::WaitingForHiddenObstacle);
-                    }
-                    Some(PilotCall::Blocked) => return Ok(EndReason::Blocked),
-                    Some(PilotCall::WalkAround) => return Ok(EndReason::WaitingForWalkAround),
-                    None => {}
-                }
+            if self.external.is_none()
+                && let Some(end) = self.pilot_called()
+            {
+                return Ok(end);
             }
             if let Some(at_s) = self.walk_around_at_s
                 && self.t_s >= at_s
@@ -115,6 +110,20 @@ impl Rig<'_> {
             }
         }
         Ok(EndReason::Completed)
+    }
+
+    /// Whether the shipped stack calls its pilot now, noting what holds the vehicle first: the
+    /// run's end, with the call's report kept.
+    fn pilot_called(&mut self) -> Option<EndReason> {
+        self.holds.note(self.t_s, self.driver.status());
+        let call = self.driver.calls_for_pilot(self.t_s)?;
+        let unseen = self.driver.start_unseen_cells().map(|(cells, _)| cells);
+        self.pilot_call = Some(self.holds.report(self.t_s, call, &self.world, unseen));
+        Some(match call {
+            PilotCall::HiddenObstacle => EndReason::WaitingForHiddenObstacle,
+            PilotCall::Blocked => EndReason::Blocked,
+            PilotCall::WalkAround => EndReason::WaitingForWalkAround,
+        })
     }
 
     /// The shipped stack's part of a step: a revolution when one is due, the late ones

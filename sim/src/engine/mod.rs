@@ -16,6 +16,7 @@ mod judge;
 mod node;
 mod observer;
 mod outcome;
+mod pilot_call;
 mod pose_error;
 mod pose_source;
 mod report;
@@ -38,6 +39,7 @@ pub use observer::{
 pub use outcome::{
     AT_FAULT_SPEED_M_S, EndReason, Event, JudgedContact, ObstacleReport, Pass, PassOutcome, Stop,
 };
+pub use pilot_call::{Hold, NEEDLESS_WINDOW_S, PilotCallReport, REAL_WITHIN_M};
 pub use pose_error::{
     ErrorLog, ErrorStats, LocalizationErrors, LocalizationReport, localization_misses,
 };

@@ -28,6 +28,10 @@ pub struct RunReport {
     /// square metres (0: none; the vehicle moved off at once).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub start_unseen_m2: Option<f64>,
+    /// The pilot call that ended the run, with what held the vehicle and whether anything was
+    /// really there ([`super::PilotCallReport`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pilot_call: Option<super::PilotCallReport>,
     /// What the stack outside the process did, when one drove ([`super::run_external`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stack: Option<super::external::StackReport>,

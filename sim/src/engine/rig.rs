@@ -223,6 +223,10 @@ pub(super) struct Rig<'a> {
     pub(super) walk_around_at_s: Option<f64>,
     /// Whether the observer has been told of the ground the start-up rule found unseen.
     pub(super) start_unseen_told: bool,
+    /// What held the vehicle in the last seconds, for the pilot call's report.
+    pub(super) holds: super::pilot_call::HoldLog,
+    /// The pilot call that ended the run, if one did.
+    pub(super) pilot_call: Option<super::PilotCallReport>,
     /// A stack outside the process driving the vehicle instead of `driver`, if any.
     pub(super) external: Option<External<'a>>,
     /// The live map's scratch directory, removed with the rig.
@@ -340,6 +344,8 @@ impl<'a> Rig<'a> {
                 _ => None,
             },
             start_unseen_told: false,
+            holds: Default::default(),
+            pilot_call: None,
             config,
             external: None,
             _live: live,
@@ -407,6 +413,7 @@ impl<'a> Rig<'a> {
             end,
             waiting_for,
             start_unseen_m2: self.driver.start_unseen_m2(),
+            pilot_call: self.pilot_call.take(),
             stack: self.external.as_ref().map(|e| StackReport {
                 stale: e.stack.stale(),
                 ..e.report.clone()

@@ -425,6 +425,22 @@ impl World {
             .min_by(|a, b| a.1.total_cmp(&b.1))
     }
 
+    /// Ground truth now: the object present nearest the vertical line through `p` (x, y; the
+    /// point at the object's own height) and that distance, metres; `None` without objects.
+    pub fn nearest_object_to(&self, p: &nalgebra::Point2<f64>) -> Option<(usize, f64)> {
+        (0..self.objects.len())
+            .filter(|&i| self.object_active(i))
+            .filter_map(|i| {
+                let c = self.physics.colliders.get(self.objects[i])?;
+                let aabb = c.compute_aabb();
+                let z = (aabb.mins.z + aabb.maxs.z) * 0.5;
+                let point = Vector::new(p.x as f32, p.y as f32, z);
+                let d = c.shape().distance_to_point(c.position(), point, true);
+                Some((i, f64::from(d)))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
     /// Ground truth at the current pose: how deep the vehicle's deepest touching part is inside
     /// an object, metres (parry's contact; 0 when nothing touches or they only graze).
     pub fn deepest_penetration_m(&self) -> f64 {

@@ -11,5 +11,6 @@ mod found;
 mod localization;
 mod overhead;
 mod permanence;
+mod pilot_calls;
 mod regress;
 mod traffic;

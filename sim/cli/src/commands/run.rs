@@ -447,6 +447,7 @@ pub fn table(r: &RunReport) -> String {
                 ))
         );
     }
+    pilot_call_line(&mut t, r);
     obstacle_rows(&mut t, r);
     closest_static_row(&mut t, r);
     for (k, c) in r.contacts.iter().enumerate() {
@@ -550,4 +551,32 @@ fn obstacle_rows(t: &mut String, r: &RunReport) {
             );
         }
     }
+}
+
+/// Why the pilot was called, and whether anything was really there.
+fn pilot_call_line(t: &mut String, r: &RunReport) {
+    use std::fmt::Write as _;
+    let Some(c) = &r.pilot_call else {
+        return;
+    };
+    let held = match (&c.hold, c.at_m) {
+        (Some(h), Some([x, y])) => format!("{} at ({x:.1}, {y:.1}) m", h.name().replace('_', " ")),
+        (Some(h), None) => h.name().replace('_', " "),
+        (None, _) => "nothing it named".to_string(),
+    };
+    let truth = match &c.nearest_object {
+        Some((id, d)) => format!("nearest object {id} {d:.2} m"),
+        None => "no object".to_string(),
+    };
+    let _ = writeln!(
+        t,
+        "pilot call at {:.1} s ({}): held by {held}; ground truth: {truth} - {}",
+        c.t_s,
+        c.call.replace('_', " "),
+        if c.needless {
+            "needless"
+        } else {
+            "something was there"
+        }
+    );
 }

@@ -1,0 +1,153 @@
+//! Why a pilot was called, as data: what held the vehicle in the seconds before the call, as the
+//! stack believed it (an obstacle it saw, one it lost from view, a mover it yielded to, ground it
+//! never saw), and - from ground truth, for the judge only - whether anything was really there.
+//! A call is **needless** when no object stood near any point that held the vehicle in the last
+//! [`NEEDLESS_WINDOW_S`] seconds.
+
+use std::collections::VecDeque;
+
+use autonomy::{DriverStatus, PilotCall};
+use nalgebra::Point2;
+use serde::Serialize;
+
+use crate::world::World;
+
+/// How far back before a call the points that held the vehicle are judged, seconds.
+pub const NEEDLESS_WINDOW_S: f64 = 3.0;
+
+/// How near a point that held the vehicle an object must be for the hold to count as real,
+/// metres: a map cell (0.2 m), the estimate's error and a mover's prediction error.
+pub const REAL_WITHIN_M: f64 = 1.0;
+
+/// What held the vehicle, as the stack believed it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum Hold {
+    /// An obstacle the sensor hit lately, in the path.
+    Obstacle {
+        /// When a revolution last hit it, seconds.
+        last_seen_s: f64,
+    },
+    /// An obstacle in the path no revolution has hit for a while (hidden by the airframe, or
+    /// only in the offline map).
+    LostObstacle {
+        /// When a revolution last hit it, if ever, seconds.
+        last_seen_s: Option<f64>,
+    },
+    /// A mover predicted to cross the path, yielded to.
+    Mover {
+        /// Its track id.
+        track_id: u32,
+    },
+    /// Ground the first plan sweeps that no sensor has seen (the start-up rule).
+    UnseenGround {
+        /// Its area, square metres.
+        unseen_m2: f64,
+    },
+}
+
+impl Hold {
+    /// What held the vehicle at `status`, and where; `None` when it was driving.
+    pub fn of(status: DriverStatus) -> Option<(Hold, Option<Point2<f64>>)> {
+        match status {
+            DriverStatus::Driving => None,
+            DriverStatus::StoppedFor {
+                obstacle,
+                last_seen_s,
+            } => Some((Hold::Obstacle { last_seen_s }, Some(obstacle))),
+            DriverStatus::WaitingForHiddenObstacle {
+                obstacle,
+                last_seen_s,
+                ..
+            } => Some((Hold::LostObstacle { last_seen_s }, Some(obstacle))),
+            DriverStatus::Yielding { track_id, mover_at } => {
+                Some((Hold::Mover { track_id }, Some(mover_at)))
+            }
+            DriverStatus::WaitingForWalkAround { unseen_m2, .. } => {
+                Some((Hold::UnseenGround { unseen_m2 }, None))
+            }
+        }
+    }
+
+    /// A short name for tables: `obstacle`, `lost_obstacle`, `mover`, `unseen_ground`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Hold::Obstacle { .. } => "obstacle",
+            Hold::LostObstacle { .. } => "lost_obstacle",
+            Hold::Mover { .. } => "mover",
+            Hold::UnseenGround { .. } => "unseen_ground",
+        }
+    }
+}
+
+/// A pilot call, with why.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PilotCallReport {
+    /// When, seconds.
+    pub t_s: f64,
+    /// Which rule called: `hidden_obstacle`, `blocked` or `walk_around`.
+    pub call: &'static str,
+    /// What held the vehicle last before the call, as the stack believed it (`None`: it was not
+    /// held by anything it could name - blocked while driving slowly).
+    pub hold: Option<Hold>,
+    /// Where that was, metres.
+    pub at_m: Option<[f64; 2]>,
+    /// Ground truth, for the judge: the object nearest any point that held the vehicle in the
+    /// last [`NEEDLESS_WINDOW_S`] s (for unseen ground: any cell of it), and how far, metres.
+    pub nearest_object: Option<(String, f64)>,
+    /// Nothing stood within [`REAL_WITHIN_M`] of any of them: the call was needless.
+    pub needless: bool,
+}
+
+/// The points that held the vehicle, step by step, for the last few seconds.
+#[derive(Default)]
+pub(super) struct HoldLog {
+    held: VecDeque<(f64, Hold, Option<Point2<f64>>)>,
+}
+
+impl HoldLog {
+    /// Notes the driver's status at `t_s`, forgetting what is older than the window.
+    pub(super) fn note(&mut self, t_s: f64, status: DriverStatus) {
+        if let Some((hold, at)) = Hold::of(status) {
+            self.held.push_back((t_s, hold, at));
+        }
+        while self
+            .held
+            .front()
+            .is_some_and(|(t, ..)| *t < t_s - NEEDLESS_WINDOW_S)
+        {
+            self.held.pop_front();
+        }
+    }
+
+    /// The call at `t_s`, judged against `world` (`unseen`: the start-up rule's unseen cells).
+    pub(super) fn report(
+        &self,
+        t_s: f64,
+        call: PilotCall,
+        world: &World,
+        unseen: Option<&[Point2<f64>]>,
+    ) -> PilotCallReport {
+        let last = self.held.back();
+        let mut points: Vec<Point2<f64>> = self.held.iter().filter_map(|(_, _, p)| *p).collect();
+        if matches!(call, PilotCall::WalkAround) {
+            points.extend(unseen.unwrap_or_default());
+        }
+        let nearest = points
+            .iter()
+            .filter_map(|p| world.nearest_object_to(p))
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        PilotCallReport {
+            t_s,
+            call: match call {
+                PilotCall::HiddenObstacle => "hidden_obstacle",
+                PilotCall::Blocked => "blocked",
+                PilotCall::WalkAround => "walk_around",
+            },
+            hold: last.map(|(_, h, _)| *h),
+            at_m: last.and_then(|(_, _, p)| p.map(|p| [p.x, p.y])),
+            needless: nearest.is_none_or(|(_, d)| d > REAL_WITHIN_M),
+            nearest_object: nearest.map(|(i, d)| (world.scene().solids[i].id.clone(), d)),
+        }
+    }
+}

@@ -1,0 +1,64 @@
+//! Every pilot call says why, as data (`RunReport::pilot_call`): the rule that called, what held
+//! the vehicle as the stack believed it and where, and - from ground truth - whether an object
+//! stood there. A phantom that holds the car is a needless call; the cone a low LiDAR stops the
+//! jet for, and the cone under the nose of a jet without a walk-around, are not.
+
+use std::path::PathBuf;
+
+use sim::engine::Hold;
+use sim::scenario::{RunConfig, Scenario};
+
+fn file(path: &str) -> Scenario {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path);
+    Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn run(s: &Scenario) -> sim::engine::RunReport {
+    crate::common::run_with(s, RunConfig::for_scenario(s, None).unwrap())
+}
+
+#[test]
+fn a_phantom_that_holds_the_car_is_a_needless_pilot_call() {
+    let s = file("found/degraded_lidar_phantom_at_the_start_holds_the_car.toml");
+    let r = run(&s);
+    let call = r.pilot_call.expect("a pilot call");
+    assert_eq!(call.call, "hidden_obstacle");
+    assert!(
+        matches!(call.hold, Some(Hold::LostObstacle { .. })),
+        "{call:?}"
+    );
+    let [x, _] = call.at_m.unwrap();
+    assert!(x < 12.0, "held near its start: {call:?}");
+    // Nothing within a metre of where the car believed it was: the nearest object is a lamp.
+    assert!(call.needless, "{call:?}");
+    assert!(
+        call.nearest_object.as_ref().is_some_and(|(_, d)| *d > 5.0),
+        "{call:?}"
+    );
+}
+
+#[test]
+fn a_cone_seen_in_the_path_or_in_the_unseen_ground_makes_a_call_that_was_needed() {
+    let s = file("../scenarios/jet_with_a_low_lidar_sees_the_cone_at_its_nose.toml");
+    let call = run(&s).pilot_call.expect("a pilot call");
+    assert_eq!(call.call, "blocked");
+    assert!(matches!(call.hold, Some(Hold::Obstacle { .. })), "{call:?}");
+    let (id, d) = call.nearest_object.clone().unwrap();
+    assert_eq!(id, "cone_left_at_the_nose");
+    assert!(d < 0.3 && !call.needless, "{call:?}");
+    let s = file("../scenarios/jet_waits_for_a_walk_around.toml");
+    let call = run(&s).pilot_call.expect("a pilot call");
+    assert_eq!(call.call, "walk_around");
+    assert!(matches!(call.hold, Some(Hold::UnseenGround { unseen_m2 }) if unseen_m2 > 10.0));
+    assert_eq!(
+        call.nearest_object.as_ref().map(|o| o.0.as_str()),
+        Some("cone_left_at_the_nose")
+    );
+    assert!(!call.needless);
+    // The same stand without the cone: the wait was needless.
+    let mut empty = s.clone();
+    empty.obstacles.clear();
+    let call = run(&empty).pilot_call.expect("a pilot call");
+    assert_eq!(call.call, "walk_around");
+    assert!(call.needless, "{call:?}");
+}
