@@ -167,6 +167,8 @@ pub struct LightObject {
 pub struct Stand {
     /// Its name (`Gate 1 South A`).
     pub name: String,
+    /// Its row's line in the file.
+    pub line: usize,
     /// Where the parked aircraft's reference point is.
     pub at: Vector2<f64>,
     /// The parked aircraft's heading in the local frame (rad from east).
@@ -334,6 +336,7 @@ impl Airport {
                 .iter()
                 .map(|s| Stand {
                     name: s.name.clone(),
+                    line: s.line,
                     at: local(s.at),
                     yaw_rad: heading(s.heading_deg, s.at),
                     kind: s.kind.clone(),
@@ -346,10 +349,68 @@ impl Airport {
         })
     }
 
-    /// The stand called `name`.
+    /// The stand called `name`; `None` when no stand is, or more than one is (see
+    /// [`Self::find_stand`], which says which).
     #[must_use]
     pub fn stand(&self, name: &str) -> Option<&Stand> {
-        self.stands.iter().find(|s| s.name == name)
+        self.find_stand(name).ok()
+    }
+
+    /// The stand called `name`, or why not: no stand is (the error lists the stands), or several
+    /// are - a file may name two stands alike -, and the error lists each (its line and where it
+    /// is) and how to pick one: `name#k`, the k-th stand of that name in file order.
+    pub fn find_stand(&self, name: &str) -> Result<&Stand, String> {
+        let (base, pick) = match name.rsplit_once('#') {
+            Some((base, k)) if !base.is_empty() => match k.trim().parse::<usize>() {
+                Ok(k) => (base, Some(k)),
+                Err(_) => (name, None),
+            },
+            _ => (name, None),
+        };
+        let named: Vec<&Stand> = self.stands.iter().filter(|s| s.name == base).collect();
+        let list = |stands: &[&Stand]| {
+            stands
+                .iter()
+                .enumerate()
+                .map(|(k, s)| {
+                    format!(
+                        "`{}#{}` (line {}, at ({:.1}, {:.1}) m)",
+                        s.name,
+                        k + 1,
+                        s.line,
+                        s.at.x,
+                        s.at.y
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        match (named.as_slice(), pick) {
+            ([], _) => Err(format!(
+                "no stand `{base}` at {} (its stands: {:?})",
+                self.code,
+                self.stands
+                    .iter()
+                    .map(|s| s.name.as_str())
+                    .collect::<Vec<_>>()
+            )),
+            ([one], None) => Ok(one),
+            (_, None) => Err(format!(
+                "stand `{base}` is ambiguous: {} stands at {} have that name: {}; pick one by \
+                 its number in file order",
+                named.len(),
+                self.code,
+                list(&named)
+            )),
+            (_, Some(k)) => named.get(k.wrapping_sub(1)).copied().ok_or_else(|| {
+                format!(
+                    "stand `{name}`: {} has {} stand(s) named `{base}`: {}",
+                    self.code,
+                    named.len(),
+                    list(&named)
+                )
+            }),
+        }
     }
 
     /// The lower-left and upper-right corners of everything in it (m).

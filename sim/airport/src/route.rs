@@ -273,9 +273,7 @@ fn start_point(
             .ok_or_else(|| format!("no network node has id {id}")),
         Place::Runway(number) => runway_node_at_threshold(airport, number).map(|n| (n, None)),
         Place::Stand(name) => {
-            let stand = airport
-                .stand(name)
-                .ok_or_else(|| format!("no stand `{name}` (stands: {:?})", stand_names(airport)))?;
+            let stand = airport.find_stand(name)?;
             let (edge, p, t) = nearest_on_edges(graph, stand.at, code).ok_or_else(|| {
                 format!("no taxiway admitting code {code} to leave stand `{name}` by")
             })?;
@@ -327,9 +325,7 @@ fn end_points(
             Ok((holds, None, None))
         }
         Place::Stand(name) => {
-            let stand = airport
-                .stand(name)
-                .ok_or_else(|| format!("no stand `{name}` (stands: {:?})", stand_names(airport)))?;
+            let stand = airport.find_stand(name)?;
             if let Some(class) = stand.size_class.filter(|&c| c < code) {
                 return Err(format!(
                     "stand `{name}` takes aircraft up to code {class}, not {code}"
@@ -347,10 +343,6 @@ fn end_points(
             Ok((vec![end], Some(stand.at), Some((edge, t))))
         }
     }
-}
-
-fn stand_names(airport: &Airport) -> Vec<&str> {
-    airport.stands.iter().map(|s| s.name.as_str()).collect()
 }
 
 fn runway_end<'a>(airport: &'a Airport, number: &str) -> Option<(&'a crate::model::Runway, usize)> {

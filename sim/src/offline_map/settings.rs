@@ -30,7 +30,11 @@ pub fn self_filter_model(vehicle: &aircraft::Vehicle) -> Result<mapper::Collisio
 /// configuration's), cumulative, under its ceiling (`aircraft::Vehicle::ceiling_m`: its top plus
 /// its overhead clearance).
 pub fn levels_of(scenario: &Scenario, config: &RunConfig) -> Result<Levels> {
-    let vehicle = &scenario.vehicle.vehicle;
+    levels_of_vehicle(&scenario.vehicle.vehicle, config)
+}
+
+/// [`levels_of`] for a vehicle without a scenario (a map from a bag or a capture).
+pub fn levels_of_vehicle(vehicle: &aircraft::Vehicle, config: &RunConfig) -> Result<Levels> {
     Ok(Levels::new(
         config.heights_of_interest_m(vehicle).to_vec(),
         mapper::LevelMode::Cumulative,

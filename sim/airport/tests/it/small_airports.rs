@@ -127,3 +127,32 @@ fn a_split_bezier_node_draws_no_needle() {
         length(&plain)
     );
 }
+
+/// Two stands named alike ("Cargo 1", as a real file has them): a route from either name alone
+/// is refused, the error listing both with their lines and places and how to pick one; `#k`
+/// picks the k-th in file order, and a number past them is refused the same way.
+#[test]
+fn an_ambiguous_stand_name_is_an_error_listing_each_and_k_picks_one() {
+    let a = airport(
+        "cargo",
+        &(line_of_three(["A", "A", "A"])
+            + "1300 43.0003 -75.997 180.0 gate jets Cargo 1\n1300 43.0003 -75.993 180.0 gate jets Cargo 1\n"),
+    );
+    let e = route(&a, "Cargo 1", "node 3", &[]).unwrap_err().to_string();
+    assert!(e.contains("ambiguous") && e.contains("2 stands"), "{e}");
+    assert!(
+        e.contains("`Cargo 1#1` (line 14") && e.contains("`Cargo 1#2` (line 15"),
+        "{e}"
+    );
+    assert!(a.stand("Cargo 1").is_none());
+    let first = a.find_stand("Cargo 1#1").unwrap();
+    let second = a.find_stand("Cargo 1#2").unwrap();
+    assert_eq!((first.line, second.line), (14, 15));
+    assert!(second.at.x > first.at.x + 300.0);
+    let r = route(&a, "Cargo 1#2", "node 0", &[]).expect("a route from the second");
+    assert!(r.length_m > 0.0);
+    let e = a.find_stand("Cargo 1#3").unwrap_err();
+    assert!(e.contains("2 stand(s) named `Cargo 1`"), "{e}");
+    let e = a.find_stand("Cargo 9").unwrap_err();
+    assert!(e.contains("no stand `Cargo 9`"), "{e}");
+}

@@ -14,7 +14,8 @@ use crate::emit;
 pub struct BenchArgs {
     /// What to measure.
     pub what: BenchTarget,
-    /// One JSON object per figure on stdout instead of a table (`bench figures`: one object).
+    /// One JSON object per figure on stdout instead of a table (`bench figures`: one object;
+    /// `bench representations`: the results, one JSON array, as `representations.json`).
     #[arg(long)]
     pub json: bool,
     /// Timed batches per figure, the median reported (default 15; `bench loop`: runs of each
@@ -119,6 +120,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             &args.scenario,
             args.out.as_deref(),
             &args.representations,
+            args.json,
         );
     }
     let scenario = args

@@ -5,7 +5,9 @@
 use std::path::PathBuf;
 
 use anyhow::Context as _;
-use sim::offline_map::{default_map_dir, levels_of, map_config, map_drive, self_filter_model};
+use sim::offline_map::{
+    default_map_dir, levels_of_vehicle, map_config, map_drive, self_filter_model,
+};
 use sim::rosbag::{BagMapOptions, DriveBag, PoseSource, map_from_bag};
 use sim::scenario::{RunConfig, Scenario};
 
@@ -21,9 +23,15 @@ pub enum PoseFrom {
 /// Arguments of `taxi-sim map`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct MapArgs {
-    /// The scenario file: its vehicle's levels and self-hit filter (and, without `--from-bag`,
-    /// the route driven).
-    pub scenario: PathBuf,
+    /// The scenario file: its vehicle's levels and self-hit filter (and, without `--from-bag` or
+    /// `--pcap`, the route driven). `--from-bag` and `--pcap` may take `--vehicle` instead.
+    #[arg(required_unless_present = "vehicle")]
+    pub scenario: Option<PathBuf>,
+    /// `--from-bag` or `--pcap` without a scenario: the vehicle whose levels and self-hit filter
+    /// the map is built for (a shipped name or a sidecar path); the map covers what the data
+    /// covers.
+    #[arg(long, value_name = "NAME|SIDECAR", conflicts_with = "scenario")]
+    pub vehicle: Option<String>,
     /// Output directory (default: out/maps/<scenario file name>, or out/maps/<bag name>-bag).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -109,7 +117,7 @@ pub(crate) fn parse_pose(text: &str) -> anyhow::Result<nalgebra::Isometry2<f64>>
 fn from_pcap(
     args: &MapArgs,
     pcap: &std::path::Path,
-    scenario: &Scenario,
+    vehicle: &aircraft::Vehicle,
     config: &RunConfig,
 ) -> anyhow::Result<()> {
     let pose = parse_pose(&args.pose)?;
@@ -127,7 +135,7 @@ fn from_pcap(
             .join("maps")
             .join(format!("{stem}-pcap"))
     });
-    let levels = levels_of(scenario, config)?;
+    let levels = levels_of_vehicle(vehicle, config)?;
     let progress = crate::bar(0, "mapping the capture");
     let poses = match &args.poses {
         Some(file) => sim::pcap::read_poses_csv(file)?,
@@ -233,7 +241,7 @@ fn build_and_record(
 fn from_bag(
     args: &MapArgs,
     bag: &std::path::Path,
-    scenario: &Scenario,
+    vehicle: &aircraft::Vehicle,
     config: &RunConfig,
 ) -> anyhow::Result<()> {
     let options = BagMapOptions {
@@ -254,8 +262,8 @@ fn from_bag(
             .join("maps")
             .join(format!("{stem}-bag"))
     });
-    let levels = levels_of(scenario, config)?;
-    let filter = self_filter_model(&scenario.vehicle.vehicle)?;
+    let levels = levels_of_vehicle(vehicle, config)?;
+    let filter = self_filter_model(vehicle)?;
     let progress = crate::bar(0, "mapping from the bag");
     let report = map_from_bag(
         bag,
@@ -294,13 +302,32 @@ fn from_bag(
 
 /// Runs `taxi-sim map`.
 pub fn run(args: &MapArgs) -> anyhow::Result<()> {
-    let scenario = Scenario::from_file(&args.scenario)?;
+    let Some(path) = &args.scenario else {
+        // Only with --vehicle (clap requires one of the two).
+        let name = args.vehicle.as_deref().unwrap_or_default();
+        let vehicle = aircraft::Vehicle::load(name)
+            .with_context(|| format!("--vehicle {name}: loading the vehicle"))?;
+        let config = match &args.config {
+            Some(file) => RunConfig::from_file(file)?,
+            None => RunConfig::default(),
+        };
+        return match (&args.from_bag, &args.pcap) {
+            (Some(bag), _) => from_bag(args, bag, &vehicle, &config),
+            (None, Some(pcap)) => from_pcap(args, pcap, &vehicle, &config),
+            (None, None) => anyhow::bail!(
+                "--vehicle {name} without a scenario: a map from data needs --from-bag BAG or \
+                 --pcap FILE; a mapping drive needs the scenario file whose route it drives"
+            ),
+        };
+    };
+    let scenario = Scenario::from_file(path)?;
     let config = RunConfig::for_scenario(&scenario, args.config.as_deref())?;
+    let vehicle = &scenario.vehicle.vehicle;
     if let Some(bag) = &args.from_bag {
-        return from_bag(args, bag, &scenario, &config);
+        return from_bag(args, bag, vehicle, &config);
     }
     if let Some(pcap) = &args.pcap {
-        return from_pcap(args, pcap, &scenario, &config);
+        return from_pcap(args, pcap, vehicle, &config);
     }
     let dir = args
         .out

@@ -125,9 +125,12 @@ pub fn run(
     scenes: &[PathBuf],
     out: Option<&Path>,
     args: &RepresentationArgs,
+    json: bool,
 ) -> anyhow::Result<()> {
+    // With --json stdout holds the JSON alone: the tables go to --out only.
+    let emit = |text: &str| if json { Ok(()) } else { emit(text) };
     if let Some(dir) = &args.redraw {
-        return redraw(dir);
+        return redraw(dir, json);
     }
     let options = options(args, out)?;
     let scenes: Vec<PathBuf> = if scenes.is_empty() && args.pcap.is_none() {
@@ -186,15 +189,20 @@ pub fn run(
         emit("\n")?;
         results.push(result);
     }
-    write_all(&results, out)
+    write_all(&results, out, json)
 }
 
-/// The headline on stdout; with `out`, the tables and the JSON in it.
-fn write_all(results: &[SceneResult], out: Option<&Path>) -> anyhow::Result<()> {
+/// The headline on stdout (`json`: the results as JSON instead, one array, as
+/// `representations.json` holds them); with `out`, the tables and the JSON in it.
+fn write_all(results: &[SceneResult], out: Option<&Path>, json: bool) -> anyhow::Result<()> {
     let mut text =
         String::from("Against the thesis' representation (multi-height, cumulative):\n\n");
     text.push_str(&study::table::headline(results));
-    emit(&text)?;
+    if json {
+        emit(&format!("{}\n", serde_json::to_string(results)?))?;
+    } else {
+        emit(&text)?;
+    }
     if let Some(dir) = out {
         let mut md = String::new();
         for r in results {
@@ -215,7 +223,8 @@ fn write_all(results: &[SceneResult], out: Option<&Path>) -> anyhow::Result<()> 
 }
 
 /// Pictures and tables again from a run's JSON.
-fn redraw(dir: &Path) -> anyhow::Result<()> {
+fn redraw(dir: &Path, json: bool) -> anyhow::Result<()> {
+    let emit = |text: &str| if json { Ok(()) } else { emit(text) };
     let path = dir.join("representations.json");
     let text =
         std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
@@ -231,5 +240,5 @@ fn redraw(dir: &Path) -> anyhow::Result<()> {
         emit(&study::table::scene_table(r))?;
         emit("\n")?;
     }
-    write_all(&results, Some(dir))
+    write_all(&results, Some(dir), json)
 }

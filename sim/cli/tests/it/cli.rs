@@ -282,3 +282,44 @@ fn model_coverage_reports_each_level_and_draws_them() {
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("cell"), "{stderr}");
 }
+
+/// `--json` means JSON: `bench representations --json` prints the results as one JSON array
+/// (what `representations.json` holds), and no Markdown; `--redraw DIR --json` the same again.
+#[test]
+fn bench_representations_json_is_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("rep");
+    let (code, stdout, stderr) = taxi_sim(&[
+        "bench",
+        "representations",
+        "--scenario",
+        "../../scenarios/straight_cone_under_wing.toml",
+        "--poses",
+        "50",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let printed: serde_json::Value =
+        serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("not JSON ({e}): {stdout}"));
+    let written: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("representations.json")).unwrap())
+            .unwrap();
+    assert_eq!(printed, written);
+    assert_eq!(printed.as_array().map(Vec::len), Some(1));
+    assert!(printed[0]["rows"].as_array().is_some_and(|r| r.len() >= 3));
+    assert!(out.join("representations.md").exists());
+    let (code, again, stderr) = taxi_sim(&[
+        "bench",
+        "representations",
+        "--redraw",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(
+        serde_json::from_str::<serde_json::Value>(&again).unwrap(),
+        written
+    );
+}

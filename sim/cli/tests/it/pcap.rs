@@ -75,6 +75,36 @@ fn a_capture_scans_maps_and_compares() {
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("mapped 1 revolutions"), "{out}");
     assert!(map.join("level0.yaml").exists() && map.join("manifest.json").exists());
+    // The same without a scenario, the vehicle named: the same map, manifest for manifest.
+    let by_vehicle = dir.path().join("map_by_vehicle");
+    let (code, out, err) = taxi_sim(&[
+        "map",
+        "--vehicle",
+        "iara_car_fake_wing",
+        "--pcap",
+        f,
+        "--pose",
+        "5,5,90",
+        "--out",
+        by_vehicle.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("mapped 1 revolutions"), "{out}");
+    let manifest = |d: &std::path::Path| {
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("manifest.json")).unwrap())
+                .unwrap();
+        (
+            v["occupied_cells"].clone(),
+            v["level_heights_m"].clone(),
+            v["blocks"].clone(),
+        )
+    };
+    assert_eq!(manifest(&map), manifest(&by_vehicle));
+    // A vehicle and no data: the mapping drive needs a scenario; said so.
+    let (code, _, err) = taxi_sim(&["map", "--vehicle", "praetor600"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--from-bag BAG or --pcap FILE"), "{err}");
     let (code, out, err) = taxi_sim(&["compare-lidar", "--pcap", f]);
     assert_eq!(code, 0, "{err}");
     assert!(

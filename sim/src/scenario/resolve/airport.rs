@@ -193,23 +193,16 @@ impl Resolver<'_> {
         for (i, parked) in spec.get_ref().parked.iter().enumerate() {
             let field = format!("airport.parked[{i}]");
             let p = parked.get_ref();
-            let stand = loaded.airport.stand(p.stand.get_ref()).ok_or_else(|| {
-                let names: Vec<&str> = loaded
-                    .airport
-                    .stands
-                    .iter()
-                    .map(|s| s.name.as_str())
-                    .collect();
-                self.err(
-                    p.stand.span(),
-                    &format!("{field}.stand"),
-                    format!(
-                        "no stand `{}` at {} (its stands: {names:?})",
-                        p.stand.get_ref(),
-                        loaded.airport.code
-                    ),
-                )
-            })?;
+            let stand = loaded
+                .airport
+                .find_stand(p.stand.get_ref())
+                .map_err(|why| {
+                    self.err(
+                        p.stand.span(),
+                        &format!("{field}.stand"),
+                        format!("{why} ({})", loaded.airport.file.display()),
+                    )
+                })?;
             let description = self.load_vehicle(&p.vehicle, &format!("{field}.vehicle"))?;
             let id = format!("stand_{}", stand.name.replace(' ', "_"));
             self.claim(
