@@ -122,10 +122,18 @@ pub fn frames(packets: &[DataPacket], calibration: &Calibration) -> Vec<Frame> {
     let mut out = vec![Frame::default()];
     let mut last_azimuth: Option<u16> = None;
     let mut firings = 0u32;
+    // The last azimuth gap between firings, hundredths of a degree (the last block of a packet
+    // has no next one to measure it by: the one before is used, as the ROS driver does).
+    let mut gap_cdeg = 0.0f64;
     for p in packets {
         let dual = p.return_mode == ReturnMode::Dual;
         for (k, block) in p.blocks.iter().enumerate() {
             let a = block.azimuth_cdeg;
+            // The next firing's block (in dual-return mode blocks come in pairs).
+            let step = if dual { 2 } else { 1 };
+            if let Some(n) = p.blocks.get(k - k % step + step) {
+                gap_cdeg = f64::from((u32::from(n.azimuth_cdeg) + 36_000 - u32::from(a)) % 36_000);
+            }
             if last_azimuth.is_some_and(|l| a < l) {
                 out.push(Frame::default());
             }
@@ -148,7 +156,8 @@ pub fn frames(packets: &[DataPacket], calibration: &Calibration) -> Vec<Frame> {
                 };
                 let time_us = firing_time_us(p, firing, j);
                 let c = calibration;
-                let az = (f64::from(a) * 0.01 - c.rotation_deg[laser]).to_radians();
+                let az = (azimuth_cdeg(p.product, a, gap_cdeg, j) * 0.01 - c.rotation_deg[laser])
+                    .to_radians();
                 let w = w.to_radians();
                 let dist = f64::from(d) * c.distance_unit_m + c.distance_offset_m[laser];
                 // VeloView's corrections (all zero in the built-in tables).
@@ -172,6 +181,22 @@ pub fn frames(packets: &[DataPacket], calibration: &Calibration) -> Vec<Frame> {
         }
     }
     out
+}
+
+/// The azimuth channel `j` of a block at `a` fired at, hundredths of a degree. A VLP-16 block
+/// holds two firing sequences of 16 lasers, one after the other, while the head turns by
+/// `gap_cdeg` to the next block: its manual's "precision azimuth" (as VeloView and the ROS driver
+/// compute it) moves each laser on by the gap times its firing time over the block's 110.592 us:
+/// the second sequence half a gap on, each laser 2.304 us after the one before. The HDL-32E's
+/// returns keep the block's azimuth (its 32 lasers fire within 1.152 us of each other: VeloView's
+/// recording is reproduced so).
+fn azimuth_cdeg(product: Product, a: u16, gap_cdeg: f64, j: usize) -> f64 {
+    if product == Product::Vlp16 {
+        let t_us = (j / 16) as f64 * 55.296 + (j % 16) as f64 * 2.304;
+        f64::from(a) + gap_cdeg * t_us / 110.592
+    } else {
+        f64::from(a)
+    }
 }
 
 /// When channel `j` of firing `k` of packet `p` fired (manuals, appendix

@@ -122,3 +122,53 @@ fn dual_return_pairs_count_a_single_echo_once() {
     assert_eq!(f.len(), 1);
     assert_eq!(f[0].points.len(), 6 * 31 + 1);
 }
+
+/// The VLP-16's precision azimuth (its manual, appendix: as VeloView and the ROS driver place
+/// its returns): each laser fired on from the block's azimuth by the gap to the next block times
+/// its firing time over the block's 110.592 us - the second 16-laser sequence half a gap on,
+/// each laser 2.304 us after the one before; the last block of a packet by the gap before it. In
+/// dual-return mode a pair's blocks share their azimuth and the gap is to the next pair.
+#[test]
+fn vlp16_returns_are_placed_at_their_precision_azimuth() {
+    let calibration = Calibration::built_in(Product::Vlp16).unwrap();
+    // Blocks 0.4 degrees apart (the VLP-16 at 600 rpm).
+    let mut p = packet(std::array::from_fn(|k| 1_000 + 40 * k as u16), 9_000);
+    p.product = Product::Vlp16;
+    let f = frames(&[p.clone()], &calibration);
+    let azimuth_deg = |q: &velodyne::Point| {
+        f64::from(q.xyz_m[0])
+            .atan2(f64::from(q.xyz_m[1]))
+            .to_degrees()
+    };
+    // Channel j's point of block k (31 a block: channel 5 has no echo).
+    let at =
+        |points: &[velodyne::Point], k: usize, j: usize| points[k * 31 + j - usize::from(j > 5)];
+    for (k, j, want_deg) in [
+        (0, 0, 10.0),
+        (0, 15, 10.0 + 0.4 * 15.0 * 2.304 / 110.592),
+        (0, 16, 10.2),
+        (0, 31, 10.2 + 0.4 * 15.0 * 2.304 / 110.592),
+        (4, 16, 11.6 + 0.2),
+        (11, 16, 14.4 + 0.2),
+    ] {
+        let q = at(&f[0].points, k, j);
+        assert_eq!(q.laser as usize, j % 16);
+        let got = azimuth_deg(&q);
+        assert!(
+            (got - want_deg).abs() < 1e-4,
+            "block {k} channel {j}: {got} against {want_deg}"
+        );
+    }
+    // Dual return: pairs at one azimuth, 0.4 degrees a pair; the gap is to the next pair.
+    let mut dual = packet(std::array::from_fn(|k| 1_000 + 40 * (k / 2) as u16), 9_000);
+    dual.product = Product::Vlp16;
+    dual.return_mode = ReturnMode::Dual;
+    for b in dual.blocks.iter_mut().skip(1).step_by(2) {
+        for c in b.channels.iter_mut().filter(|c| c.0 > 0) {
+            c.0 += 100; // a second, farther echo on every channel that had one
+        }
+    }
+    let f = frames(&[dual], &calibration);
+    let q = at(&f[0].points, 1, 16);
+    assert!((azimuth_deg(&q) - 10.2).abs() < 1e-4, "{}", azimuth_deg(&q));
+}
