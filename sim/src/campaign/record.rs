@@ -125,6 +125,9 @@ pub struct RunRecord {
     /// That call was needless: ground truth had no object near what held the vehicle.
     #[serde(default)]
     pub needless_pilot_call: bool,
+    /// Ground truth at that call: the object nearest what held the vehicle, and how far, metres.
+    #[serde(default)]
+    pub pilot_call_object: Option<(String, f64)>,
 }
 
 impl RunRecord {
@@ -336,6 +339,10 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
             )
         }),
         needless_pilot_call: r.pilot_call.as_ref().is_some_and(|c| c.needless),
+        pilot_call_object: r
+            .pilot_call
+            .as_ref()
+            .and_then(|c| c.nearest_object.clone()),
     }
 }
 
@@ -380,6 +387,7 @@ pub(super) fn invalid(campaign: &Campaign, v: &Variant, why: &str) -> RunRecord 
         faults: Default::default(),
         pilot_call: None,
         needless_pilot_call: false,
+        pilot_call_object: None,
     }
 }
 

@@ -247,12 +247,20 @@ pub fn chart(dir: &Path, title: &str, records: &[RunRecord]) -> Result<()> {
 /// The pilot calls by cause (the rule that called / what held the vehicle), with the needless
 /// ones: those where ground truth had no object near what held it.
 fn pilot_calls(records: &[RunRecord]) -> String {
-    let mut by_cause: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
+    // Per cause: calls, needless ones, and the objects nearest what held the vehicle (their
+    // ids without a trailing variant number: `careful_van`, `person`).
+    let mut by_cause: BTreeMap<&str, (usize, usize, BTreeMap<String, usize>)> = BTreeMap::new();
     for r in records {
         if let Some(cause) = &r.pilot_call {
             let e = by_cause.entry(cause.as_str()).or_default();
             e.0 += 1;
             e.1 += usize::from(r.needless_pilot_call);
+            if let Some((id, _)) = &r.pilot_call_object
+                && !r.needless_pilot_call
+            {
+                let kind = id.trim_end_matches(|c: char| c.is_ascii_digit() || c == '_');
+                *e.2.entry(kind.to_string()).or_default() += 1;
+            }
         }
     }
     let calls: usize = by_cause.values().map(|c| c.0).sum();
@@ -264,9 +272,10 @@ fn pilot_calls(records: &[RunRecord]) -> String {
         crate::engine::NEEDLESS_WINDOW_S
     );
     if calls > 0 {
-        s += "\n| call / what held it | calls | needless |\n|---|---|---|\n";
-        for (cause, (n, k)) in by_cause {
-            let _ = writeln!(s, "| {cause} | {n} | {k} |");
+        s += "\n| call / what held it | calls | needless | what was there (ground truth) |\n|---|---|---|---|\n";
+        for (cause, (n, k, there)) in by_cause {
+            let there: Vec<String> = there.iter().map(|(id, c)| format!("{id} {c}")).collect();
+            let _ = writeln!(s, "| {cause} | {n} | {k} | {} |", there.join(", "));
         }
     }
     s

@@ -34,6 +34,22 @@ fn the_smoke_campaign_runs_every_variant_under_every_setting() {
         summary.contains("| autonomy.planner_safety_m = 0.6 | 6 |"),
         "{summary}"
     );
+    // Every run that ended in a pilot call says why (and what stood there); the summary counts
+    // them by cause.
+    for r in records.iter() {
+        let called = matches!(
+            r.end.as_str(),
+            "waiting_for_hidden_obstacle" | "blocked" | "waiting_for_walk_around"
+        );
+        assert_eq!(r.pilot_call.is_some(), called, "variant {}: {}", r.index, r.end);
+        assert!(r.pilot_call_object.is_some() || !called || r.needless_pilot_call);
+    }
+    let calls = records.iter().filter(|r| r.pilot_call.is_some()).count();
+    assert!(calls > 0, "the smoke campaign's variant 10 calls a pilot");
+    assert!(
+        summary.contains(&format!("{calls} of 12 runs ended with a pilot call")),
+        "{summary}"
+    );
     // Every failing variant and only those has a failure file, listed in the error table, and
     // its bag (run again: `record_failures`) with the run's clouds and its events.
     let files = std::fs::read_dir(dir.path().join("failures"))
