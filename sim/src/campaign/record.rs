@@ -339,10 +339,7 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
             )
         }),
         needless_pilot_call: r.pilot_call.as_ref().is_some_and(|c| c.needless),
-        pilot_call_object: r
-            .pilot_call
-            .as_ref()
-            .and_then(|c| c.nearest_object.clone()),
+        pilot_call_object: r.pilot_call.as_ref().and_then(|c| c.nearest_object.clone()),
     }
 }
 

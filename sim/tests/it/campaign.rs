@@ -41,7 +41,13 @@ fn the_smoke_campaign_runs_every_variant_under_every_setting() {
             r.end.as_str(),
             "waiting_for_hidden_obstacle" | "blocked" | "waiting_for_walk_around"
         );
-        assert_eq!(r.pilot_call.is_some(), called, "variant {}: {}", r.index, r.end);
+        assert_eq!(
+            r.pilot_call.is_some(),
+            called,
+            "variant {}: {}",
+            r.index,
+            r.end
+        );
         assert!(r.pilot_call_object.is_some() || !called || r.needless_pilot_call);
     }
     let calls = records.iter().filter(|r| r.pilot_call.is_some()).count();
