@@ -1,7 +1,8 @@
 //! Real Velodyne captures in the simulator's tools (`velodyne` decodes them): a revolution of a
 //! pcap as the simulator's LiDAR scan (`taxi-sim scan --pcap`, PLY), and the offline map of a
 //! recording (`taxi-sim map SCENARIO --pcap`: the scenario's vehicle gives the levels), written
-//! as the mapping drive writes its map.
+//! as the mapping drive writes its map; and the other way, the simulator's revolutions written
+//! as a capture VeloView opens ([`write_capture`], `taxi-sim scan SCENARIO --out FILE.pcap`).
 //!
 //! The sensor stands at a pose the user gives (a standing recording; a moving one needs poses,
 //! not read yet), at a height the user gives or that the ground says ([`Ground`]: a plane fitted
@@ -409,4 +410,78 @@ fn fit_plane(points: &[Point3<f64>]) -> Option<Ground> {
         c: s.z,
         spread_m: 0.0,
     })
+}
+
+/// The Velodyne product whose packets carry `scan`'s beams: a 16-beam scan the VLP-16's, a
+/// 32-beam one the HDL-32E's; `None` for another beam count.
+pub fn product_of(scan: &LidarScan) -> Option<velodyne::Product> {
+    match scan.scan.beams() {
+        16 => Some(velodyne::Product::Vlp16),
+        32 => Some(velodyne::Product::Hdl32e),
+        _ => None,
+    }
+}
+
+/// `scans` (consecutive revolutions of one sensor turning at `rotation_hz`, the first starting
+/// at `start_s` past the hour) as the data packets the sensor would send, written atomically as
+/// a pcap (Ethernet, UDP port 2368). Each column is a firing at the azimuth of its beams
+/// (VeloView's: clockwise from ahead), its returns' ranges and intensities (0-1 scaled to
+/// 0-255). The simulator's head turns anticlockwise and a Velodyne's clockwise: a revolution's
+/// columns are written in the sensor's order, from the one straight ahead (column 0) clockwise
+/// (the last column next) - for a standing sensor the same revolution. Returns the packets
+/// written.
+///
+/// # Errors
+/// A scan of neither sensor's beam count, a range a packet cannot carry, or the file.
+pub fn write_capture(
+    scans: &[LidarScan],
+    rotation_hz: f64,
+    start_s: f64,
+    path: &Path,
+) -> Result<usize> {
+    let Some(first) = scans.first() else {
+        return Err(Error::Invalid("no revolution to write".into()));
+    };
+    let product = product_of(first).ok_or_else(|| {
+        Error::Invalid(format!(
+            "{} beams: a capture holds an HDL-32E's 32 or a VLP-16's 16",
+            first.scan.beams()
+        ))
+    })?;
+    let mut firings = Vec::new();
+    for (r, scan) in scans.iter().enumerate() {
+        let (beams, columns) = (scan.scan.beams(), scan.scan.columns().len());
+        for k in 0..columns {
+            let c = (columns - k) % columns;
+            // The column's heading in the sensor frame (x ahead, y left), from any beam.
+            let d = scan.directions_in_sensor[c * beams];
+            let azimuth_deg = f64::from(-d[1]).atan2(f64::from(d[0])).to_degrees();
+            let by_beam = scan.scan.returns()[c * beams..(c + 1) * beams]
+                .iter()
+                .map(|ret| {
+                    ret.map(|ret| {
+                        let intensity = (f64::from(ret.intensity).clamp(0.0, 1.0) * 255.0).round();
+                        (f64::from(ret.range_m), intensity as u8)
+                    })
+                })
+                .collect();
+            let t_s = start_s + (r as f64 + k as f64 / columns as f64) / rotation_hz;
+            firings.push(velodyne::encode::Firing {
+                azimuth_deg,
+                time_us: t_s * 1e6,
+                by_beam,
+            });
+        }
+    }
+    let packets = velodyne::encode::data_packets(product, &firings).map_err(Error::Invalid)?;
+    let datagrams: Vec<(f64, u16, Vec<u8>)> = packets
+        .iter()
+        .map(|p| {
+            let t_s = f64::from(p.timestamp_us) * 1e-6;
+            (t_s, velodyne::packet::DATA_PORT, p.encode())
+        })
+        .collect();
+    mapper::write_atomically(path, &velodyne::pcap_bytes(&datagrams))
+        .map_err(|e| Error::Invalid(format!("writing {}: {e}", path.display())))?;
+    Ok(packets.len())
 }

@@ -174,7 +174,7 @@ fn decoder_figure(samples: usize) -> crate::Result<Figure> {
     let seconds = median_seconds(samples, 1, || {
         let packets: Result<Vec<_>, String> = payloads
             .iter()
-            .map(|b| velodyne::DataPacket::decode(b))
+            .map(|b| velodyne::DataPacket::decode(b).map_err(|e| e.to_string()))
             .collect();
         let outcome = packets.and_then(|p| {
             let frames = velodyne::frames(&p, &calibration);

@@ -472,6 +472,7 @@ fn velodyne_pose_files() {
                 azimuth_cdeg: 0,
                 firing: 0,
                 time_us,
+                echo: velodyne::Echo::Strongest,
             }],
         })
         .to_vec();

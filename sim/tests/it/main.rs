@@ -6,6 +6,7 @@
 //! `tests/fixtures`.
 
 mod campaign;
+mod capture_out;
 mod external_stack;
 mod fuzz;
 mod map_files;

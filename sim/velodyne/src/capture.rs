@@ -4,7 +4,8 @@
 //! not IPv4 UDP (ARP, IPv6, TCP) are skipped; so is, as VeloView and Wireshark read on past it,
 //! one that cannot be read whole - a fragment, cut short by the capture's snap length, a length
 //! field past its end - counted by why when it was for the sensor's ports (2368, 8308)
-//! ([`Skipped`]). An unsupported link type is an error.
+//! ([`Skipped`]). A file that ends inside a packet, or a record whose header cannot be read, is
+//! read up to there, the rest counted as skipped. An unsupported link type is an error.
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -149,17 +150,26 @@ pub fn read_datagrams(path: &Path) -> Result<(Vec<Datagram>, Skipped), VelodyneE
                     break;
                 }
             }
+            // A capture cut short (the recorder stopped mid-write) or a record whose header is
+            // damaged: what came before is read, the rest skipped and counted (the framing is
+            // lost past it), as Wireshark and VeloView read up to it.
             Err(PcapError::UnexpectedEof) => {
-                return Err(whole(format!(
-                    "cut short: the file ends inside packet {index} (after {} whole UDP \
-                     datagrams)",
-                    out.len()
-                )));
+                skipped.add("cut short: the file ends inside it".into(), index);
+                break;
             }
-            Err(e) => return Err(packet_error(path, index, format!("unreadable ({e:?})"))),
+            Err(e) => {
+                if index == 0 {
+                    return Err(packet_error(path, index, format!("unreadable ({e:?})")));
+                }
+                skipped.add(
+                    format!("unreadable ({e:?}), and every record after it"),
+                    index,
+                );
+                break;
+            }
         }
     }
-    if index == 0 {
+    if index == 0 && skipped.total() == 0 {
         return Err(whole("no packets".into()));
     }
     Ok((out, skipped))

@@ -3,8 +3,10 @@
 //! vertical angle and `a` the block's azimuth (clockwise from +y; no per-laser azimuth
 //! interpolation on the HDL-32E, as VeloView). A revolution ends where a block's azimuth is
 //! smaller than the one before it (so the first and last of a capture are partial). Returns of
-//! distance 0 (no echo) are skipped; in dual-return mode the second block of a pair is skipped
-//! where it repeats the first. The VLP-16's second firing sequence of a block is placed at
+//! distance 0 (no echo) are skipped; in dual-return mode a pair's first block holds the last
+//! echo and its second the strongest (the second strongest where the last is the strongest), each
+//! point marked with its [`Echo`]; where both blocks report one distance (a single echo) it is
+//! one point, marked [`Echo::LastAndStrongest`]. The VLP-16's second firing sequence of a block is placed at
 //! the block's azimuth too (VeloView shifts it by half a step; not done here yet).
 
 use std::path::Path;
@@ -31,6 +33,23 @@ pub struct Point {
     pub firing: u32,
     /// When it fired, microseconds past the hour (the sensor's clock).
     pub time_us: f64,
+    /// Which echo of its firing it is.
+    pub echo: Echo,
+}
+
+/// Which echo of a laser's firing a point is, as the packet's return mode and block say.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Echo {
+    /// Single-return mode `strongest` (0x37), and packets of firmware that name no mode (0x00:
+    /// the HDL-32E's only mode before its dual-return firmware).
+    Strongest,
+    /// Single-return mode `last` (0x38), or a dual-return pair's first block.
+    Last,
+    /// A dual-return pair's second block where it differs from the first: the strongest echo,
+    /// or the second strongest where the last is also the strongest.
+    DualStrongest,
+    /// Dual return, both blocks the same distance: the one echo, last and strongest.
+    LastAndStrongest,
 }
 
 /// One revolution's returns, in firing order.
@@ -55,8 +74,10 @@ pub struct Capture {
 impl Capture {
     /// Reads the Velodyne packets of the capture at `path`: UDP datagrams to port 2368 of 1206
     /// bytes and to port 8308 of 512 bytes; others are skipped, and counted when they were for
-    /// those ports ([`Capture::skipped`]). Data packets from more than one kind of sensor are an
-    /// error; so is a capture with no data packet.
+    /// those ports ([`Capture::skipped`]), as are packets to the data port that cannot be a
+    /// sensor's (a block flag, azimuth, return mode or product byte no sensor sends). Data
+    /// packets from more than one kind of sensor are an error; so is a capture with no data
+    /// packet (saying what was skipped).
     pub fn read(path: &Path) -> Result<Capture, VelodyneError> {
         let mut capture = Capture::default();
         let located = |index: usize, what: String| VelodyneError::Packet {
@@ -68,7 +89,16 @@ impl Capture {
         capture.skipped = skipped;
         for d in datagrams {
             if d.dst_port == DATA_PORT && d.payload.len() == DATA_LEN {
-                let p = DataPacket::decode(&d.payload).map_err(|w| located(d.index, w))?;
+                // A packet that cannot be sensor data is skipped and counted, by kind (VeloView
+                // and Wireshark read on past it); so only a capture of none is refused.
+                let p = match DataPacket::decode(&d.payload) {
+                    Ok(p) => p,
+                    Err(fault) => {
+                        let why = format!("to port {DATA_PORT} {}", fault.kind);
+                        capture.skipped.add(why, d.index);
+                        continue;
+                    }
+                };
                 if let Some((first, q)) = capture.data.first()
                     && (q.product, q.return_mode) != (p.product, p.return_mode)
                 {
@@ -83,8 +113,13 @@ impl Capture {
                 }
                 capture.data.push((d.index, p));
             } else if d.dst_port == POSITION_PORT && d.payload.len() == POSITION_LEN {
-                let p = PositionPacket::decode(&d.payload).map_err(|w| located(d.index, w))?;
-                capture.positions.push((d.index, p));
+                match PositionPacket::decode(&d.payload) {
+                    Ok(p) => capture.positions.push((d.index, p)),
+                    Err(_) => capture.skipped.add(
+                        format!("to port {POSITION_PORT} not a position packet"),
+                        d.index,
+                    ),
+                }
             } else if d.dst_port == DATA_PORT || d.dst_port == POSITION_PORT {
                 let why = format!(
                     "to port {} of neither {DATA_LEN} nor {POSITION_LEN} bytes",
@@ -168,6 +203,20 @@ pub fn frames(packets: &[DataPacket], calibration: &Calibration) -> Vec<Frame> {
                     xy * az.cos() + h_off * az.sin(),
                     dist * w.sin() + v_off * w.cos(),
                 ];
+                let echo = match (p.return_mode, repeat.is_some()) {
+                    (ReturnMode::Strongest | ReturnMode::Unspecified, _) => Echo::Strongest,
+                    (ReturnMode::Last, _) => Echo::Last,
+                    (ReturnMode::Dual, true) => Echo::DualStrongest,
+                    (ReturnMode::Dual, false) => {
+                        // The pair's second block repeating this distance: one echo.
+                        let second = p.blocks.get(k + 1).map(|b| b.channels[j].0);
+                        if second == Some(d) {
+                            Echo::LastAndStrongest
+                        } else {
+                            Echo::Last
+                        }
+                    }
+                };
                 frame.points.push(Point {
                     xyz_m: xyz.map(|v| v as f32),
                     distance_m: dist as f32,
@@ -176,6 +225,7 @@ pub fn frames(packets: &[DataPacket], calibration: &Calibration) -> Vec<Frame> {
                     azimuth_cdeg: a,
                     firing: firings - sequences + j as u32 * sequences / CHANNELS as u32,
                     time_us,
+                    echo,
                 });
             }
         }

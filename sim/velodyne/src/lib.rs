@@ -13,9 +13,12 @@
 //!   values (`monterey.test`) can be reproduced exactly.
 //! - [`scan`]: a revolution as a [`mapper::Scan`] (columns = firing sequences, beams = lasers
 //!   by vertical angle), what the mapper inserts.
+//! - [`encode`]: the other way, firings into data packets (the simulator's revolutions written
+//!   as a capture).
 
 pub mod calibration;
 pub mod capture;
+pub mod encode;
 mod error;
 pub mod frames;
 pub mod packet;
@@ -24,6 +27,6 @@ pub mod scan;
 pub use calibration::Calibration;
 pub use capture::{Datagram, Skipped, pcap_bytes, read_datagrams};
 pub use error::VelodyneError;
-pub use frames::{Capture, Frame, Point, frames};
-pub use packet::{DataPacket, PositionPacket, Product, ReturnMode};
+pub use frames::{Capture, Echo, Frame, Point, frames};
+pub use packet::{DataPacket, PacketFault, PositionPacket, Product, ReturnMode};
 pub use scan::{SensorScan, to_scan};

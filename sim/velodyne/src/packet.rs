@@ -66,13 +66,37 @@ pub struct DataPacket {
     pub product: Product,
 }
 
+/// Why a payload is not a data packet: its kind (what a capture's summary counts it by) and
+/// the detail (which block, which byte).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PacketFault {
+    /// The kind, the same for every packet with this fault.
+    pub kind: &'static str,
+    /// What exactly is wrong.
+    pub detail: String,
+}
+
+impl std::fmt::Display for PacketFault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.detail)
+    }
+}
+
 impl DataPacket {
     /// Decodes a data packet's payload.
-    pub fn decode(payload: &[u8]) -> Result<DataPacket, String> {
+    ///
+    /// # Errors
+    /// A payload of another length, a block whose flag is not 0xEEFF or whose azimuth is past a
+    /// turn, or a return mode or product byte no sensor sends.
+    pub fn decode(payload: &[u8]) -> Result<DataPacket, PacketFault> {
+        let fault = |kind: &'static str, detail: String| PacketFault { kind, detail };
         if payload.len() != DATA_LEN {
-            return Err(format!(
-                "a data packet has {DATA_LEN} bytes, this one {}",
-                payload.len()
+            return Err(fault(
+                "of another length than a data packet's",
+                format!(
+                    "a data packet has {DATA_LEN} bytes, this one {}",
+                    payload.len()
+                ),
             ));
         }
         let u16_at = |at: usize| u16::from_le_bytes([payload[at], payload[at + 1]]);
@@ -84,17 +108,24 @@ impl DataPacket {
             let at = 100 * k;
             let flag = u16_at(at);
             if flag != 0xEEFF {
-                return Err(format!(
-                    "block {k}: flag {flag:#06x}, not 0xeeff (lasers 32-63 of an HDL-64E, or \
-                     not a Velodyne data packet)"
+                return Err(fault(
+                    "with a block flag other than 0xeeff (an HDL-64E's upper lasers, or not \
+                     Velodyne data)",
+                    format!(
+                        "block {k}: flag {flag:#06x}, not 0xeeff (lasers 32-63 of an HDL-64E, or \
+                         not a Velodyne data packet)"
+                    ),
                 ));
             }
             block.azimuth_cdeg = u16_at(at + 2);
             // 36000 occurs in real captures (the HDL-32E's encoder reading a full turn).
             if block.azimuth_cdeg > 36000 {
-                return Err(format!(
-                    "block {k}: azimuth {} beyond 360 degrees",
-                    block.azimuth_cdeg
+                return Err(fault(
+                    "with an azimuth beyond 360 degrees",
+                    format!(
+                        "block {k}: azimuth {} beyond 360 degrees",
+                        block.azimuth_cdeg
+                    ),
                 ));
             }
             for (j, c) in block.channels.iter_mut().enumerate() {
@@ -107,15 +138,21 @@ impl DataPacket {
             0x38 => ReturnMode::Last,
             0x39 => ReturnMode::Dual,
             0x00 => ReturnMode::Unspecified,
-            other => return Err(format!("return mode byte {other:#04x} unknown")),
+            other => {
+                return Err(fault(
+                    "with a return mode byte no sensor sends",
+                    format!("return mode byte {other:#04x} unknown"),
+                ));
+            }
         };
         let product = match payload[1205] {
             0x21 => Product::Hdl32e,
             0x22 => Product::Vlp16,
             0x00 => Product::Unspecified,
             other => {
-                return Err(format!(
-                    "product byte {other:#04x}: not an HDL-32E (0x21) or a VLP-16 (0x22)"
+                return Err(fault(
+                    "of a sensor not read here (product byte not 0x21 or 0x22)",
+                    format!("product byte {other:#04x}: not an HDL-32E (0x21) or a VLP-16 (0x22)"),
                 ));
             }
         };

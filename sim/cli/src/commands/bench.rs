@@ -14,8 +14,8 @@ use crate::emit;
 pub struct BenchArgs {
     /// What to measure.
     pub what: BenchTarget,
-    /// One JSON object per figure on stdout instead of a table (`bench figures`: one object;
-    /// `bench representations`: the results, one JSON array, as `representations.json`).
+    /// JSON lines on stdout instead of a table: one object per figure (`bench figures`: one
+    /// object; `bench representations`: one per scene, as `representations.json` lists them).
     #[arg(long)]
     pub json: bool,
     /// Timed batches per figure, the median reported (default 15; `bench loop`: runs of each

@@ -29,7 +29,7 @@ pub struct CompareLidarArgs {
     /// Seed of the synthetic sensor's noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Write both sensors' figures, every beam's, as JSON here (atomically).
+    /// Write both sensors' figures, every beam's, here (atomically): one JSON object, one line.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
 }
@@ -62,10 +62,11 @@ pub fn run(args: &CompareLidarArgs) -> anyhow::Result<()> {
         test,
     )?;
     if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&serde_json::json!({
+        // One object on one line, as every `--json` writes.
+        let text = serde_json::to_string(&serde_json::json!({
             "sensors": [&real, &synthetic],
             "rows": rows(&real, &synthetic),
-        }))?;
+        }))? + "\n";
         mapper::write_atomically(path, text.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
     }

@@ -192,14 +192,18 @@ pub fn run(
     write_all(&results, out, json)
 }
 
-/// The headline on stdout (`json`: the results as JSON instead, one array, as
-/// `representations.json` holds them); with `out`, the tables and the JSON in it.
+/// The headline on stdout (`json`: the results as JSON lines instead, one scene's object a
+/// line); with `out`, the tables and the JSON (one array, `representations.json`) in it.
 fn write_all(results: &[SceneResult], out: Option<&Path>, json: bool) -> anyhow::Result<()> {
     let mut text =
         String::from("Against the thesis' representation (multi-height, cumulative):\n\n");
     text.push_str(&study::table::headline(results));
     if json {
-        emit(&format!("{}\n", serde_json::to_string(results)?))?;
+        let mut lines = String::new();
+        for r in results {
+            writeln!(lines, "{}", serde_json::to_string(r)?)?;
+        }
+        emit(&lines)?;
     } else {
         emit(&text)?;
     }

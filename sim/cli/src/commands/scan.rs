@@ -1,5 +1,6 @@
 //! `taxi-sim scan`: one LiDAR revolution of a scenario's world from a point of its route, or one
-//! revolution of a real Velodyne capture, as PLY.
+//! revolution of a real Velodyne capture, as PLY; a scenario's revolutions as a Velodyne capture
+//! (`--out FILE.pcap`), what VeloView and the ROS driver read.
 
 use std::path::PathBuf;
 
@@ -41,9 +42,16 @@ pub struct ScanArgs {
     /// Where on the route, metres along it from its first point (0 = the start pose).
     #[arg(long, default_value_t = 0.0)]
     pub at: f64,
-    /// Output PLY file.
+    /// Output file: PLY, or - ending in `.pcap`, for a scenario - a Velodyne capture of the
+    /// sensor's packets (HDL-32E or VLP-16, as `--lidar-model` or `[lidar]` say).
     #[arg(long)]
     pub out: PathBuf,
+    /// Revolutions to write to a `.pcap`, the sensor standing (default 1).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub revolutions: usize,
+    /// The sensor model instead of `[lidar]`'s beams: `hdl-32e` or `vlp-16`.
+    #[arg(long, value_name = "MODEL", conflicts_with = "pcap")]
+    pub lidar_model: Option<String>,
     /// Frame of the points.
     #[arg(long, value_enum, default_value_t = Frame::World)]
     pub frame: Frame,
@@ -102,8 +110,32 @@ pub fn run(args: &ScanArgs) -> anyhow::Result<()> {
         Some(path) => RunConfig::from_file(path)?,
         None => RunConfig::default(),
     };
+    let lidar_config = match &args.lidar_model {
+        Some(name) => config.lidar.with_model(name).ok_or_else(|| {
+            anyhow::anyhow!("--lidar-model {name}: not a model (hdl-32e, vlp-16)")
+        })?,
+        None => config.lidar,
+    };
+    let hz = lidar_config.rotation_frequency_hz;
     let lidar =
-        Lidar::new(config.lidar, vehicle.vehicle_from_lidar()).map_err(anyhow::Error::msg)?;
+        Lidar::new(lidar_config, vehicle.vehicle_from_lidar()).map_err(anyhow::Error::msg)?;
+    if args.out.extension().is_some_and(|e| e == "pcap") {
+        anyhow::ensure!(args.revolutions >= 1, "--revolutions: at least 1");
+        let scans: Vec<_> = (0..args.revolutions as u64)
+            .map(|r| lidar.scan(&world, &SweepPoses::still(pose), r, scenario.seed))
+            .collect();
+        let packets = sim::pcap::write_capture(&scans, hz, 0.0, &args.out)?;
+        let n: usize = scans
+            .iter()
+            .map(|s| s.scan.returns().iter().flatten().count())
+            .sum();
+        return crate::emit(&format!(
+            "{}: {} revolution(s), {n} returns in {packets} data packets; wrote {}\n",
+            scenario.name,
+            scans.len(),
+            args.out.display()
+        ));
+    }
     let scan = lidar.scan(&world, &SweepPoses::still(pose), 0, scenario.seed);
     sim::world::ply::write(&scan, args.frame.into(), &args.out)
         .with_context(|| format!("writing {}", args.out.display()))?;

@@ -283,8 +283,22 @@ fn model_coverage_reports_each_level_and_draws_them() {
     assert!(stderr.contains("cell"), "{stderr}");
 }
 
-/// `--json` means JSON: `bench representations --json` prints the results as one JSON array
-/// (what `representations.json` holds), and no Markdown; `--redraw DIR --json` the same again.
+/// Every line of `stdout` one JSON object (what `--json` promises), parsed.
+fn json_lines(stdout: &str) -> Vec<serde_json::Value> {
+    assert!(!stdout.trim().is_empty(), "nothing printed");
+    stdout
+        .lines()
+        .map(|line| {
+            let v: serde_json::Value = serde_json::from_str(line)
+                .unwrap_or_else(|e| panic!("not a JSON line ({e}): {line}"));
+            assert!(v.is_object(), "not an object: {line}");
+            v
+        })
+        .collect()
+}
+
+/// `--json` means JSON: `bench representations --json` prints one scene's results a line (what
+/// `representations.json` lists), and no Markdown; `--redraw DIR --json` the same again.
 #[test]
 fn bench_representations_json_is_json() {
     let dir = tempfile::tempdir().unwrap();
@@ -294,6 +308,8 @@ fn bench_representations_json_is_json() {
         "representations",
         "--scenario",
         "../../scenarios/straight_cone_under_wing.toml",
+        "--scenario",
+        "../../scenarios/cone_in_path_car.toml",
         "--poses",
         "50",
         "--out",
@@ -301,13 +317,12 @@ fn bench_representations_json_is_json() {
         "--json",
     ]);
     assert_eq!(code, 0, "{stderr}");
-    let printed: serde_json::Value =
-        serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("not JSON ({e}): {stdout}"));
+    let printed = json_lines(&stdout);
     let written: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("representations.json")).unwrap())
             .unwrap();
-    assert_eq!(printed, written);
-    assert_eq!(printed.as_array().map(Vec::len), Some(1));
+    assert_eq!(Some(&printed), written.as_array());
+    assert_eq!(printed.len(), 2);
     assert!(printed[0]["rows"].as_array().is_some_and(|r| r.len() >= 3));
     assert!(out.join("representations.md").exists());
     let (code, again, stderr) = taxi_sim(&[
@@ -318,8 +333,69 @@ fn bench_representations_json_is_json() {
         "--json",
     ]);
     assert_eq!(code, 0, "{stderr}");
-    assert_eq!(
-        serde_json::from_str::<serde_json::Value>(&again).unwrap(),
-        written
-    );
+    assert_eq!(Some(&json_lines(&again)), written.as_array());
+}
+
+/// Every command with a `--json` switch prints JSON lines on stdout and nothing else: the
+/// commands are found in `taxi-sim --help` (so a new `--json` without a case here fails), each
+/// run small.
+#[test]
+fn every_json_switch_prints_json_lines() {
+    let (code, top, _) = taxi_sim(&["--help"]);
+    assert_eq!(code, 0);
+    // Every subcommand path (`bench`, `model coverage`, ...) whose help lists a `--json`
+    // switch (not `--json <FILE>`, which writes a file).
+    let mut with_switch = Vec::new();
+    let mut pending: Vec<Vec<String>> = commands_in(&top).into_iter().map(|c| vec![c]).collect();
+    while let Some(path) = pending.pop() {
+        let mut args: Vec<&str> = path.iter().map(String::as_str).collect();
+        args.push("--help");
+        let (_, help, _) = taxi_sim(&args);
+        pending.extend(commands_in(&help).into_iter().map(|c| {
+            let mut p = path.clone();
+            p.push(c);
+            p
+        }));
+        let switch = |l: &str| {
+            let mut words = l.split_whitespace();
+            words.next() == Some("--json") && !words.next().is_some_and(|w| w.starts_with('<'))
+        };
+        if help.lines().any(switch) {
+            with_switch.push(path.join(" "));
+        }
+    }
+    with_switch.sort();
+    let cases: &[(&str, &[&str])] = &[
+        ("bench", &["bench", "mapper", "--samples", "1", "--json"]),
+        (
+            "model coverage",
+            &[
+                "model",
+                "coverage",
+                "praetor600",
+                "--margin-m",
+                "4",
+                "--json",
+            ],
+        ),
+    ];
+    let covered: Vec<String> = cases.iter().map(|(c, _)| (*c).to_string()).collect();
+    assert_eq!(with_switch, covered, "a --json switch with no case here");
+    for (name, args) in cases {
+        let (code, stdout, stderr) = taxi_sim(args);
+        assert_eq!(code, 0, "{name}: {stderr}");
+        assert!(!json_lines(&stdout).is_empty(), "{name}");
+    }
+}
+
+/// The subcommands a `--help` lists under `Commands:` (`help` aside).
+fn commands_in(help: &str) -> Vec<String> {
+    help.lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .map(str::to_string)
+        .collect()
 }

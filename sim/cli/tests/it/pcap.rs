@@ -178,3 +178,74 @@ fn bad_pcap_arguments_exit_2_naming_them() {
         "{err}"
     );
 }
+
+/// `scan SCENARIO --out FILE.pcap`: the simulator's VLP-16 written as a capture that `scan
+/// --pcap` reads back (the revolutions, the sensor's height from the ground), the same file cut
+/// inside its last packet read up to the cut with a line saying what was skipped; a LiDAR model
+/// that is not one, or a revolution count of 0, exit 2 naming the flag.
+#[test]
+fn a_scenario_written_as_a_capture_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let pcap = dir.path().join("vlp16.pcap");
+    let (code, out, err) = taxi_sim(&[
+        "scan",
+        "../../scenarios/straight_cone_under_wing.toml",
+        "--lidar-model",
+        "vlp-16",
+        "--revolutions",
+        "2",
+        "--out",
+        pcap.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("2 revolution(s)") && out.contains("in 150 data packets"),
+        "{out}"
+    );
+    let ply = dir.path().join("back.ply");
+    let (code, out, err) = taxi_sim(&[
+        "scan",
+        "--pcap",
+        pcap.to_str().unwrap(),
+        "--revolution",
+        "0",
+        "--out",
+        ply.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    // The Praetor's LiDAR stands 2.15 m up on the straight road's flat ground.
+    assert!(
+        out.contains("revolution 0 of 2")
+            && out.contains("in 1800 firings of 16 lasers, the sensor 2.15 m"),
+        "{out}"
+    );
+    let bytes = std::fs::read(&pcap).unwrap();
+    let cut = dir.path().join("cut.pcap");
+    std::fs::write(&cut, &bytes[..bytes.len() - 500]).unwrap();
+    let (code, _, err) = taxi_sim(&[
+        "scan",
+        "--pcap",
+        cut.to_str().unwrap(),
+        "--revolution",
+        "0",
+        "--out",
+        ply.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("cut short: the file ends inside it (the first packet 149)"),
+        "{err}"
+    );
+    for (flag, value) in [("--lidar-model", "vlp-32"), ("--revolutions", "0")] {
+        let (code, _, err) = taxi_sim(&[
+            "scan",
+            "../../scenarios/straight_cone_under_wing.toml",
+            flag,
+            value,
+            "--out",
+            pcap.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{flag}: {err}");
+        assert!(err.contains(flag), "{flag}: {err}");
+    }
+}

@@ -20,9 +20,13 @@ fn error_of(bytes: &[u8]) -> String {
 fn hostile_captures_are_located_errors() {
     let good = packet([0; 12], 0).encode();
     let whole = pcap(1, &[ethernet_udp(2368, &good), ethernet_udp(2368, &good)]);
-    // Cut inside the second packet.
-    let e = error_of(&whole[..whole.len() - 100]);
-    assert!(e.contains("cut short") && e.contains("packet 1"), "{e}");
+    // Cut inside the first packet: nothing to read, and the error says so.
+    let e = error_of(&whole[..24 + 16 + 600]);
+    assert!(
+        e.contains("no Velodyne data packets")
+            && e.contains("1 cut short: the file ends inside it (the first packet 0)"),
+        "{e}"
+    );
     // Not a capture at all.
     let e = error_of(b"# not a capture\n");
     assert!(e.contains("not a pcap"), "{e}");
@@ -32,24 +36,22 @@ fn hostile_captures_are_located_errors() {
         e.contains("packet 0") && e.contains("link type 105 not supported"),
         "{e}"
     );
-    // A packet from another sensor (product byte 0x28, a VLP-32C).
+    // Only packets of a sensor not read here (product byte 0x28, a VLP-32C).
     let mut other = good.clone();
     other[1205] = 0x28;
-    let e = error_of(&pcap(
-        1,
-        &[ethernet_udp(2368, &good), ethernet_udp(2368, &other)],
-    ));
+    let e = error_of(&pcap(1, &[ethernet_udp(2368, &other)]));
     assert!(
-        e.contains("packet 1") && e.contains("product byte 0x28"),
+        e.contains("no Velodyne data packets")
+            && e.contains("1 to port 2368 of a sensor not read here (product byte not 0x21 or 0x22) (the first packet 0)"),
         "{e}"
     );
-    // A block whose flag is not 0xEEFF (an HDL-64E's lower bank).
+    // Only a packet with a block whose flag is not 0xEEFF (an HDL-64E's lower bank).
     let mut lower = good.clone();
     lower[300] = 0xff;
     lower[301] = 0xdd;
     let e = error_of(&pcap(1, &[ethernet_udp(2368, &lower)]));
     assert!(
-        e.contains("packet 0") && e.contains("block 3: flag 0xddff"),
+        e.contains("no Velodyne data packets") && e.contains("block flag other than 0xeeff"),
         "{e}"
     );
     // A VLP-16 packet among HDL-32E ones.
@@ -81,8 +83,8 @@ fn hostile_captures_are_located_errors() {
 /// Odd packets among good ones are skipped and counted by why, as VeloView reads on past them:
 /// a position packet whose IPv4 header claims more bytes than it has (a recording tool's quirk
 /// seen in a real VLP-16 capture), a data packet cut by the snap length, an IPv4 fragment to the
-/// data port, a datagram to the data port of another length; the good packets decode as they do
-/// without them.
+/// data port, a datagram to the data port of another length, data packets no sensor would send,
+/// and a last packet the file ends inside; the good packets decode as they do without them.
 #[test]
 fn odd_packets_among_good_ones_are_skipped_and_counted() {
     let dir = tempfile::tempdir().unwrap();
@@ -97,34 +99,53 @@ fn odd_packets_among_good_ones_are_skipped_and_counted() {
     fragment[14 + 6] = 0x20; // more fragments
     let other_length = ethernet_udp(2368, &[0u8; 100]);
     let snapped = good[1][..300].to_vec();
-    let records = [
+    // Data packets that cannot be a sensor's: a block flag, an azimuth, a return mode byte and a
+    // product byte no sensor sends.
+    let payload = packet([0; 12], 0).encode();
+    let odd_data = [(200, 0x00), (202, 0xff), (1204, 0x41), (1205, 0x28)].map(|(at, byte)| {
+        let mut p = payload.clone();
+        p[at] = byte;
+        if at == 202 {
+            p[203] = 0xff; // azimuth 655.35 degrees
+        }
+        ethernet_udp(2368, &p)
+    });
+    let mut records = vec![
         good[0].clone(),
         position,
         good[1].clone(),
         fragment,
         snapped.clone(),
         other_length,
-        good[2].clone(),
     ];
+    records.extend(odd_data);
+    records.push(good[2].clone());
     let mut bytes = pcap(1, &records);
     // The snapped record (the fifth) says 300 of its whole length kept.
     let at = 24 + records[..4].iter().map(|r| 16 + r.len()).sum::<usize>();
     bytes[at + 12..at + 16].copy_from_slice(&(good[1].len() as u32).to_le_bytes());
+    // And the file cut inside a last, eleventh packet (the recorder stopped mid-write).
+    bytes.extend(&bytes[24..24 + 16 + 700].to_vec());
     let c = Capture::read(&write(dir.path(), "odd.pcap", &bytes)).unwrap();
     let decoded: Vec<_> = c.data.iter().map(|(_, p)| p.clone()).collect();
     let expected: Vec<_> = clean.data.iter().map(|(_, p)| p.clone()).collect();
     assert_eq!(decoded, expected);
     assert_eq!(
         c.data.iter().map(|(i, _)| *i).collect::<Vec<_>>(),
-        [0, 2, 6]
+        [0, 2, 10]
     );
-    assert_eq!(c.skipped.total(), 4, "{}", c.skipped);
+    assert_eq!(c.skipped.total(), 9, "{}", c.skipped);
     let text = c.skipped.to_string();
     for why in [
         "1 with an IPv4 total length outside the packet (the first packet 1)",
         "1 IPv4 fragments (Velodyne packets are never fragmented) (the first packet 3)",
         "1 cut short by the capture's snap length (the first packet 4)",
         "1 to port 2368 of neither 1206 nor 512 bytes (the first packet 5)",
+        "1 to port 2368 with a block flag other than 0xeeff (an HDL-64E's upper lasers, or not Velodyne data) (the first packet 6)",
+        "1 to port 2368 with an azimuth beyond 360 degrees (the first packet 7)",
+        "1 to port 2368 with a return mode byte no sensor sends (the first packet 8)",
+        "1 to port 2368 of a sensor not read here (product byte not 0x21 or 0x22) (the first packet 9)",
+        "1 cut short: the file ends inside it (the first packet 11)",
     ] {
         assert!(text.contains(why), "{why}: {text}");
     }

@@ -1,7 +1,7 @@
 //! Captures the tests build (a pcap written here, packets encoded here) decoded into points,
 //! revolutions and the mapper's scans: HDL-32E and VLP-16, single and dual return.
 
-use velodyne::{Calibration, Capture, DataPacket, Product, ReturnMode, frames};
+use velodyne::{Calibration, Capture, DataPacket, Echo, Product, ReturnMode, frames};
 
 use crate::common::{ethernet_udp, packet, pcap, write};
 
@@ -111,16 +111,44 @@ fn a_vlp16_block_is_two_columns() {
 }
 
 /// In dual-return mode a block pair repeats an azimuth; where the second repeats the first's
-/// distance (one echo), the return is counted once.
+/// distance (one echo), the return is counted once and marked last and strongest; where they
+/// differ, both are kept, the first block's marked last, the second's strongest. A single-return
+/// packet's points carry its mode.
 #[test]
-fn dual_return_pairs_count_a_single_echo_once() {
+fn dual_return_pairs_count_a_single_echo_once_and_mark_both_echoes() {
     let mut p = packet(std::array::from_fn(|k| 100 * (k as u16 / 2)), 5_000);
     p.return_mode = ReturnMode::Dual;
     // Block 1 (the pair of block 0) has a farther echo on channel 0.
     p.blocks[1].channels[0].0 += 500;
-    let f = frames(&[p], &Calibration::built_in(Product::Hdl32e).unwrap());
+    let calibration = Calibration::built_in(Product::Hdl32e).unwrap();
+    let f = frames(&[p.clone()], &calibration);
     assert_eq!(f.len(), 1);
-    assert_eq!(f[0].points.len(), 6 * 31 + 1);
+    let points = &f[0].points;
+    assert_eq!(points.len(), 6 * 31 + 1);
+    let of = |echo: Echo| points.iter().filter(|q| q.echo == echo).count();
+    assert_eq!(of(Echo::LastAndStrongest), 6 * 31 - 1);
+    assert_eq!((of(Echo::Last), of(Echo::DualStrongest)), (1, 1));
+    let (last, strongest) = (
+        points.iter().find(|q| q.echo == Echo::Last).unwrap(),
+        points
+            .iter()
+            .find(|q| q.echo == Echo::DualStrongest)
+            .unwrap(),
+    );
+    // One laser's firing: the same laser and firing, the strongest 500 units (1 m) farther.
+    assert_eq!(
+        (last.laser, last.firing),
+        (strongest.laser, strongest.firing)
+    );
+    assert!((strongest.distance_m - last.distance_m - 1.0).abs() < 1e-4);
+    for (mode, echo) in [
+        (ReturnMode::Strongest, Echo::Strongest),
+        (ReturnMode::Last, Echo::Last),
+    ] {
+        p.return_mode = mode;
+        let f = frames(&[p.clone()], &calibration);
+        assert!(f[0].points.iter().all(|q| q.echo == echo), "{mode:?}");
+    }
 }
 
 /// The VLP-16's precision azimuth (its manual, appendix: as VeloView and the ROS driver place
