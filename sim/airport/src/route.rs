@@ -252,6 +252,56 @@ fn nearest_on_edges(
         .map(|(i, p, t, _)| (i, p, t))
 }
 
+/// Where a stand's axis (the line through it along its heading) meets taxilane `edge`, and how
+/// far along the edge (0 at its start node, 1 at its end): the point an aircraft is pushed back
+/// to, or turns in at, so that it stands on the stand aligned as the file places it. `None` where
+/// the axis runs within 30 degrees of the edge's line, or meets it off the edge.
+fn stand_join(
+    network: &Network,
+    edge: usize,
+    stand: &crate::model::Stand,
+) -> Option<(Vector2<f64>, f64)> {
+    let e = &network.edges[edge];
+    let (a, b) = (network.nodes[e.from].at, network.nodes[e.to].at);
+    let along = b - a;
+    let axis = Vector2::new(stand.yaw_rad.cos(), stand.yaw_rad.sin());
+    let cross = |u: &Vector2<f64>, v: &Vector2<f64>| u.x * v.y - u.y * v.x;
+    let denominator = cross(&along, &axis);
+    if denominator.abs() < 0.5 * along.norm() {
+        return None;
+    }
+    // a + t (b - a) = stand + s axis, solved for t.
+    let t = cross(&(stand.at - a), &axis) / denominator;
+    (0.0..=1.0).contains(&t).then(|| (a + along * t, t))
+}
+
+/// How much farther than the nearest taxilane a stand's axis may meet the one it is joined to
+/// (m): an aircraft is pushed straight back to a taxilane its axis meets rather than dragged
+/// across to a nearer one beside it.
+const AXIS_JOIN_SLACK_M: f64 = 60.0;
+
+/// Where an aircraft leaves or enters `stand` on the network: the admitting taxilane its axis
+/// meets nearest (`stand_join`), when no more than [`AXIS_JOIN_SLACK_M`] farther than the
+/// nearest taxilane; else the nearest taxilane's point nearest it. (edge, point, where along.)
+fn stand_place(
+    graph: &Graph,
+    stand: &crate::model::Stand,
+    code: SizeClass,
+) -> Option<(usize, Vector2<f64>, f64)> {
+    let (edge, p, t) = nearest_on_edges(graph, stand.at, code)?;
+    let nearest = (p - stand.at).norm();
+    let network = graph.network;
+    network
+        .edges
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.class != EdgeClass::Runway && e.admits(code))
+        .filter_map(|(i, _)| stand_join(network, i, stand).map(|(k, t)| (i, k, t)))
+        .filter(|(_, k, _)| (k - stand.at).norm() <= nearest + AXIS_JOIN_SLACK_M)
+        .min_by(|a, b| (a.1 - stand.at).norm().total_cmp(&(b.1 - stand.at).norm()))
+        .or(Some((edge, p, t)))
+}
+
 /// A stand's place on the network: the edge it leaves or joins by, and where along it.
 type OnEdge = Option<(usize, f64)>;
 
@@ -274,7 +324,7 @@ fn start_point(
         Place::Runway(number) => runway_node_at_threshold(airport, number).map(|n| (n, None)),
         Place::Stand(name) => {
             let stand = airport.find_stand(name)?;
-            let (edge, p, t) = nearest_on_edges(graph, stand.at, code).ok_or_else(|| {
+            let (edge, p, t) = stand_place(graph, stand, code).ok_or_else(|| {
                 format!("no taxiway admitting code {code} to leave stand `{name}` by")
             })?;
             let e = graph.network.edges[edge].clone();
@@ -331,7 +381,7 @@ fn end_points(
                     "stand `{name}` takes aircraft up to code {class}, not {code}"
                 ));
             }
-            let (edge, p, t) = nearest_on_edges(graph, stand.at, code).ok_or_else(|| {
+            let (edge, p, t) = stand_place(graph, stand, code).ok_or_else(|| {
                 format!("no taxiway admitting code {code} to reach stand `{name}` by")
             })?;
             let e = graph.network.edges[edge].clone();

@@ -17,6 +17,8 @@ use crate::error::{Error, Result};
 pub struct RouteOverlay {
     /// Its points.
     pub points: Vec<Vector2<f64>>,
+    /// The push-back before it, from the stand to where the tug lets go (drawn dashed), if any.
+    pub pushback: Vec<Vector2<f64>>,
     /// What it is (the legend).
     pub label: String,
 }
@@ -204,7 +206,8 @@ fn draw<DB: DrawingBackend>(
     Ok(())
 }
 
-/// The route: a thick line, a green start and a red end, its label top left.
+/// The route: a thick line (the push-back before it dashed), a green start and a red end, its
+/// label top left.
 fn draw_route<DB: DrawingBackend>(
     plot: &Plot<DB>,
     route: &RouteOverlay,
@@ -217,7 +220,15 @@ fn draw_route<DB: DrawingBackend>(
         points.clone(),
         RGBColor(20, 20, 160).stroke_width(4),
     ))?;
-    if let (Some(first), Some(last)) = (points.first(), points.last()) {
+    // The push-back: the tug's path, dashed in orange, from the stand (the start).
+    let tow: Vec<(f64, f64)> = route.pushback.iter().map(xy).collect();
+    for pair in tow.chunks(2).filter(|c| c.len() == 2) {
+        plot.draw(&PathElement::new(
+            pair.to_vec(),
+            RGBColor(230, 120, 0).stroke_width(4),
+        ))?;
+    }
+    if let (Some(first), Some(last)) = (tow.first().or(points.first()), points.last()) {
         plot.draw(&Circle::new(*first, 7, RGBColor(0, 170, 0).filled()))?;
         plot.draw(&Circle::new(*last, 7, RED.filled()))?;
         plot.draw(&Text::new(

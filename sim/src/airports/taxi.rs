@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 
 use aircraft::Vehicle;
-use airport::{Airport, NetworkRoute, PathOptions, Place, RouteRequest, SizeClass, TaxiPath};
+use airport::{Airport, NetworkRoute, PathOptions, Place, RouteRequest, SizeClass, TaxiPath, Tow};
 
 use crate::error::{Error, Result};
 
@@ -28,6 +28,9 @@ pub struct PlannedTaxi {
     pub route: NetworkRoute,
     /// The path driven, with its speed limits.
     pub path: TaxiPath,
+    /// From a stand the aircraft faces away from its taxilane: the push-back before the path
+    /// (which then starts at its release point).
+    pub pushback: Option<Tow>,
 }
 
 impl PlannedTaxi {
@@ -70,6 +73,13 @@ impl PlannedTaxi {
                 format!("; crosses runway zones {}", self.route.crossings.join(", "))
             }
         );
+        if let Some(tow) = &self.pushback {
+            let _ = writeln!(
+                out,
+                "  pushed back {:.0} m tail first from the stand (the tug's tightest turn {:.1} m), released on the taxilane facing the route",
+                tow.length_m, tow.radius_m
+            );
+        }
         out
     }
 }
@@ -114,17 +124,31 @@ pub fn plan_taxi(
         via: via.to_vec(),
         code,
     };
-    let route = airport::find(airport, &request).map_err(|e| Error::Invalid(e.to_string()))?;
+    // From a stand: on the stand as the file places the aircraft, pushed back where it faces
+    // away from its taxilane (the tug turns it as tight as the aircraft itself can turn).
+    let stand = match &request.from {
+        Place::Stand(name) => Some(airport.find_stand(name).map_err(Error::Invalid)?),
+        _ => None,
+    };
+    let from_stand = |route: NetworkRoute| -> Result<(NetworkRoute, Option<Tow>)> {
+        match stand {
+            Some(stand) => airport::leave_stand(stand, &route, vehicle.min_turn_radius_m())
+                .map_err(|e| Error::Invalid(e.to_string())),
+            None => Ok((route, None)),
+        }
+    };
+    let err = |e: airport::AirportError| Error::Invalid(e.to_string());
+    let (route, pushback) = from_stand(airport::find(airport, &request).map_err(err)?)?;
     let options = path_options(vehicle, turn_radius_m, speed_m_s);
     // On the paint where the network strays; should the paint's line not round for this
     // aircraft (its turn radius) where the network's does, the network's own line.
-    let (route, path) = match airport::smooth(&route, &options) {
-        Ok(path) => (route, path),
+    let (route, path, pushback) = match airport::smooth(&route, &options) {
+        Ok(path) => (route, path, pushback),
         Err(on_paint) => {
-            let network = airport::find_on_network(airport, &request)
-                .map_err(|e| Error::Invalid(e.to_string()))?;
+            let (network, pushback) =
+                from_stand(airport::find_on_network(airport, &request).map_err(err)?)?;
             match airport::smooth(&network, &options) {
-                Ok(path) => (network, path),
+                Ok(path) => (network, path, pushback),
                 Err(_) => return Err(Error::Invalid(on_paint.to_string())),
             }
         }
@@ -134,5 +158,6 @@ pub fn plan_taxi(
         code,
         route,
         path,
+        pushback,
     })
 }

@@ -36,7 +36,9 @@ impl Rig<'_> {
             if self.t_s > self.timeout_s {
                 return Ok(EndReason::TimedOut);
             }
+            // No pilot is called while the tug has the aircraft.
             if self.external.is_none()
+                && self.towing.is_none()
                 && let Some(end) = self.pilot_called()
             {
                 return Ok(end);
@@ -78,15 +80,29 @@ impl Rig<'_> {
                 self.own_stack_step(tasks, &truth, observer)?
             };
             let physics = Instant::now();
-            self.bicycle.step(&mut self.state, &command, dt);
+            // Towed, the stack's command is not the vehicle's.
+            let (released, speed_command) = match self.towing.as_mut() {
+                Some(tow) => (tow.step(&mut self.state, dt), self.state.speed_m_s),
+                None => {
+                    self.bicycle.step(&mut self.state, &command, dt);
+                    (false, command.speed_m_s)
+                }
+            };
             self.t_s += dt;
             self.step += 1;
             self.world
                 .set_vehicle_pose(&self.state.world_from_vehicle(), self.t_s);
+            if let Some(tow) = self.towing.as_mut() {
+                tow.note(&self.world);
+                if released {
+                    self.pushback = Some(tow.report(self.t_s));
+                    self.towing = None;
+                }
+            }
             self.split.physics += physics.elapsed().as_secs_f64();
-            let verdict =
-                self.judge
-                    .after_step(self.t_s, &self.state, command.speed_m_s, &self.world);
+            let verdict = self
+                .judge
+                .after_step(self.t_s, &self.state, speed_command, &self.world);
             for (t, event) in self.judge.drain_events() {
                 observer.event(t, &event)?;
             }

@@ -5,7 +5,8 @@
 //! fault, traffic conflicts with movers - `conflict`: time to collision, post-encroachment time -,
 //! verdicts), the
 //! observer hook ([`Observer`]), the report ([`RunReport`]) and the run-time traffic
-//! ([`Traffic`]: each obstacle's pose and speed each step, drivers that yield to the vehicle).
+//! ([`Traffic`]: each obstacle's pose and speed each step, drivers that yield to the vehicle)
+//! and the push-back from a stand (`pushback`: the tug's kinematic tow, [`PushbackReport`]).
 //! The vocabulary of a run's outcome ([`Event`], [`PassOutcome`], [`EndReason`], [`Stop`], ...)
 //! is the leaf `outcome`, which the judge, the observer and the report all point down at.
 
@@ -19,6 +20,7 @@ mod outcome;
 mod pilot_call;
 mod pose_error;
 mod pose_source;
+mod pushback;
 mod report;
 mod rig;
 mod schedule;
@@ -44,6 +46,7 @@ pub use pose_error::{
     ErrorLog, ErrorStats, LocalizationErrors, LocalizationReport, localization_misses,
 };
 pub use pose_source::{LocalizationContext, Localizer, NoisyTruth, PoseSource, Truth, from_config};
+pub use pushback::{PushbackReport, TOW_SPEED_M_S};
 pub use report::{
     CLOSE_STATIC_M, CLOSEST_STATIC_COUNT, HiddenObstacle, Progress, RunReport, SpeedLowered,
     StaticClearance, TimeSplit,

@@ -32,6 +32,9 @@ pub struct RunReport {
     /// really there ([`super::PilotCallReport`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pilot_call: Option<super::PilotCallReport>,
+    /// The push-back from the stand, when the route began with one ([`super::PushbackReport`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pushback: Option<super::PushbackReport>,
     /// What the stack outside the process did, when one drove ([`super::run_external`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stack: Option<super::external::StackReport>,

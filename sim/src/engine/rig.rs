@@ -227,6 +227,10 @@ pub(super) struct Rig<'a> {
     pub(super) holds: super::pilot_call::HoldLog,
     /// The pilot call that ended the run, if one did.
     pub(super) pilot_call: Option<super::PilotCallReport>,
+    /// The push-back under way (a taxi route from a stand the vehicle faces away from its
+    /// taxilane), and once the tug let go what it did.
+    pub(super) towing: Option<super::pushback::Towing>,
+    pub(super) pushback: Option<super::PushbackReport>,
     /// A stack outside the process driving the vehicle instead of `driver`, if any.
     pub(super) external: Option<External<'a>>,
     /// The live map's scratch directory, removed with the rig.
@@ -346,6 +350,12 @@ impl<'a> Rig<'a> {
             start_unseen_told: false,
             holds: Default::default(),
             pilot_call: None,
+            towing: scenario
+                .route
+                .pushback
+                .as_ref()
+                .map(|t| super::pushback::Towing::new(t, vehicle.spec.motion.wheelbase_m)),
+            pushback: None,
             config,
             external: None,
             _live: live,
@@ -414,6 +424,7 @@ impl<'a> Rig<'a> {
             waiting_for,
             start_unseen_m2: self.driver.start_unseen_m2(),
             pilot_call: self.pilot_call.take(),
+            pushback: self.pushback.take(),
             stack: self.external.as_ref().map(|e| StackReport {
                 stale: e.stack.stale(),
                 ..e.report.clone()

@@ -90,7 +90,8 @@ pub fn map_drive_with(
     )?;
     // One revolution every 0.1 s at the route's speed.
     let spacing = (scenario.route.speed_m_s * 0.1).max(0.05);
-    let scans = (route.length_m() / spacing).ceil() as usize + 1;
+    let poses = drive_poses(scenario, &route, spacing);
+    let scans = poses.len();
     // Each revolution is cast beside the insertion of the one before (the same insertions, in
     // the same order: the same map).
     let mut taken: Option<(Isometry2<f64>, mapper::Scan)> = None;
@@ -98,12 +99,9 @@ pub fn map_drive_with(
         if let Some((pose, scan)) = &taken {
             revolution(((k - 1) as f64 * 0.1, pose, scan))?;
         }
-        let cast = (k < scans).then(|| {
-            let s = (k as f64 * spacing).min(route.length_m());
-            let (p, heading) = route.at(s);
-            let pose = Isometry2::new(p.coords, heading);
-            world.set_vehicle_pose(&pose, k as f64 * 0.1);
-            pose
+        let cast = poses.get(k).map(|pose| {
+            world.set_vehicle_pose(pose, k as f64 * 0.1);
+            *pose
         });
         let (scan, inserted) = rayon::join(
             || {
@@ -139,6 +137,32 @@ pub fn map_drive_with(
             route.length_m(),
         ),
     )
+}
+
+/// The mapping drive's poses, `spacing` metres apart: the push-back's from the stand first, when
+/// the route begins with one (so the stand is mapped as the run will meet it), then the route's.
+fn drive_poses(scenario: &Scenario, route: &RoutePath, spacing: f64) -> Vec<Isometry2<f64>> {
+    let mut poses = Vec::new();
+    if let Some(tow) = &scenario.route.pushback {
+        let mut left = 0.0;
+        for w in tow.poses.windows(2) {
+            let ((a, ya), (b, yb)) = (w[0], w[1]);
+            let len = (b - a).norm();
+            while left <= len {
+                let f = if len > 0.0 { left / len } else { 0.0 };
+                let yaw = ya + crate::world::wrap_angle(yb - ya) * f;
+                poses.push(Isometry2::new(a + (b - a) * f, yaw));
+                left += spacing;
+            }
+            left -= len;
+        }
+    }
+    let scans = (route.length_m() / spacing).ceil() as usize + 1;
+    poses.extend((0..scans).map(|k| {
+        let (p, heading) = route.at((k as f64 * spacing).min(route.length_m()));
+        Isometry2::new(p.coords, heading)
+    }));
+    poses
 }
 
 /// Exports a flushed map's levels from its blocks in `out` and writes its manifest, made of

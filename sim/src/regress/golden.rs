@@ -27,6 +27,32 @@ fn round(x: f64, step: f64) -> Value {
 /// ended, laps, stops, contacts, every pass, the static objects it came nearest (an airport's
 /// lights and signs, ground truth); wall time and real-time factor left out.
 pub fn summary(r: &RunReport) -> Value {
+    let mut v = numbers(r);
+    // A run that began with a push-back: how long it was and what it came nearest (only then:
+    // the other goldens stay as they were).
+    if let (Some(p), Some(map)) = (&r.pushback, v.as_object_mut()) {
+        map.insert(
+            "pushback".into(),
+            json!(format!(
+                "{} m, released at {} s, {}",
+                round(p.length_m, 0.1),
+                round(p.released_s, 0.1),
+                p.nearest_object.as_deref().map_or_else(
+                    || "nothing within range".to_string(),
+                    |id| format!(
+                        "nearest {} at {} m",
+                        id.split('/').next().unwrap_or(id),
+                        round(p.min_clearance_m, 0.05)
+                    )
+                )
+            )),
+        );
+    }
+    v
+}
+
+/// [`summary`] but the push-back.
+fn numbers(r: &RunReport) -> Value {
     json!({
         "scenario": r.scenario,
         "seed": r.seed,

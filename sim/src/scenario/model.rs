@@ -67,6 +67,9 @@ pub struct Route {
     pub speed_m_s: f64,
     /// A speed limit at each waypoint, m/s (a taxi route's turns, braked into), if any.
     pub speed_limits_m_s: Option<Vec<f64>>,
+    /// A taxi route from a stand the aircraft faces away from its taxilane: the push-back that
+    /// brings it from the stand (the start pose) to the route's first waypoint, towed.
+    pub pushback: Option<airport::Tow>,
 }
 
 impl Route {

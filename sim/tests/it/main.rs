@@ -18,6 +18,7 @@ mod scenario;
 mod short_obstacles;
 mod small_obstacles;
 mod smoke_campaign;
+mod stands;
 mod taxi_plan;
 mod traffic;
 mod traffic_judge;

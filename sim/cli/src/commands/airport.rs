@@ -74,6 +74,11 @@ fn show(args: &ShowArgs) -> anyhow::Result<()> {
         text.push_str(&planned.describe());
         overlay = Some(sim::airports::RouteOverlay {
             points: planned.path.points.clone(),
+            pushback: planned
+                .pushback
+                .iter()
+                .flat_map(|t| t.poses.iter().map(|p| p.0))
+                .collect(),
             label: planned.title(),
         });
     }

@@ -447,6 +447,7 @@ pub fn table(r: &RunReport) -> String {
                 ))
         );
     }
+    pushback_line(&mut t, r);
     pilot_call_line(&mut t, r);
     obstacle_rows(&mut t, r);
     closest_static_row(&mut t, r);
@@ -551,6 +552,23 @@ fn obstacle_rows(t: &mut String, r: &RunReport) {
             );
         }
     }
+}
+
+/// The push-back from the stand: how long, and how near it came to what stands round the stand.
+fn pushback_line(t: &mut String, r: &RunReport) {
+    use std::fmt::Write as _;
+    let Some(p) = &r.pushback else {
+        return;
+    };
+    let nearest = match &p.nearest_object {
+        Some(id) => format!("nearest {id} at {:.2} m", p.min_clearance_m),
+        None => "nothing within range".to_string(),
+    };
+    let _ = writeln!(
+        t,
+        "push-back: {:.1} m tail first, turned at {:.1} m radius, released at {:.1} s; {nearest}",
+        p.length_m, p.radius_m, p.released_s
+    );
 }
 
 /// Why the pilot was called, and whether anything was really there.

@@ -130,6 +130,7 @@ impl Resolver<'_> {
             closed: false,
             speed_m_s: spec.speed_m_s.0,
             speed_limits_m_s: Some(planned.path.speed_m_s.clone()),
+            pushback: planned.pushback,
         })
     }
 

@@ -78,6 +78,7 @@ impl Resolver<'_> {
             closed: spec.closed,
             speed_m_s: spec.speed_m_s.0,
             speed_limits_m_s: None,
+            pushback: None,
         })
     }
 
@@ -167,6 +168,12 @@ impl Resolver<'_> {
                     ));
                 }
                 Isometry2::new(Vector2::new(p.x_m.0, p.y_m.0), p.yaw_rad.0)
+            }
+            // Pushed back: from the stand, on its heading.
+            None if route.pushback.is_some() => {
+                let first = route.pushback.as_ref().and_then(|t| t.poses.first());
+                let (at, yaw) = first.copied().unwrap_or_default();
+                Isometry2::new(at, yaw)
             }
             None => {
                 let (a, b) = (route.waypoints_m[0], route.waypoints_m[1]);

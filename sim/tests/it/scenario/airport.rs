@@ -55,14 +55,18 @@ fn an_airport_scenario_takes_its_world_from_the_file() {
     assert!(s.objects.iter().any(|o| o.id == "stand_S2/wing_left#3"));
     // Painted lines: one patch per segment.
     assert!(s.patches.len() > 1000 && s.patches.iter().all(|p| p.id.starts_with("line_")));
-    // The route: from abeam S3 to runway 27's hold point, turns braked into.
+    // The route: from where the tug lets go, 9.6 m east of abeam S3 (its push-back's turn and
+    // 5 m on), to runway 27's hold point, turns braked into; the vehicle starts on S3.
     let route = &s.route;
-    // 1,015 m on the network, 8 m less round its three right-angle turns (radius 6.04 m).
+    // 1,015 m on the network and the 9.6 m, 8 m less round its three right-angle turns (radius
+    // 6.04 m).
     assert!(
-        (route.length_m() - 1007.2).abs() < 0.5,
+        (route.length_m() - 1016.8).abs() < 0.5,
         "{}",
         route.length_m()
     );
+    let s3 = s.route.pushback.as_ref().expect("S3 is a gate").poses[0].0;
+    assert_eq!(s.vehicle.world_from_start.translation.vector, s3);
     let limits = route.speed_limits_m_s.as_ref().expect("speed limits");
     assert_eq!(limits.len(), route.waypoints_m.len());
     assert!(limits.contains(&6.0) && limits.iter().any(|&v| v < 2.5));
