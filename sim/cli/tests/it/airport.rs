@@ -30,16 +30,19 @@ fn show_summarises_routes_and_draws_the_fictional_airport() {
         "taxi network: 15 nodes, 17 edges (1 code B, 14 code C, 2 runway, 2 one-way), 4.2 km, 1 component(s)",
         "stands (4): 1 gate code B, 2 gate code C, 1 tie_down code A",
         "route stand S3 -> runway 27 via B, A (praetor600, code B)",
-        "1015 m along the taxiways, 1007 m driven",
+        // From the tug's release point, 9.6 m east of where S3's axis meets the taxilane.
+        "1025 m along the taxiways, 1017 m driven",
+        "pushed back 58 m tail first from the stand (the tug's tightest turn 4.6 m)",
         "tightest turn 6.0 m; speed 6.0 m/s on straights, down to 2.5 in turns",
     ] {
         assert!(out.contains(line), "{line}\n{out}");
     }
     let image = image::open(&picture).expect("a PNG");
     assert_eq!(image.width(), 2000);
-    // The route's start marker (green) and end marker (red) are drawn.
+    // The route's start marker (green), end marker (red) and the push-back (orange) are drawn.
     let rgb = image.to_rgb8();
     assert!(rgb.pixels().any(|p| p.0 == [0, 170, 0]) && rgb.pixels().any(|p| p.0 == [255, 0, 0]));
+    assert!(rgb.pixels().any(|p| p.0 == [230, 120, 0]));
 }
 
 #[test]
