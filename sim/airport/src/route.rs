@@ -226,6 +226,19 @@ fn on_runway(r: &crate::model::Runway, p: &Vector2<f64>) -> bool {
     (a + (b - a) * t - p).norm() <= r.width_m / 2.0 + 1.0
 }
 
+/// The network's edges an aircraft of `code` may taxi along to or from a stand (no runway), with
+/// their indices.
+fn taxilanes(
+    network: &Network,
+    code: SizeClass,
+) -> impl Iterator<Item = (usize, &crate::network::Edge)> {
+    network
+        .edges
+        .iter()
+        .enumerate()
+        .filter(move |(_, e)| e.class != EdgeClass::Runway && e.admits(code))
+}
+
 /// The admitting taxiway edge nearest `at`: its index, the nearest point on it and where that
 /// lies along it (0 at its start node, 1 at its end). Edges of no length are passed over.
 fn nearest_on_edges(
@@ -234,11 +247,7 @@ fn nearest_on_edges(
     code: SizeClass,
 ) -> Option<(usize, Vector2<f64>, f64)> {
     let network = graph.network;
-    network
-        .edges
-        .iter()
-        .enumerate()
-        .filter(|(_, e)| e.class != EdgeClass::Runway && e.admits(code))
+    taxilanes(network, code)
         .filter_map(|(i, e)| {
             let (a, b) = (network.nodes[e.from].at, network.nodes[e.to].at);
             let length2 = (b - a).norm_squared();
@@ -291,11 +300,7 @@ fn stand_place(
     let (edge, p, t) = nearest_on_edges(graph, stand.at, code)?;
     let nearest = (p - stand.at).norm();
     let network = graph.network;
-    network
-        .edges
-        .iter()
-        .enumerate()
-        .filter(|(_, e)| e.class != EdgeClass::Runway && e.admits(code))
+    taxilanes(network, code)
         .filter_map(|(i, _)| stand_join(network, i, stand).map(|(k, t)| (i, k, t)))
         .filter(|(_, k, _)| (k - stand.at).norm() <= nearest + AXIS_JOIN_SLACK_M)
         .min_by(|a, b| (a.1 - stand.at).norm().total_cmp(&(b.1 - stand.at).norm()))
