@@ -8,6 +8,7 @@
 mod capture;
 pub mod coverage;
 mod faults;
+mod ground;
 mod lidar;
 mod motion;
 mod odometry;
@@ -17,8 +18,9 @@ mod scene;
 
 pub use capture::{Captured, NamedLidar, Sensor};
 pub use faults::{FaultCounts, FaultsConfig, LostRevolutions, StaleMap, degrade, stale_scene};
+pub use ground::GroundTexture;
 pub use lidar::{Lidar, LidarConfig, LidarScan, SweepPoses};
 pub use motion::{Bicycle, Command, VehicleState, wrap_angle};
 pub use odometry::{OdometryConfig, OdometrySensor};
 pub use physics::{Contact, Owner, World, planar_to_3d, to_pose};
-pub use scene::{Area, GroundTexture, ObjectKind, Patch, Scene, Solid, SolidShape, pavement};
+pub use scene::{Area, ObjectKind, Patch, Scene, Solid, SolidShape, pavement};

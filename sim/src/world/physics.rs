@@ -87,7 +87,7 @@ pub struct World {
     scene: Scene,
     /// The ground's remission with the patches prepared and binned, built once (patches do not
     /// move; the LiDAR reads it every revolution).
-    ground: super::scene::GroundTexture,
+    ground: super::ground::GroundTexture,
     objects: Vec<ColliderHandle>,
     object_active: Vec<bool>,
     owners: HashMap<ColliderHandle, Owner>,
@@ -183,7 +183,7 @@ impl World {
         let n = objects.len();
         let mut world = World {
             physics,
-            ground: scene.ground_texture(),
+            ground: super::ground::GroundTexture::new(&scene),
             scene,
             objects,
             object_active: vec![true; n],
@@ -209,7 +209,7 @@ impl World {
         &self.scene
     }
     /// The ground's remission texture of the scene (prepared once).
-    pub fn ground_texture(&self) -> &super::scene::GroundTexture {
+    pub fn ground_texture(&self) -> &super::ground::GroundTexture {
         &self.ground
     }
     /// Simulation time of the last update, seconds.

@@ -514,7 +514,7 @@ impl Lidar {
     fn measure(
         &self,
         scene: &super::scene::Scene,
-        ground: &super::scene::GroundTexture,
+        ground: &super::ground::GroundTexture,
         rng: &mut Xoshiro256PlusPlus,
         (origin, d, bias): (Point3<f64>, &[f32; 3], f64),
         hit: Option<(f32, Owner)>,
