@@ -12,24 +12,37 @@ use crate::scenario::{RunConfig, Scenario};
 /// The static world's key: what the mapping drive depends on (world, static objects, patches,
 /// route, vehicle and start, seed, levels, map and LiDAR settings, a stale map's faults, the
 /// map format: a campaign directory of an older build gets new maps, not blocks it cannot read).
-/// Variants with the same key share one offline map.
+/// Variants with the same key share one offline map. An airport's survey (`[airport]
+/// surveyed_stands`) depends on what it saw and the legs it drove, not on the run's route,
+/// start, seed, speed or parked aircraft: every run at the airport with one vehicle shares it.
 pub fn static_world_key(scenario: &Scenario, config: &RunConfig) -> Result<String> {
+    let (seed, speed_m_s) = crate::offline_map::drive_seed_and_speed(scenario);
+    let drive = match &scenario.survey {
+        Some(survey) => format!("survey {:?}|{}", survey.legs, speed_m_s.to_bits()),
+        None => format!(
+            "{:?}|{:?}",
+            scenario.route, scenario.vehicle.world_from_start
+        ),
+    };
     let mut text = format!(
-        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{}|{:?}|{:?}|{:?}|{}",
+        "{:?}|{:?}|{:?}|{}|{:?}|{}|{:?}|{:?}|{:?}|{}",
         scenario.world,
-        scenario.objects,
+        scenario.survey_scene().solids,
         scenario.patches,
-        scenario.route,
+        drive,
         scenario.vehicle.vehicle,
-        scenario.vehicle.world_from_start,
-        scenario.seed,
+        seed,
         crate::offline_map::levels_of(scenario, config)?,
         crate::offline_map::map_config(config),
         config.lidar,
         crate::offline_map::MAP_FORMAT,
     );
     if config.faults.stale_map.any() {
-        text.push_str(&format!("|{:?}", config.faults.stale_map));
+        // A stale map's ghosts stand near the route.
+        text.push_str(&format!(
+            "|{:?}|{:?}",
+            config.faults.stale_map, scenario.route
+        ));
     }
     Ok(format!(
         "{:08x}{:06x}",
@@ -78,8 +91,20 @@ impl MapCache {
     /// The map of a scenario read from its own file (`taxi-sim regress`): driven as it is, its
     /// relative paths (vehicle sidecar, airport, pose file) resolved where the file lives.
     pub fn get_for_file(&self, scenario: &Scenario, config: &RunConfig) -> Result<PathBuf> {
+        self.get_for_file_showing(scenario, config, &|_, _| {})
+    }
+
+    /// [`MapCache::get_for_file`], calling `progress(done, total)` after each scan when it
+    /// drives the map (`taxi-sim run --maps-dir`'s bar: an airport's survey takes minutes).
+    pub fn get_for_file_showing(
+        &self,
+        scenario: &Scenario,
+        config: &RunConfig,
+        progress: &(dyn Fn(usize, usize) + Sync),
+    ) -> Result<PathBuf> {
         self.get_with(scenario, config, &|scratch| {
-            crate::offline_map::map_drive(scenario, config, scratch, &mut |_, _| {}).map(|_| ())
+            crate::offline_map::map_drive(scenario, config, scratch, &mut |d, t| progress(d, t))
+                .map(|_| ())
         })
     }
 

@@ -140,6 +140,8 @@ pub struct Campaign {
     base_doc: Table,
     drop_base_obstacles: bool,
     scenario: Option<Node>,
+    /// Fields set in every variant over the file's draws ([`Campaign::set_field`]).
+    set: Vec<(String, Value)>,
     obstacles: Vec<Node>,
     pool: Option<(Node, usize, Vec<Node>)>,
 }
@@ -277,6 +279,7 @@ impl Campaign {
             base_doc,
             drop_base_obstacles: spec.drop_base_obstacles,
             scenario,
+            set: Vec::new(),
             obstacles,
             pool,
         };
@@ -298,6 +301,24 @@ impl Campaign {
             self.sampler = kind;
             self.digest = format!("{}-{}", self.digest, kind.as_str());
         }
+    }
+
+    /// Sets scenario field `path` (dotted, as in `[scenario]`) to `value` in every variant, over
+    /// what the file sets or draws (`campaign run --set`): the same variants with one thing
+    /// changed. The digest follows (their results never share a directory with the file's own),
+    /// and the variant at the centre of the draws must still be a valid scenario.
+    pub fn set_field(&mut self, path: &str, value: Value) -> crate::Result<()> {
+        self.digest = format!(
+            "{}-set{:08x}",
+            self.digest,
+            crc32fast::hash(format!("{path}={value}").as_bytes())
+        );
+        self.set.push((path.to_string(), value));
+        let v = self.variant_at(0, &vec![0.5; self.layout.dims.len()]);
+        Scenario::from_str(&v.text, &self.variant_path(0)).map_err(|e| {
+            crate::Error::Invalid(format!("--set {path}: the variants are not valid: {e}"))
+        })?;
+        Ok(())
     }
 
     /// The base scenario.
@@ -348,6 +369,9 @@ impl Campaign {
             for (path, v) in t {
                 set_path(&mut doc, &path, v);
             }
+        }
+        for (path, v) in &self.set {
+            set_path(&mut doc, path, v.clone());
         }
         // Obstacles are placed along the variant's own route when its route or airport is drawn
         // (a taxi route from a drawn stand), else along the base's.

@@ -18,7 +18,7 @@ use mapper::{BlockIndex, BlockStore, GridGeometry, Levels, MultiHeightMap};
 use nalgebra::{Isometry2, Point2};
 
 use super::manifest::{MapManifest, fingerprint};
-use super::settings::{levels_of, map_config, self_filter_model};
+use super::settings::{drive_seed_and_speed, levels_of, map_config, self_filter_model};
 use crate::error::{Error, Result};
 use crate::scenario::RunConfig;
 use crate::scenario::Scenario;
@@ -67,11 +67,19 @@ pub fn map_drive_with(
     let blocks_dir = out.join("blocks");
     clear_blocks(&blocks_dir)?;
     let route = RoutePath::new(&scenario.route.waypoints_m, scenario.route.closed);
-    let start = scenario.vehicle.world_from_start;
+    let (seed, speed_m_s) = drive_seed_and_speed(scenario);
+    // One revolution every 0.1 s at the drive's speed.
+    let spacing = (speed_m_s * 0.1).max(0.05);
+    let poses = drive_poses(scenario, &route, spacing);
+    // A survey starts where it starts, not where the run does.
+    let start = match (&scenario.survey, poses.first()) {
+        (Some(_), Some(first)) => *first,
+        _ => scenario.vehicle.world_from_start,
+    };
     let scene = crate::world::stale_scene(
-        &scenario.static_scene(),
+        &scenario.survey_scene(),
         &config.faults.stale_map,
-        scenario.seed,
+        seed,
         &route,
     );
     let mut world = World::static_only(&scene, vehicle, &start);
@@ -88,9 +96,6 @@ pub fn map_drive_with(
         None,
         Some(&blocks_dir),
     )?;
-    // One revolution every 0.1 s at the route's speed.
-    let spacing = (scenario.route.speed_m_s * 0.1).max(0.05);
-    let poses = drive_poses(scenario, &route, spacing);
     let scans = poses.len();
     // Each revolution is cast beside the insertion of the one before (the same insertions, in
     // the same order: the same map).
@@ -106,8 +111,7 @@ pub fn map_drive_with(
         let (scan, inserted) = rayon::join(
             || {
                 cast.map(|pose| {
-                    let scan =
-                        lidar.scan(&world, &SweepPoses::still(pose), k as u64, scenario.seed);
+                    let scan = lidar.scan(&world, &SweepPoses::still(pose), k as u64, seed);
                     (pose, scan.scan)
                 })
             },
@@ -134,15 +138,36 @@ pub fn map_drive_with(
             fingerprint(scenario, config)?,
             scenario.name.clone(),
             scans,
-            route.length_m(),
+            scenario
+                .survey
+                .as_ref()
+                .map_or(route.length_m(), |s| s.length_m()),
         ),
     )
 }
 
-/// The mapping drive's poses, `spacing` metres apart: the push-back's from the stand first, when
-/// the route begins with one (so the stand is mapped as the run will meet it), then the route's.
+/// The mapping drive's poses, `spacing` metres apart: a survey's legs, each from its first point
+/// to its second (and a zero-length leg's one pose); else the push-back's from the stand first,
+/// when the route begins with one (so the stand is mapped as the run will meet it), then the
+/// route's.
 fn drive_poses(scenario: &Scenario, route: &RoutePath, spacing: f64) -> Vec<Isometry2<f64>> {
     let mut poses = Vec::new();
+    if let Some(survey) = &scenario.survey {
+        for &[a, b] in &survey.legs {
+            let d = b - a;
+            let (len, yaw) = (d.norm(), d.y.atan2(d.x));
+            let steps = (len / spacing).ceil() as usize;
+            poses.extend((0..=steps).map(|k| {
+                let f = if steps == 0 {
+                    0.0
+                } else {
+                    k as f64 / steps as f64
+                };
+                Isometry2::new((a + d * f).coords, yaw)
+            }));
+        }
+        return poses;
+    }
     if let Some(tow) = &scenario.route.pushback {
         let mut left = 0.0;
         for w in tow.poses.windows(2) {

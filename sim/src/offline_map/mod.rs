@@ -14,4 +14,7 @@ pub(crate) use drive::{clear_blocks, finish_map};
 pub use ensure::{Ensured, ensure};
 pub(crate) use manifest::MAP_FORMAT;
 pub use manifest::{MapManifest, default_map_dir, fingerprint, fresh_manifest};
-pub use settings::{levels_of, levels_of_vehicle, map_config, self_filter_model};
+pub use settings::{
+    SURVEY_SEED, SURVEY_SPEED_M_S, drive_seed_and_speed, levels_of, levels_of_vehicle, map_config,
+    self_filter_model,
+};

@@ -41,3 +41,21 @@ pub fn levels_of_vehicle(vehicle: &aircraft::Vehicle, config: &RunConfig) -> Res
         Some(vehicle.ceiling_m()),
     )?)
 }
+
+/// The LiDAR seed of a surveyed map's drive (`[airport] surveyed_stands`): one survey, whatever
+/// the seed of the run that uses it.
+pub const SURVEY_SEED: u64 = 1;
+
+/// The speed of a surveyed map's drive, m/s (a revolution every 0.5 m): one survey, whatever the
+/// run's speed.
+pub const SURVEY_SPEED_M_S: f64 = 5.0;
+
+/// The seed and speed of a scenario's mapping drive: the survey's when its map is surveyed apart
+/// from the run ([`Scenario::survey_scene`]), else the run's own.
+pub fn drive_seed_and_speed(scenario: &Scenario) -> (u64, f64) {
+    if scenario.survey.is_some() {
+        (SURVEY_SEED, SURVEY_SPEED_M_S)
+    } else {
+        (scenario.seed, scenario.route.speed_m_s)
+    }
+}

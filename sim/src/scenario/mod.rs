@@ -24,7 +24,7 @@ mod spec;
 
 pub use model::{
     Ground, KnownProblem, MotionStop, MoverState, Obstacle, ObstacleMotion,
-    REACTIVE_ACCELERATION_M_S2, Route, Scenario, ScenarioVehicle, TrainLink, WalkAround,
+    REACTIVE_ACCELERATION_M_S2, Route, Scenario, ScenarioVehicle, Survey, TrainLink, WalkAround,
 };
 pub use numbers::{Count, Finite, Laps, NonNegative, Positive, Remission};
 pub use overlap::start_overlap;
@@ -35,5 +35,6 @@ pub use run_config::{
 pub use spec::{
     Expectation, ExpectationsSpec, ExpectedEnd, MAX_ROW_OBJECTS, MAX_TRAIN_CARS, ObjectSpec,
     ObstacleSpec, PatchSpec, RegressSpec, RouteSpec, RowLine, RowSpec, ScenarioFile, StartPose,
-    StopSpec, TodayEnd, TodaySpec, TrainSpec, VehicleEntry, WalkAroundSpec, WorldSpec,
+    StopSpec, SurveyedStands, TodayEnd, TodaySpec, TrainSpec, VehicleEntry, WalkAroundSpec,
+    WorldSpec,
 };

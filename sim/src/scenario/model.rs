@@ -389,6 +389,12 @@ pub struct Scenario {
     /// Static objects (`runtime` false): the `[[objects]]` in file order, then the objects of
     /// each `[[rows]]` in file order.
     pub objects: Vec<Solid>,
+    /// The airport's survey, when `[airport] surveyed_stands` is not `as_run`: the offline map
+    /// is then driven over the airport's whole network through what the survey saw, with the
+    /// survey's seed and speed, whatever the run's route, seed, speed and parked aircraft
+    /// ([`Scenario::survey_scene`]). `None`: the map is the run's own static world along its
+    /// route.
+    pub survey: Option<Survey>,
     /// Painted patches.
     pub patches: Vec<Patch>,
     /// Run-time obstacles.
@@ -422,6 +428,26 @@ pub struct Scenario {
     pub golden: Option<PathBuf>,
 }
 
+/// An airport's survey (`[airport] surveyed_stands`): what it saw and where it drove. One survey
+/// serves every run at the airport with one vehicle and one set of map settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Survey {
+    /// The static objects it saw: the scenario's, less the aircraft parked after it (and their
+    /// equipment).
+    pub objects: Vec<Solid>,
+    /// Its drive: straight legs, each driven from its first point to its second - every edge of
+    /// the airport's taxi network inside the world, then a leg from each stand to the nearest
+    /// point of the network.
+    pub legs: Vec<[Point2<f64>; 2]>,
+}
+
+impl Survey {
+    /// The length of its drive, metres.
+    pub fn length_m(&self) -> f64 {
+        self.legs.iter().map(|[a, b]| (b - a).norm()).sum()
+    }
+}
+
 /// A scenario's known problem: why it fails today, and how it ends today.
 #[derive(Clone, Debug, PartialEq)]
 pub struct KnownProblem {
@@ -441,6 +467,16 @@ impl Scenario {
     /// The world as a [`Scene`] without its run-time obstacles: the mapping drive's world.
     pub fn static_scene(&self) -> Scene {
         self.scene(false)
+    }
+
+    /// The world the offline map is made in: the surveyed objects when the map is surveyed apart
+    /// from the run, else [`Scenario::static_scene`].
+    pub fn survey_scene(&self) -> Scene {
+        let mut scene = self.static_scene();
+        if let Some(survey) = &self.survey {
+            scene.solids.clone_from(&survey.objects);
+        }
+        scene
     }
 
     fn scene(&self, include_runtime: bool) -> Scene {

@@ -275,6 +275,26 @@ pub struct AirportSpec {
     /// largest shipped aircraft its size class takes (code C and up an A320, B a Praetor; A or
     /// none stays empty). Never the route's own stands. Default 0.
     pub occupancy: Option<Spanned<Remission>>,
+    /// The stands as the prior map's survey found them. Default `as_run`.
+    #[serde(default)]
+    pub surveyed_stands: SurveyedStands,
+}
+
+/// `[airport] surveyed_stands`: what the offline map holds of the stands. A surveyed map is
+/// driven once per route and vehicle, whatever the run's seed, speed and stand occupancy, so a
+/// campaign's variants share it; what the run parks after the survey is news to the stack.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurveyedStands {
+    /// The map is driven through the run's own static world, with its seed and speed: every
+    /// parked aircraft and its equipment in it (a map made the day of the run).
+    #[default]
+    AsRun,
+    /// Surveyed with the `parked` aircraft (and their equipment) at their stands; the stands
+    /// `occupancy` fills were empty.
+    Parked,
+    /// Surveyed with every stand empty.
+    Empty,
 }
 
 fn yes() -> bool {

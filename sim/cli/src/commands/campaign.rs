@@ -21,7 +21,7 @@ type MakeStack<'a> =
 pub enum CampaignCommand {
     /// Run a campaign's variants not yet in DIR (resumable; Ctrl-C keeps every finished run).
     /// Exit code 0 when no run failed, 1 when some did, 2 on bad input.
-    Run(CampaignRunArgs),
+    Run(Box<CampaignRunArgs>),
     /// Print the summary of a campaign directory (rewritten from its results).
     Show {
         /// The campaign's output directory.
@@ -58,6 +58,12 @@ pub struct CampaignRunArgs {
     /// searched another way (its results go to another directory).
     #[arg(long)]
     pub sampler: Option<String>,
+    /// Set a scenario field in every variant, over the file: `--set FIELD=VALUE` (dotted as in
+    /// the file's `[scenario]`, VALUE a TOML value or else a string; repeatable). The same
+    /// variants with that changed, e.g. `--set airport.surveyed_stands=as_run` (results go to
+    /// another directory).
+    #[arg(long = "set", value_name = "FIELD=VALUE")]
+    pub set: Vec<String>,
     /// Run one shard of the campaign: `I/N` runs the variants `i` with `i % N == I`; `auto/N`
     /// takes `I` from SLURM_ARRAY_TASK_ID or JOB_COMPLETION_INDEX. Merge the shards' `--out`
     /// directories with `campaign merge`.
@@ -117,6 +123,10 @@ pub(crate) fn run_args(args: &CampaignRunArgs) -> anyhow::Result<(usize, bool)> 
                 anyhow::anyhow!("--sampler {name}: expected grid, random, halton or falsify")
             })?;
         campaign.set_sampler(kind);
+    }
+    for set in &args.set {
+        let (field, value) = parse_set(set)?;
+        campaign.set_field(&field, value)?;
     }
     let jobs = args
         .jobs
@@ -280,4 +290,22 @@ fn external_stacks(
             Ok(Box::new(ros2_live::Ros2Stack::new(options)?) as Box<dyn ExternalStack>)
         },
     )))
+}
+
+/// `--set FIELD=VALUE`: the field and its value (a TOML value, or else the text as a string).
+fn parse_set(text: &str) -> anyhow::Result<(String, toml::Value)> {
+    let (field, value) = text
+        .split_once('=')
+        .ok_or_else(|| anyhow::anyhow!("--set {text}: expected FIELD=VALUE"))?;
+    let field = field.trim();
+    anyhow::ensure!(
+        !field.is_empty() && field.split('.').all(|p| !p.is_empty()),
+        "--set {text}: the field is a dotted path such as airport.surveyed_stands"
+    );
+    let value = value.trim();
+    let parsed = toml::from_str::<toml::Table>(&format!("v = {value}"))
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(value.to_string()));
+    Ok((field.to_string(), parsed))
 }

@@ -240,7 +240,17 @@ fn offline_map_dir(
         Some(cache) => {
             std::fs::create_dir_all(cache)
                 .with_context(|| format!("creating the map cache {}", cache.display()))?;
-            sim::campaign::MapCache::new(cache.clone()).get_for_file(scenario, config)?
+            let bar = crate::bar(0, "mapping");
+            let dir = sim::campaign::MapCache::new(cache.clone()).get_for_file_showing(
+                scenario,
+                config,
+                &|done, total| {
+                    bar.set_length(total as u64);
+                    bar.set_position(done as u64);
+                },
+            )?;
+            bar.finish_and_clear();
+            dir
         }
         None => {
             let dir = args

@@ -10,8 +10,8 @@ use toml::Spanned;
 
 use super::Resolver;
 use crate::airports::{AirportWorld, Furniture, GRASS_REMISSION, airport_world, plan_taxi};
-use crate::scenario::model::{Ground, Route, ScenarioVehicle};
-use crate::scenario::spec::{AirportSpec, RouteSpec, TaxiSpec, VehicleEntry};
+use crate::scenario::model::{Ground, Route, ScenarioVehicle, Survey};
+use crate::scenario::spec::{AirportSpec, RouteSpec, SurveyedStands, TaxiSpec, VehicleEntry};
 use crate::toml_file::LocatedError;
 use crate::world::{ObjectKind, Patch, Solid, SolidShape};
 
@@ -146,7 +146,7 @@ impl Resolver<'_> {
         ids: &mut HashMap<String, String>,
         seed: u64,
         route_stands: &[String],
-    ) -> Result<(Vec<Solid>, Vec<Patch>), LocatedError> {
+    ) -> Result<AirportObjects, LocatedError> {
         let inside = |x: f64, y: f64| {
             x >= world.min_m[0] && x <= world.max_m[0] && y >= world.min_m[1] && y <= world.max_m[1]
         };
@@ -163,6 +163,7 @@ impl Resolver<'_> {
             self.no_start_overlap(vehicle, solid, "airport", spec.span())?;
             solids.push(solid.clone());
         }
+        let furniture = solids.len();
         for (stand, description, span) in self.occupied_stands(spec, loaded, seed, route_stands)? {
             let id = format!("stand_{}", stand.name.replace(' ', "_"));
             self.claim(
@@ -191,6 +192,7 @@ impl Resolver<'_> {
             }
             solids.extend(here);
         }
+        let drawn = solids.len();
         for (i, parked) in spec.get_ref().parked.iter().enumerate() {
             let field = format!("airport.parked[{i}]");
             let p = parked.get_ref();
@@ -234,8 +236,32 @@ impl Resolver<'_> {
             .filter(|p| inside(p.x_m, p.y_m))
             .cloned()
             .collect();
-        Ok((solids, patches))
+        // What the survey saw of them: the furniture, and the `parked` aircraft unless empty.
+        let seen = match spec.get_ref().surveyed_stands {
+            SurveyedStands::AsRun => None,
+            SurveyedStands::Parked => Some([&solids[..furniture], &solids[drawn..]].concat()),
+            SurveyedStands::Empty => Some(solids[..furniture].to_vec()),
+        };
+        let survey = seen.map(|objects| Survey {
+            objects,
+            legs: survey_legs(&loaded.airport, &inside),
+        });
+        Ok(AirportObjects {
+            solids,
+            survey,
+            patches,
+        })
     }
+}
+
+/// An airport's objects in a scenario's world, and what its map's survey saw of them.
+pub(super) struct AirportObjects {
+    /// Its furniture, then the aircraft `occupancy` parks, then the `parked` ones.
+    pub solids: Vec<Solid>,
+    /// The airport's survey (`None`: the map is made of the run's own world).
+    pub survey: Option<Survey>,
+    /// Its painted lines.
+    pub patches: Vec<Patch>,
 }
 
 impl Resolver<'_> {
@@ -356,4 +382,35 @@ fn ground_equipment(id: &str, span_m: f64, at: Vector2<f64>, yaw_rad: f64) -> Ve
         })
     })
     .collect()
+}
+
+/// The survey's legs: every edge of the network with both ends inside the world, then for each
+/// stand inside it a leg from the stand to the nearest point of those edges (the way a tug
+/// pushes an aircraft back), so the stands are mapped from close by.
+fn survey_legs(airport: &Airport, inside: &dyn Fn(f64, f64) -> bool) -> Vec<[Point2<f64>; 2]> {
+    let nodes = &airport.network.nodes;
+    let mut legs: Vec<[Point2<f64>; 2]> = airport
+        .network
+        .edges
+        .iter()
+        .map(|e| [Point2::from(nodes[e.from].at), Point2::from(nodes[e.to].at)])
+        .filter(|[a, b]| inside(a.x, a.y) && inside(b.x, b.y))
+        .collect();
+    let edges = legs.len();
+    for stand in &airport.stands {
+        let at = Point2::from(stand.at);
+        if !inside(at.x, at.y) {
+            continue;
+        }
+        let nearest = legs[..edges]
+            .iter()
+            .map(|&[a, b]| {
+                let ab = b - a;
+                let t = ((at - a).dot(&ab) / ab.norm_squared().max(1e-12)).clamp(0.0, 1.0);
+                a + ab * t
+            })
+            .min_by(|p, q| (p - at).norm().total_cmp(&(q - at).norm()));
+        legs.push([at, nearest.unwrap_or(at)]);
+    }
+    legs
 }

@@ -95,18 +95,27 @@ impl Resolver<'_> {
         let vehicle = self.vehicle(&spec.vehicle, &route, &world)?;
         // Every id, with who uses it (as error messages name it).
         let mut ids: HashMap<String, String> = HashMap::new();
-        let (mut objects, mut patches) = match (&spec.airport, &airport) {
+        let (mut objects, mut survey, mut patches) = match (&spec.airport, &airport) {
             (Some(a), Some(loaded)) => {
                 let route_stands: Vec<String> = (spec.route.get_ref().taxi.iter())
                     .flat_map(|t| [t.get_ref().from.clone(), t.get_ref().to.clone()])
                     .collect();
                 let (seed, stands) = (spec.seed, &route_stands);
-                self.airport_objects(a, loaded, &world, &vehicle, &mut ids, seed, stands)?
+                let a =
+                    self.airport_objects(a, loaded, &world, &vehicle, &mut ids, seed, stands)?;
+                (a.solids, a.survey, a.patches)
             }
-            _ => (Vec::new(), Vec::new()),
+            _ => (Vec::new(), None, Vec::new()),
         };
+        let airport_objects = objects.len();
         objects.extend(self.objects(&spec.objects, &world, &vehicle, &mut ids)?);
         self.rows(&spec.rows, &world, &route, &vehicle, &mut ids, &mut objects)?;
+        // The scenario's own objects and rows were there when the airport was surveyed.
+        if let Some(survey) = &mut survey {
+            survey
+                .objects
+                .extend_from_slice(&objects[airport_objects..]);
+        }
         patches.extend(self.patches(&spec.patches, &world, &mut ids)?);
         let obstacles = self.obstacles(&spec.obstacles, &world, &vehicle, &mut ids)?;
         let known_problem = self.known_problem(&mut spec.expectations)?;
@@ -125,6 +134,7 @@ impl Resolver<'_> {
             vehicle,
             route,
             objects,
+            survey,
             patches,
             obstacles,
             danger_distance_m: spec.expectations.danger_distance_m.map(|d| d.0),

@@ -197,3 +197,115 @@ fn airport_mistakes_are_located() {
         error(&stray_radius)
     );
 }
+
+/// XTSM with S1's stated aircraft, S2 drawn by `occupancy` (the route's S3 and the code A S4 are
+/// never filled), ground equipment, and the map surveyed as `stands` says.
+fn surveyed(stands: &str, seed: u64, speed_m_s: f64, occupancy: f64) -> sim::scenario::Scenario {
+    let extra = format!(
+        "parked = [{{ stand = \"S1\", vehicle = \"praetor600\" }}]\noccupancy = {occupancy}\n\
+         ground_equipment = true\nsurveyed_stands = \"{stands}\"\n"
+    );
+    let text = xtsm(&extra)
+        .replace("speed_m_s = 6.0", &format!("speed_m_s = {speed_m_s}"))
+        .replacen('\n', &format!("\nseed = {seed}\n"), 1);
+    read(&text).expect("reads")
+}
+
+#[test]
+fn a_surveyed_map_holds_the_stands_as_surveyed_and_one_serves_every_seed_speed_and_occupancy() {
+    use sim::campaign::static_world_key;
+    let config = sim::scenario::RunConfig::default();
+    let key = |s: &sim::scenario::Scenario| static_world_key(s, &config).expect("key");
+    let parked_at = |solids: &[sim::world::Solid], stand: &str| {
+        solids
+            .iter()
+            .filter(|o| o.id.starts_with(&format!("stand_{stand}/")))
+            .count()
+    };
+    // A seed whose draw fills S2 and one whose draw leaves it empty (occupancy 0.5).
+    let fills = |seed| parked_at(&surveyed("empty", seed, 6.0, 0.5).objects, "S2") > 0;
+    let full = (1..40).find(|&s| fills(s)).expect("a seed filling S2");
+    let empty = (1..40)
+        .find(|&s| !fills(s))
+        .expect("a seed leaving S2 empty");
+    let (a, b) = (
+        surveyed("empty", full, 6.0, 0.5),
+        surveyed("empty", empty, 4.0, 0.5),
+    );
+    let solids = |s: &sim::scenario::Scenario| s.survey_scene().solids;
+    let kinds =
+        |solids: &[sim::world::Solid], kind| solids.iter().filter(|o| o.kind == kind).count();
+    // The run's world has its aircraft, equipment and furniture; the survey only the furniture.
+    assert!(parked_at(&a.objects, "S1") > 0 && parked_at(&a.objects, "S2") > 0);
+    assert_eq!(kinds(&a.objects, ObjectKind::Tug), 2);
+    for k in [
+        ObjectKind::ParkedAircraft,
+        ObjectKind::Tug,
+        ObjectKind::BaggageCart,
+    ] {
+        assert_eq!(kinds(&solids(&a), k), 0, "{k:?} in the survey");
+    }
+    for k in [
+        ObjectKind::Sign,
+        ObjectKind::EdgeLight,
+        ObjectKind::Windsock,
+    ] {
+        assert_eq!(kinds(&solids(&a), k), kinds(&a.objects, k));
+    }
+    assert_eq!(a.static_scene().solids, a.objects);
+    // One survey for both runs, whatever their seeds, speeds and occupancy: every edge of the
+    // network (all inside the world) and a leg from each of the four stands to it.
+    assert_eq!(solids(&a), solids(&b));
+    assert_eq!(key(&a), key(&b));
+    let survey = a.survey.as_ref().expect("surveyed");
+    let apt = airport::Airport::read(&repo().join("scenarios/airports/xtsm/apt.dat"), None)
+        .expect("reads");
+    assert_eq!(survey.legs.len(), apt.network.edges.len() + 4);
+    assert!(survey.length_m() > 1000.0, "{}", survey.length_m());
+    for (leg, stand) in survey.legs[apt.network.edges.len()..]
+        .iter()
+        .zip(&apt.stands)
+    {
+        assert_eq!(leg[0].coords, stand.at);
+        assert!((leg[1] - leg[0]).norm() < 120.0, "{leg:?}");
+    }
+    // ... and whatever their route: a survey is the airport's, not the route's.
+    let other_route = read(
+        &xtsm("surveyed_stands = \"empty\"\noccupancy = 0.5\n").replace(
+            "to = \"runway 27\", via = [\"B\", \"A\"]",
+            "to = \"runway 09\"",
+        ),
+    )
+    .expect("reads");
+    assert_ne!(other_route.route.waypoints_m, a.route.waypoints_m);
+    assert_eq!(
+        other_route.survey.as_ref().expect("surveyed").legs,
+        survey.legs
+    );
+    assert_eq!(key(&other_route), key(&a));
+    // `parked`: S1's stated aircraft and its equipment surveyed, S2's drawn one not.
+    let p = surveyed("parked", full, 6.0, 0.5);
+    assert_eq!(parked_at(&solids(&p), "S1"), parked_at(&p.objects, "S1"));
+    assert_eq!(parked_at(&solids(&p), "S2"), 0);
+    assert_eq!(kinds(&solids(&p), ObjectKind::Tug), 1);
+    assert_ne!(key(&p), key(&a));
+    assert_eq!(key(&p), key(&surveyed("parked", empty, 4.0, 0.5)));
+    // `as_run` (the default): the map is the run's own world, its key the run's seed and speed.
+    let (c, d) = (
+        surveyed("as_run", full, 6.0, 0.5),
+        surveyed("as_run", full, 4.0, 0.5),
+    );
+    assert!(c.survey.is_none());
+    assert_eq!(c.survey_scene(), c.static_scene());
+    assert_ne!(key(&c), key(&d));
+    assert_ne!(key(&c), key(&surveyed("as_run", empty, 6.0, 0.5)));
+    assert_ne!(key(&c), key(&a));
+    // A survey that is not one of the three.
+    let text = xtsm("surveyed_stands = \"full\"\n");
+    assert_error(
+        &text,
+        "\"full\"",
+        "airport.surveyed_stands",
+        "unknown variant `full`",
+    );
+}
