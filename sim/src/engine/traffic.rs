@@ -16,7 +16,15 @@
 //!   (down to standing, and it waits); otherwise it speeds up at `a` towards `speed_m_s`, as far
 //!   as its next stop or the path's end lets it brake in time. `a` is `acceleration_m_s2`, or
 //!   [`REACTIVE_ACCELERATION_M_S2`] (2.0 m/s^2). It starts from rest at its appearance, waits
-//!   `wait_s` at each stop, and stands at the path's end;
+//!   `wait_s` at each stop, and stands at the path's end. **Making room** (`makes_room_m`, the
+//!   ramp rule for a vehicle meeting an aircraft head-on): once it has stood
+//!   [`MAKE_ROOM_AFTER_S`] for a vehicle coming towards it (headings within 45 degrees of
+//!   opposite) with its near side less than `makes_room_m` beyond the vehicle's widest part
+//!   (from the vehicle's centre line), it backs along its path at up to
+//!   [`MAKE_ROOM_SPEED_M_S`] over three times the shift it needs (8-30 m), pulling aside on a
+//!   smooth curve away from that line, its nose along the curve; from there on its path is
+//!   shifted by as much, and it yields on it as before (it may come on until the stretch ahead
+//!   is near the vehicle again) and drives on once the vehicle has passed. Once per run.
 //! - a train's car: it keeps its place behind its lead (`TrainLink::behind_m` along the path)
 //!   whatever the lead does - profiles, stops, waits for the vehicle.
 //!
@@ -26,12 +34,51 @@
 //! (they are kinematic) and come out under a wing, where the vehicle moving on meets it again.
 
 use aircraft::footprint::{Footprint, segment_distance, segments_distance};
-use nalgebra::{Isometry2, Point2};
+use nalgebra::{Isometry2, Point2, Vector2};
 
 use crate::scenario::{MoverState, Obstacle, ObstacleMotion, REACTIVE_ACCELERATION_M_S2};
 
 /// Arc lengths closer than this are the same place, metres.
 const SAME_PLACE_M: f64 = 1e-9;
+
+/// A driver that makes room does so once it has stood this long for the vehicle, seconds.
+pub const MAKE_ROOM_AFTER_S: f64 = 3.0;
+
+/// ... backing at up to this speed, m/s.
+pub const MAKE_ROOM_SPEED_M_S: f64 = 2.0;
+
+/// Making room: where it started backing, how far it backs, and the shift it pulls aside by.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Room {
+    /// Arc length it started backing from, metres.
+    from_arc_m: f64,
+    /// How far it backs along its path, metres.
+    back_m: f64,
+    /// Its full sideways shift, metres (world frame).
+    shift: Vector2<f64>,
+    /// True once it has backed the whole way.
+    done: bool,
+}
+
+impl Room {
+    /// How far aside it is at arc length `arc_m` (0 to 1, smoothstep), and that fraction's
+    /// rate per metre of arc (negative: it grows as the arc falls).
+    fn blend(&self, arc_m: f64) -> (f64, f64) {
+        if self.done {
+            return (1.0, 0.0);
+        }
+        let u = ((self.from_arc_m - arc_m) / self.back_m).clamp(0.0, 1.0);
+        (u * u * (3.0 - 2.0 * u), -6.0 * u * (1.0 - u) / self.back_m)
+    }
+}
+
+/// What a driver that makes room knows of the vehicle: its true pose and half its span.
+#[derive(Clone, Copy, Debug)]
+struct VehicleView {
+    world_from_vehicle: Isometry2<f64>,
+    /// The largest |y| of any part's footprint in the vehicle frame, metres.
+    half_span_m: f64,
+}
 
 /// The state a yielding driver carries from step to step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -48,6 +95,10 @@ struct Reactive {
     started: bool,
     /// True while it brakes or stands for the vehicle.
     yielding: bool,
+    /// How long it has stood yielding, seconds.
+    stood_s: f64,
+    /// Making room, once it began to.
+    room: Option<Room>,
 }
 
 /// How one obstacle is moved.
@@ -73,6 +124,8 @@ pub struct Traffic {
     parts: Vec<Footprint>,
     /// Radius around the vehicle frame's origin holding every footprint, metres.
     reach_m: f64,
+    /// The largest |y| of any footprint in the vehicle frame, metres.
+    half_span_m: f64,
     /// Time of the last step, seconds.
     t_s: Option<f64>,
 }
@@ -95,6 +148,13 @@ impl Traffic {
                     .fold(0.0, f64::max)
             })
             .fold(0.0, f64::max);
+        let half_span_m = parts
+            .iter()
+            .map(|f| {
+                let (lo, hi) = f.bounds();
+                lo.y.abs().max(hi.y.abs())
+            })
+            .fold(0.0, f64::max);
         let drives = obstacles
             .iter()
             .map(|o| match &o.motion {
@@ -114,6 +174,7 @@ impl Traffic {
             states: vec![None; obstacles.len()],
             parts,
             reach_m,
+            half_span_m,
             t_s: None,
         }
     }
@@ -132,19 +193,25 @@ impl Traffic {
             } else {
                 match (&mut self.drives[k], &o.motion) {
                     (Drive::Yielding(r), Some(m)) => {
-                        let length_m = o.solid.shape.length_m();
+                        let size_m = [o.solid.shape.length_m(), o.solid.shape.width_m()];
+                        let shift = r
+                            .room
+                            .map_or_else(Vector2::zeros, |room| room.shift * room.blend(r.arc_m).0);
                         let near = |from_m: f64, to_m: f64, within_m: f64| {
                             near_path(
                                 &self.parts,
                                 self.reach_m,
                                 m,
-                                from_m,
-                                to_m,
+                                (from_m, to_m, &shift),
                                 within_m,
                                 &vehicle_from_world,
                             )
                         };
-                        Some(advance(r, m, length_m, dt, near))
+                        let vehicle = VehicleView {
+                            world_from_vehicle: *world_from_vehicle,
+                            half_span_m: self.half_span_m,
+                        };
+                        Some(advance(r, m, size_m, dt, near, &vehicle))
                     }
                     (Drive::Halted(at), _) => Some(*at),
                     (Drive::Car { lead, behind_m }, Some(m)) => {
@@ -204,17 +271,20 @@ impl Traffic {
     }
 }
 
-/// One step of `dt` of a yielding driver of `length_m` along `m`; `near(from, to, within)` says
-/// whether the vehicle is within `within` of the stretch of the path between those arc lengths.
+/// One step of `dt` of a yielding driver of `size_m` (length, width) along `m`;
+/// `near(from, to, within)` says whether the vehicle is within `within` of the stretch of the
+/// path between those arc lengths (shifted as far aside as it has made room).
 fn advance(
     r: &mut Reactive,
     m: &ObstacleMotion,
-    length_m: f64,
+    size_m: [f64; 2],
     dt: f64,
     near: impl Fn(f64, f64, f64) -> bool,
+    vehicle: &VehicleView,
 ) -> MoverState {
     let a = m.acceleration().unwrap_or(REACTIVE_ACCELERATION_M_S2);
     let path_m = m.length_m();
+    let length_m = size_m[0];
     r.yielding = false;
     if !r.started {
         // It appears at rest at the start of its path.
@@ -224,13 +294,16 @@ fn advance(
         };
         return m.state_at_arc(0.0, 0.0);
     }
+    if let Some(room) = r.room.filter(|room| !room.done) {
+        return backing(r, room, m, a, dt);
+    }
     if r.wait_left_s > 0.0 {
         r.wait_left_s -= dt;
         if r.wait_left_s <= 0.0 {
             r.wait_left_s = 0.0;
             r.next_stop += 1;
         }
-        return m.state_at_arc(r.arc_m, 0.0);
+        return placed(r, m, 0.0);
     }
     let rest_m = m.stops.get(r.next_stop).map_or(path_m, |s| s.at_m);
     if rest_m - r.arc_m <= SAME_PLACE_M {
@@ -239,12 +312,20 @@ fn advance(
         if let Some(stop) = m.stops.get(r.next_stop) {
             r.wait_left_s = stop.wait_s;
         }
-        return m.state_at_arc(r.arc_m, 0.0);
+        return placed(r, m, 0.0);
     }
     let front_m = r.arc_m + 0.5 * length_m;
     let reach_m = front_m + r.speed_m_s * r.speed_m_s / (2.0 * a) + length_m;
     let within_m = m.yields_to_vehicle_m.unwrap_or(0.0);
     r.yielding = front_m < path_m && near(front_m, reach_m.min(path_m), within_m);
+    r.stood_s = if r.yielding && r.speed_m_s <= 0.0 {
+        r.stood_s + dt
+    } else {
+        0.0
+    };
+    if r.room.is_none() && r.stood_s >= MAKE_ROOM_AFTER_S {
+        r.room = make_room(r, m, size_m[1], vehicle);
+    }
     r.speed_m_s = if r.yielding {
         (r.speed_m_s - a * dt).max(0.0)
     } else {
@@ -252,23 +333,94 @@ fn advance(
         (r.speed_m_s + a * dt).min(m.speed_m_s).min(can_stop)
     };
     r.arc_m = (r.arc_m + r.speed_m_s * dt).min(rest_m);
-    m.state_at_arc(r.arc_m, r.speed_m_s)
+    placed(r, m, r.speed_m_s)
+}
+
+/// Its state at its arc length moving at `speed_m_s` along its path, shifted as far aside as
+/// it has made room, its nose along the curve it backs on.
+fn placed(r: &Reactive, m: &ObstacleMotion, speed_m_s: f64) -> MoverState {
+    let mut state = m.state_at_arc(r.arc_m, speed_m_s);
+    if let Some(room) = r.room {
+        let (blend, rate) = room.blend(r.arc_m);
+        let at = Vector2::new(state.x_m, state.y_m) + room.shift * blend;
+        let along = Vector2::new(state.heading_rad.cos(), state.heading_rad.sin());
+        let tangent = along + room.shift * rate;
+        let heading = tangent.y.atan2(tangent.x);
+        state.yaw_rad += heading - state.heading_rad;
+        (state.x_m, state.y_m, state.heading_rad) = (at.x, at.y, heading);
+    }
+    state
+}
+
+/// The room a driver standing head-on to the vehicle makes, if it must: `None` when the
+/// vehicle does not come towards it or it already stands `makes_room_m` clear.
+fn make_room(
+    r: &Reactive,
+    m: &ObstacleMotion,
+    width_m: f64,
+    vehicle: &VehicleView,
+) -> Option<Room> {
+    let clear_m = m.makes_room_m?;
+    let here = m.state_at_arc(r.arc_m, 0.0);
+    let v = &vehicle.world_from_vehicle;
+    // Headings within 45 degrees of opposite: the vehicle comes towards it.
+    let opposite = -(here.heading_rad - v.rotation.angle()).cos();
+    if opposite < std::f64::consts::FRAC_1_SQRT_2 {
+        return None;
+    }
+    let local = v.inverse() * Point2::new(here.x_m, here.y_m);
+    let wanted_m = vehicle.half_span_m + 0.5 * width_m + clear_m;
+    let need_m = wanted_m - local.y.abs();
+    if need_m <= 0.0 {
+        return None;
+    }
+    // Away from the vehicle's centre line, on the side it stands (on the line: the vehicle's
+    // left, the driver's right).
+    let side = if local.y < 0.0 { -1.0 } else { 1.0 };
+    Some(Room {
+        from_arc_m: r.arc_m,
+        back_m: (3.0 * need_m).clamp(8.0, 30.0),
+        shift: v.rotation * Vector2::new(0.0, side * need_m),
+        done: false,
+    })
+}
+
+/// One step of `dt` backing to make `room`: up to [`MAKE_ROOM_SPEED_M_S`], braking to stand
+/// at the curve's end, where the room is made.
+fn backing(r: &mut Reactive, room: Room, m: &ObstacleMotion, a: f64, dt: f64) -> MoverState {
+    let left_m = (r.arc_m - (room.from_arc_m - room.back_m)).max(0.0);
+    let speed = (r.speed_m_s.abs() + a * dt)
+        .min(MAKE_ROOM_SPEED_M_S)
+        .min((2.0 * a * left_m).sqrt());
+    r.yielding = true;
+    if left_m - speed * dt <= SAME_PLACE_M {
+        r.arc_m = room.from_arc_m - room.back_m;
+        r.speed_m_s = 0.0;
+        r.room = Some(Room { done: true, ..room });
+        return placed(r, m, 0.0);
+    }
+    r.arc_m -= speed * dt;
+    r.speed_m_s = -speed;
+    placed(r, m, r.speed_m_s)
 }
 
 /// True when any of the vehicle's `parts` (footprints in its frame, all within `reach_m` of its
 /// origin) lies within `within_m` of the stretch of `m`'s path between arc lengths `from_m` and
-/// `to_m`, in plan; `vehicle_from_world` places the path in the vehicle's frame.
+/// `to_m`, moved by `shift`, in plan; `vehicle_from_world` places the path in the vehicle's
+/// frame.
 fn near_path(
     parts: &[Footprint],
     reach_m: f64,
     m: &ObstacleMotion,
-    from_m: f64,
-    to_m: f64,
+    (from_m, to_m, shift): (f64, f64, &Vector2<f64>),
     within_m: f64,
     vehicle_from_world: &Isometry2<f64>,
 ) -> bool {
     let stretch = stretch(m, from_m, to_m);
-    let local: Vec<Point2<f64>> = stretch.iter().map(|p| vehicle_from_world * p).collect();
+    let local: Vec<Point2<f64>> = stretch
+        .iter()
+        .map(|p| vehicle_from_world * (p + shift))
+        .collect();
     let origin = Point2::origin();
     local.windows(2).any(|w| {
         segment_distance(&origin, &w[0], &w[1]) <= reach_m + within_m
@@ -409,6 +561,74 @@ speed_m_s = 3.0
                 plain.obstacles[0].pose_at(t)
             );
         }
+    }
+
+    /// A driver that makes room, head-on to the standing vehicle: it stands 3 s, backs and
+    /// pulls aside until its near side is `makes_room_m` beyond the vehicle's widest part,
+    /// nose along its path, then yields on beside its path as before, and once the vehicle is
+    /// gone drives on to its end.
+    /// Crossing the vehicle's path (not head-on) it only waits, as before.
+    #[test]
+    fn a_driver_head_on_makes_room_and_drives_on_beside_its_path() {
+        let head_on =
+            scenario("yields_to_vehicle_m = 30.0\nmakes_room_m = 3.0\n").obstacles[0].clone();
+        let mut van = head_on.clone();
+        let m = van.motion.as_mut().expect("moves");
+        m.path_m = vec![Point2::new(80.0, 0.5), Point2::new(-40.0, 0.5)];
+        let s = scenario("yields_to_vehicle_m = 30.0\nmakes_room_m = 3.0\n");
+        let mut traffic = Traffic::new(std::slice::from_ref(&van), &s.vehicle.vehicle);
+        let here = Isometry2::identity();
+        traffic.step(0.0, &here);
+        let mut t = 0.0;
+        // Until it first stands for the vehicle, then 2.9 s on: it has not moved.
+        while !(traffic.yielding(0) && traffic.state(0).is_some_and(|v| v.speed_m_s == 0.0)) {
+            t = run(&mut traffic, t, t + 0.01, &here);
+        }
+        let first = traffic.state(0).expect("present");
+        t = run(&mut traffic, t, t + 2.9, &here);
+        assert_eq!(traffic.state(0), Some(first));
+        let mut farthest = first.x_m;
+        for _ in 0..6000 {
+            t = run(&mut traffic, t, t + 0.01, &here);
+            farthest = farthest.max(traffic.state(0).expect("present").x_m);
+        }
+        let stood = traffic.state(0).expect("present");
+        assert_eq!(stood.speed_m_s, 0.0);
+        assert!(traffic.yielding(0));
+        // Its near side (half its 1.9 m width in) stands 3 m beyond the widest part, on the
+        // side it was (+y), its nose along its path (-x).
+        let near_side = stood.y_m - 0.5 * van.solid.shape.width_m();
+        assert!(
+            (near_side - traffic.half_span_m - 3.0).abs() < 1e-9,
+            "near side at {near_side}, span {}",
+            traffic.half_span_m
+        );
+        assert!((stood.heading_rad.abs() - std::f64::consts::PI).abs() < 1e-9);
+        // Backed three times the shift (at least 8 m) from where it stopped first, then came
+        // on beside its path as far as the yield rule lets it: 30 m from the vehicle again.
+        let shift = stood.y_m - first.y_m;
+        let back = farthest - first.x_m;
+        assert!(
+            (stood.x_m - first.x_m).abs() < 1.0,
+            "stands at {}",
+            stood.x_m
+        );
+        assert!(
+            (back - (3.0 * shift).clamp(8.0, 30.0)).abs() < 1e-9,
+            "backed {back} for {shift}"
+        );
+        // The vehicle gone, it drives on to its path's end, shifted aside.
+        let gone = Isometry2::new(nalgebra::Vector2::new(200.0, 0.0), 0.0);
+        run(&mut traffic, t, t + 60.0, &gone);
+        let end = traffic.state(0).expect("present");
+        assert_eq!((end.x_m, end.y_m), (-40.0, stood.y_m));
+        // Crossing the vehicle's path, the same driver only waits (the yield test's van).
+        let mut traffic = Traffic::new(&s.obstacles, &s.vehicle.vehicle);
+        let across = Isometry2::new(nalgebra::Vector2::new(20.0, 0.0), 0.0);
+        traffic.step(0.0, &across);
+        run(&mut traffic, 0.0, 30.0, &across);
+        let van = traffic.state(0).expect("present");
+        assert_eq!((van.x_m, van.speed_m_s), (20.0, 0.0));
     }
 
     /// A plain mover and a yielding driver, halted (they touched the vehicle), stand where

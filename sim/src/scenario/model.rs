@@ -130,6 +130,9 @@ pub struct ObstacleMotion {
     /// A driver that yields to the vehicle within this distance, metres (`None`: it does not
     /// react).
     pub yields_to_vehicle_m: Option<f64>,
+    /// A driver that yields and makes room: it pulls aside until its near side is this far
+    /// beyond the vehicle's widest part, metres (`None`: it stands where it stopped).
+    pub makes_room_m: Option<f64>,
     /// A train's car: its lead (whose profile, stops and reaction the car's motion copies) and
     /// how far behind it the car stays. `None`: it moves on its own.
     pub train: Option<TrainLink>,
@@ -515,6 +518,7 @@ mod tests {
                 .map(|&(at_m, wait_s)| MotionStop { at_m, wait_s })
                 .collect(),
             yields_to_vehicle_m: None,
+            makes_room_m: None,
             train: None,
         }
     }

@@ -562,6 +562,15 @@ pub struct ObstacleSpec {
     /// plus its own length), it brakes to a stop and waits; it drives on once the stretch is
     /// clear. Only with `path_m`. Default none: it does not react.
     pub yields_to_vehicle_m: Option<Spanned<Positive>>,
+    /// A driver that yields and makes room for the vehicle, metres, > 0 (the ramp rule: a
+    /// vehicle meeting an aircraft head-on gives way and pulls aside): once it has stood 3 s
+    /// for the vehicle coming towards it (headings within 45 degrees of opposite) with its
+    /// near side less than this beyond the vehicle's widest part (measured from the vehicle's
+    /// centre line), it backs along its path and pulls aside, away from that line, until it
+    /// is; from there it yields beside its path as before and drives on once the vehicle has
+    /// passed. Only
+    /// with `yields_to_vehicle_m`, not with `train`. Default none: it stands where it stopped.
+    pub makes_room_m: Option<Spanned<Positive>>,
     /// A towed train: this mover is the lead (a tug) and `cars` cars follow it along `path_m`,
     /// each an obstacle `<id>_car1`, `<id>_car2`, ... Only with `path_m`. Default none.
     pub train: Option<Spanned<TrainSpec>>,

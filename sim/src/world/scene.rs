@@ -82,6 +82,13 @@ impl SolidShape {
             SolidShape::Part { .. } => 2.0 * self.footprint_radius_m(),
         }
     }
+    /// Extent across the object's heading, metres (a box's y size, a round shape's diameter).
+    pub fn width_m(&self) -> f64 {
+        match *self {
+            SolidShape::Box { size_m } => size_m[1],
+            _ => self.length_m(),
+        }
+    }
     /// Radius of the smallest vertical cylinder around the shape's axis holding it, metres.
     /// (A part: around the vehicle frame's origin.)
     pub fn footprint_radius_m(&self) -> f64 {

@@ -1,6 +1,6 @@
 //! Traffic on the ramp (issue 36, the world's side): the new kinds (`person`, `tug`,
 //! `baggage_cart`, `fuel_truck`) and their default sizes, the movers' fields
-//! (`acceleration_m_s2`, `stops`, `yields_to_vehicle_m`, `train`) checked while read - each bad
+//! (`acceleration_m_s2`, `stops`, `yields_to_vehicle_m`, `makes_room_m`, `train`) checked while read - each bad
 //! value's error names its field -, and towed trains: cars expanded behind their lead, keeping
 //! their spacing along a bend, waiting with it.
 
@@ -75,6 +75,24 @@ fn each_bad_mover_field_is_refused_naming_it() {
         "yields_to_vehicle_m",
         "obstacles[0].yields_to_vehicle_m",
         "must be finite and > 0",
+    );
+    refused(
+        &tug("makes_room_m = -2.0\nyields_to_vehicle_m = 40.0\n"),
+        "makes_room_m",
+        "obstacles[0].makes_room_m",
+        "must be finite and > 0",
+    );
+    refused(
+        &tug("makes_room_m = 6.0\n"),
+        "makes_room_m",
+        "obstacles[0].makes_room_m",
+        "only for a driver that yields: give yields_to_vehicle_m too",
+    );
+    refused(
+        &tug("yields_to_vehicle_m = 40.0\nmakes_room_m = 6.0\ntrain = { cars = 2 }\n"),
+        "makes_room_m",
+        "obstacles[0].makes_room_m",
+        "not for a train",
     );
     refused(
         &tug("stops = [{ at_m = -1.0, wait_s = 4.0 }]\n"),
@@ -175,6 +193,7 @@ fn stops_and_trains_are_checked_against_the_path() {
         ("train", "{ cars = 3 }"),
         ("acceleration_m_s2", "1.0"),
         ("yields_to_vehicle_m", "5.0"),
+        ("makes_room_m", "6.0"),
     ] {
         refused(
             &parked(&format!("{key} = {value}\n")),

@@ -36,8 +36,21 @@ impl Resolver<'_> {
             acceleration_m_s2: s.acceleration_m_s2.as_ref().map(|a| a.get_ref().0),
             stops: Vec::new(),
             yields_to_vehicle_m: s.yields_to_vehicle_m.as_ref().map(|y| y.get_ref().0),
+            makes_room_m: s.makes_room_m.as_ref().map(|y| y.get_ref().0),
             train: None,
         };
+        if let Some(room) = &s.makes_room_m {
+            let why = if s.yields_to_vehicle_m.is_none() {
+                Some("makes_room_m is only for a driver that yields: give yields_to_vehicle_m too")
+            } else if s.train.is_some() {
+                Some("makes_room_m is not for a train: its cars cannot back aside with it")
+            } else {
+                None
+            };
+            if let Some(why) = why {
+                return Err(self.err(room.span(), &format!("{field}.makes_room_m"), why));
+            }
+        }
         if let Some(stops) = &s.stops {
             motion.stops = self.stops(stops.get_ref(), field, motion.length_m())?;
         }
@@ -98,6 +111,7 @@ impl Resolver<'_> {
                 "yields_to_vehicle_m",
                 s.yields_to_vehicle_m.as_ref().map(Spanned::span),
             ),
+            ("makes_room_m", s.makes_room_m.as_ref().map(Spanned::span)),
             ("train", s.train.as_ref().map(Spanned::span)),
         ];
         for (key, span) in given {
