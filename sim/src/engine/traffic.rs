@@ -48,7 +48,7 @@ pub const MAKE_ROOM_AFTER_S: f64 = 3.0;
 pub const MAKE_ROOM_SPEED_M_S: f64 = 2.0;
 
 /// Making room: where it started backing, how far it backs, and the shift it pulls aside by.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct Room {
     /// Arc length it started backing from, metres.
     from_arc_m: f64,
@@ -99,6 +99,14 @@ struct Reactive {
     stood_s: f64,
     /// Making room, once it began to.
     room: Option<Room>,
+}
+
+impl Reactive {
+    /// How far aside it stands now, having made room (zero before), metres.
+    fn shift(&self) -> Vector2<f64> {
+        self.room
+            .map_or_else(Vector2::zeros, |room| room.shift * room.blend(self.arc_m).0)
+    }
 }
 
 /// How one obstacle is moved.
@@ -194,9 +202,7 @@ impl Traffic {
                 match (&mut self.drives[k], &o.motion) {
                     (Drive::Yielding(r), Some(m)) => {
                         let size_m = [o.solid.shape.length_m(), o.solid.shape.width_m()];
-                        let shift = r
-                            .room
-                            .map_or_else(Vector2::zeros, |room| room.shift * room.blend(r.arc_m).0);
+                        let shift = r.shift();
                         let near = |from_m: f64, to_m: f64, within_m: f64| {
                             near_path(
                                 &self.parts,
@@ -341,8 +347,8 @@ fn advance(
 fn placed(r: &Reactive, m: &ObstacleMotion, speed_m_s: f64) -> MoverState {
     let mut state = m.state_at_arc(r.arc_m, speed_m_s);
     if let Some(room) = r.room {
-        let (blend, rate) = room.blend(r.arc_m);
-        let at = Vector2::new(state.x_m, state.y_m) + room.shift * blend;
+        let rate = room.blend(r.arc_m).1;
+        let at = Vector2::new(state.x_m, state.y_m) + r.shift();
         let along = Vector2::new(state.heading_rad.cos(), state.heading_rad.sin());
         let tangent = along + room.shift * rate;
         let heading = tangent.y.atan2(tangent.x);
