@@ -118,7 +118,8 @@ pub struct RunRecord {
     #[serde(default)]
     pub faults: crate::world::FaultCounts,
     /// The pilot call that ended the run, as `call/hold` (`blocked/mover`,
-    /// `hidden_obstacle/lost_obstacle`, `walk_around/unseen_ground`, ...; see
+    /// `hidden_obstacle/lost_obstacle`, `hidden_obstacle/mover_lost_at_body`,
+    /// `walk_around/unseen_ground`, ...; see
     /// `engine::PilotCallReport`).
     #[serde(default)]
     pub pilot_call: Option<String>,

@@ -2,10 +2,11 @@
 //! stack believed it (an obstacle it saw, one it lost from view, a mover it yielded to, ground it
 //! never saw), and - from ground truth, for the judge only - whether anything was really there.
 //! A call is **needless** when no object stood near any point that held the vehicle in the last
-//! [`NEEDLESS_WINDOW_S`] seconds.
+//! [`NEEDLESS_WINDOW_S`] seconds, and none that struck the vehicle stands against it.
 
 use std::collections::VecDeque;
 
+use autonomy::traffic::LostMover;
 use autonomy::{DriverStatus, PilotCall};
 use nalgebra::Point2;
 use serde::Serialize;
@@ -33,6 +34,8 @@ pub enum Hold {
     LostObstacle {
         /// When a revolution last hit it, if ever, seconds.
         last_seen_s: Option<f64>,
+        /// A mover believed at the body though none is seen there, and why (`None`: map cells).
+        mover: Option<LostMover>,
     },
     /// A mover predicted to cross the path, yielded to.
     Mover {
@@ -58,8 +61,9 @@ impl Hold {
             DriverStatus::WaitingForHiddenObstacle {
                 obstacle,
                 last_seen_s,
+                mover,
                 ..
-            } => Some((Hold::LostObstacle { last_seen_s }, Some(obstacle))),
+            } => Some((Hold::LostObstacle { last_seen_s, mover }, Some(obstacle))),
             DriverStatus::Yielding { track_id, mover_at } => {
                 Some((Hold::Mover { track_id }, Some(mover_at)))
             }
@@ -69,11 +73,24 @@ impl Hold {
         }
     }
 
-    /// A short name for tables: `obstacle`, `lost_obstacle`, `mover`, `unseen_ground`.
+    /// A short name for tables: `obstacle`, `lost_obstacle` (map cells), `mover_lost_at_body`,
+    /// `mover_lost_coasting`, `mover_lost_standing`, `mover`, `unseen_ground`.
     pub fn name(&self) -> &'static str {
         match self {
             Hold::Obstacle { .. } => "obstacle",
-            Hold::LostObstacle { .. } => "lost_obstacle",
+            Hold::LostObstacle { mover: None, .. } => "lost_obstacle",
+            Hold::LostObstacle {
+                mover: Some(LostMover::AtBody),
+                ..
+            } => "mover_lost_at_body",
+            Hold::LostObstacle {
+                mover: Some(LostMover::Coasting),
+                ..
+            } => "mover_lost_coasting",
+            Hold::LostObstacle {
+                mover: Some(LostMover::Standing),
+                ..
+            } => "mover_lost_standing",
             Hold::Mover { .. } => "mover",
             Hold::UnseenGround { .. } => "unseen_ground",
         }
@@ -93,7 +110,8 @@ pub struct PilotCallReport {
     /// Where that was, metres.
     pub at_m: Option<[f64; 2]>,
     /// Ground truth, for the judge: the object nearest any point that held the vehicle in the
-    /// last [`NEEDLESS_WINDOW_S`] s (for unseen ground: any cell of it), and how far, metres.
+    /// last [`NEEDLESS_WINDOW_S`] s (for unseen ground: any cell of it), or to the vehicle's
+    /// parts of one that struck it, and how far, metres.
     pub nearest_object: Option<(String, f64)>,
     /// Nothing stood within [`REAL_WITHIN_M`] of any of them: the call was needless.
     pub needless: bool,
@@ -133,9 +151,21 @@ impl HoldLog {
         if matches!(call, PilotCall::WalkAround) {
             points.extend(unseen.unwrap_or_default());
         }
+        // An object that struck the vehicle and stands against it holds it too, wherever the
+        // stack last saw it: a person who walked on into the nose out of view.
+        let pressed = (0..world.scene().solids.len())
+            .filter(|&i| {
+                let id = &world.scene().solids[i].id;
+                world.contacts().iter().any(|c| &c.object == id)
+            })
+            .filter_map(|i| {
+                let d = world.distances_to(i).into_iter().reduce(f64::min)?;
+                Some((i, d))
+            });
         let nearest = points
             .iter()
             .filter_map(|p| world.nearest_object_to(p))
+            .chain(pressed)
             .min_by(|a, b| a.1.total_cmp(&b.1));
         PilotCallReport {
             t_s,

@@ -401,6 +401,7 @@ impl<'a> Rig<'a> {
                     obstacle,
                     last_seen_s,
                     since_s,
+                    ..
                 },
             ) => Some(HiddenObstacle {
                 x_m: obstacle.x,

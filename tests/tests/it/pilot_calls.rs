@@ -1,7 +1,8 @@
 //! Every pilot call says why, as data (`RunReport::pilot_call`): the rule that called, what held
 //! the vehicle as the stack believed it and where, and - from ground truth - whether an object
 //! stood there. A phantom that holds the car is a needless call; the cone a low LiDAR stops the
-//! jet for, and the cone under the nose of a jet without a walk-around, are not.
+//! jet for, the cone under the nose of a jet without a walk-around, and a person who walked on
+//! into the standing jet out of view, are not.
 
 use std::path::PathBuf;
 
@@ -24,8 +25,8 @@ fn a_phantom_that_holds_the_car_is_a_needless_pilot_call() {
     let call = r.pilot_call.expect("a pilot call");
     assert_eq!(call.call, "hidden_obstacle");
     assert!(
-        matches!(call.hold, Some(Hold::LostObstacle { .. })),
-        "{call:?}"
+        matches!(call.hold, Some(Hold::LostObstacle { mover: None, .. })),
+        "map cells, not a mover: {call:?}"
     );
     let [x, _] = call.at_m.unwrap();
     assert!(x < 12.0, "held near its start: {call:?}");
@@ -61,4 +62,28 @@ fn a_cone_seen_in_the_path_or_in_the_unseen_ground_makes_a_call_that_was_needed(
     let call = run(&empty).pilot_call.expect("a pilot call");
     assert_eq!(call.call, "walk_around");
     assert!(call.needless, "{call:?}");
+}
+
+/// The person of `person_walks_into_the_standing_jet.toml`, last seen a step short of the
+/// fuselage, walked on into it out of view and stands against it: the stack waits for a mover
+/// lost at its body, and the call was needed - the person is within centimetres of the
+/// airframe, though over a metre from where the stack last saw them.
+#[test]
+fn a_person_who_walked_into_the_standing_jet_out_of_view_makes_a_call_that_was_needed() {
+    let s = file("found/person_walks_into_the_standing_jet.toml");
+    let call = run(&s).pilot_call.expect("a pilot call");
+    assert_eq!(call.call, "hidden_obstacle");
+    assert!(
+        matches!(
+            call.hold,
+            Some(Hold::LostObstacle {
+                mover: Some(autonomy::traffic::LostMover::AtBody),
+                ..
+            })
+        ),
+        "{call:?}"
+    );
+    let (id, d) = call.nearest_object.clone().unwrap();
+    assert_eq!(id, "person_1");
+    assert!(d < 0.1 && !call.needless, "{call:?}");
 }

@@ -6,7 +6,7 @@ use nalgebra::Point2;
 use super::Driver;
 use crate::online_map::OnlineMap;
 use crate::planner::{AutonomyConfig, Plan};
-use crate::traffic::BodyHold;
+use crate::traffic::{BodyHold, LostMover};
 
 /// What the driver is doing about obstacles.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,6 +31,8 @@ pub enum DriverStatus {
         last_seen_s: Option<f64>,
         /// When the wait began, seconds.
         since_s: f64,
+        /// A mover none sees that is believed at the body, and why (`None`: the map's cells).
+        mover: Option<LostMover>,
     },
     /// Not moved off yet: part of the ground its first plan sweeps is ground its sensors cannot
     /// see from where it stands, and no walk-around has confirmed it (the start-up rule,
@@ -119,6 +121,7 @@ impl Driver {
                     DriverStatus::WaitingForHiddenObstacle { since_s, .. } => since_s,
                     _ => now_s,
                 },
+                mover: None,
             },
         }
     }
@@ -155,13 +158,18 @@ impl Driver {
                 obstacle: at,
                 last_seen_s,
             },
-            BodyHold::Lost { at, last_seen_s } => DriverStatus::WaitingForHiddenObstacle {
+            BodyHold::Lost {
+                at,
+                last_seen_s,
+                why,
+            } => DriverStatus::WaitingForHiddenObstacle {
                 obstacle: at,
                 last_seen_s: Some(last_seen_s),
                 since_s: match self.status {
                     DriverStatus::WaitingForHiddenObstacle { since_s, .. } => since_s,
                     _ => now_s,
                 },
+                mover: Some(why),
             },
         }
     }

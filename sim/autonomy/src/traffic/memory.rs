@@ -5,7 +5,7 @@
 use mapper::TrackState;
 use nalgebra::Isometry2;
 
-use super::rules::{AtBody, BodyHold, MoverStreak, TrafficRules};
+use super::rules::{AtBody, BodyHold, LostMover, MoverStreak, TrafficRules};
 use super::{
     TrafficConfig, at_body, may_have_walked_to, may_reach_body, moved_beyond_its_extent,
     surely_moving,
@@ -44,6 +44,12 @@ const LOST_STANDING_WALK_M_S: f64 = 1.5;
 const LOST_STANDING_FOR_S: f64 = 60.0;
 pub(super) const LOST_STANDING_EXTENT_M: f64 = 2.0;
 
+/// A mover lost at the body is the same mover as a track that started within this many seconds
+/// after it was lost ...
+const ELSEWHERE_WITHIN_S: f64 = 10.0;
+/// ... where it could have gone by then at its peak speed, or at least this, m/s (a brisk walk).
+const ELSEWHERE_M_S: f64 = 1.5;
+
 impl TrafficRules {
     /// The movers at the body now ([`at_body`]) joined to those lost there before; what holds
     /// the vehicle for them (`None`: nothing at the body): stopped for the one seen last, if
@@ -63,6 +69,7 @@ impl TrafficRules {
             return None;
         }
         self.note_streaks(now_s);
+        self.note_first_seen(movers);
         self.note_lost_standing(movers, now_s, cfg);
         // A mover arriving at the body, or one held there before and not seen away.
         let mut body: Vec<AtBody> = movers
@@ -77,21 +84,26 @@ impl TrafficRules {
                 }
                 self.arriving(t, now_s, cfg) && at()
             })
-            .map(|t| AtBody {
-                id: t.id,
-                at: t.position,
-                seen_s: t.t_s,
-            })
+            .map(|t| AtBody::of(t, LostMover::AtBody))
             .collect();
-        // One lost (its track gone, or renumbered: seen again beyond its own extent from where
-        // it was lost) is waited for for good, as a hidden obstacle: the pilot is called. Its
-        // cells reading free would prove nothing - within the map's self-hit margin of the
-        // body nothing is ever mapped.
-        let lost = self
-            .at_body
-            .iter()
-            .filter(|r| !movers.iter().any(|t| t.id == r.id));
-        body.extend(lost);
+        // One lost (its track gone) is waited for for good, as a hidden obstacle: the pilot is
+        // called. Its cells reading free would prove nothing - within the map's self-hit margin
+        // of the body nothing is ever mapped. Unless it is seen elsewhere under a new number
+        // (`seen_elsewhere`): it walked or drove on out of the blind zone.
+        let lost: Vec<AtBody> = (self.at_body.iter())
+            .filter(|r| !movers.iter().any(|t| t.id == r.id))
+            .copied()
+            .collect();
+        let mut claimed = Vec::new();
+        for r in lost {
+            match self.seen_elsewhere(&r, movers, pose, now_s, cfg, &claimed) {
+                Some(id) => {
+                    claimed.push(id);
+                    self.lost_standing.retain(|l| l.id != r.id);
+                }
+                None => body.push(r),
+            }
+        }
         // A mover that coasted out of view toward a standing vehicle and whose track was then
         // dropped: if it may reach the body within `DROPPED_AT_BODY_S`, it is waited for as
         // one lost there (a van that drove into the blind zone behind the wing has not gone).
@@ -101,15 +113,12 @@ impl TrafficRules {
                 .iter()
                 .filter(|t| !movers.iter().any(|m| m.id == t.id))
                 .filter(|t| !body.iter().any(|r| r.id == t.id) && now_s - t.t_s >= COASTED_S)
+                .filter(|t| !part_of_another(t, movers, now_s))
                 .filter(|t| {
                     let window = (now_s, now_s + DROPPED_AT_BODY_S);
                     may_reach_body(&self.model, pose, t, window, cfg)
                 })
-                .map(|t| AtBody {
-                    id: t.id,
-                    at: t.position,
-                    seen_s: t.t_s,
-                })
+                .map(|t| AtBody::of(t, LostMover::Coasting))
                 .collect::<Vec<_>>();
             body.extend(dropped);
             let lost = self.lost_standing_at(pose, now_s, &body, cfg);
@@ -150,7 +159,63 @@ impl TrafficRules {
         Some(BodyHold::Lost {
             at: r.at,
             last_seen_s: r.seen_s,
+            why: r.why,
         })
+    }
+
+    /// Notes where and when each of `movers` was first given to the rules; forgets those gone.
+    fn note_first_seen(&mut self, movers: &[TrackState]) {
+        self.first_seen
+            .retain(|(id, ..)| movers.iter().any(|t| t.id == *id));
+        for t in movers {
+            if !self.first_seen.iter().any(|(id, ..)| *id == t.id) {
+                self.first_seen.push((t.id, t.position, t.t_s));
+            }
+        }
+    }
+
+    /// The track of `movers` (not one of `claimed`) that is `lost` - a mover lost from view
+    /// at the body of the vehicle at `pose` - seen again under a new number, if any: seen now,
+    /// away from the body ([`at_body`]), moved beyond its own extent, hit in a level `lost` was,
+    /// no smaller than half its extent nor larger by 2 m, and first given to the rules within
+    /// [`ELSEWHERE_WITHIN_S`] after `lost` was last seen (or a second before: a track may split
+    /// as it is renumbered), where it could have gone by then at its peak speed (at least
+    /// [`ELSEWHERE_M_S`]). The nearest to where `lost` was, when several are.
+    fn seen_elsewhere(
+        &self,
+        lost: &AtBody,
+        movers: &[TrackState],
+        pose: &Isometry2<f64>,
+        now_s: f64,
+        cfg: &TrafficConfig,
+        claimed: &[u32],
+    ) -> Option<u32> {
+        let started_where_it_went = |t: &TrackState| {
+            let Some(&(_, from, since)) = self.first_seen.iter().find(|f| f.0 == t.id) else {
+                return false;
+            };
+            let dt = since - lost.seen_s;
+            let speed = t.peak_speed_m_s.max(ELSEWHERE_M_S);
+            (-1.0..=ELSEWHERE_WITHIN_S).contains(&dt)
+                && (from - lost.at).norm() <= lost.extent_m + t.extent_m + speed * dt.max(0.0)
+        };
+        movers
+            .iter()
+            .filter(|t| t.id != lost.id && !claimed.contains(&t.id))
+            .filter(|t| {
+                now_s - t.t_s <= 0.25
+                    && t.levels & lost.levels != 0
+                    && t.extent_m >= 0.5 * lost.extent_m
+                    && t.extent_m <= lost.extent_m + 2.0
+                    && moved_beyond_its_extent(t, cfg)
+                    && !at_body(&self.model, pose, t, now_s, cfg)
+                    && started_where_it_went(t)
+            })
+            .min_by(|a, b| {
+                let d = |t: &TrackState| (t.position - lost.at).norm();
+                d(a).total_cmp(&d(b))
+            })
+            .map(|t| t.id)
     }
 
     /// Whether track `t` is a mover that may arrive at the body: one predicted on a streak
@@ -218,11 +283,7 @@ impl TrafficRules {
             .filter(|l| {
                 may_have_walked_to(&self.model, pose, l, now_s, LOST_STANDING_WALK_M_S, cfg)
             })
-            .map(|l| AtBody {
-                id: l.id,
-                at: l.position,
-                seen_s: l.t_s,
-            })
+            .map(|l| AtBody::of(l, LostMover::Standing))
             .collect()
     }
 
@@ -261,4 +322,21 @@ impl TrafficRules {
         }
         self.streaks.retain(|r| now_s - r.last_s <= MOVER_LATELY_S);
     }
+}
+
+/// Whether `t`, a track dropped, lay when last seen within the extent of another of `movers`,
+/// seen now, no smaller than half of it and hit in a level it was, where that one's motion puts
+/// it then: a part of it tracked apart, or the same object tracked twice - a fuel truck's
+/// split-off part that seemed to move the other way, a van's front (variants 27 and 32 of
+/// `traffic_jet.toml`, waited for as lost until the pilot was called). Two vans in convoy
+/// closer than their length would be taken for one.
+fn part_of_another(t: &TrackState, movers: &[TrackState], now_s: f64) -> bool {
+    movers.iter().any(|o| {
+        let then = o.position + o.velocity * (t.t_s - o.t_s);
+        o.id != t.id
+            && now_s - o.t_s <= 0.25
+            && o.levels & t.levels != 0
+            && o.extent_m >= 0.5 * t.extent_m
+            && (then - t.position).norm() <= o.extent_m.max(t.extent_m)
+    })
 }

@@ -71,7 +71,7 @@ pub use conflict::{
     stand_clear,
 };
 pub use predict::{moved_beyond_its_extent, predict, predict_keeping, surely_moving};
-pub use rules::{BodyHold, MoverDecision, MoverInputs, TrafficRules};
+pub use rules::{BodyHold, LostMover, MoverDecision, MoverInputs, TrafficRules};
 
 /// How the stack predicts movers and checks its path against them.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -14,6 +14,7 @@
 
 use mapper::{CollisionModel, TrackState};
 use nalgebra::{Isometry2, Point2};
+use serde::Serialize;
 
 use super::predict::predict_keeping;
 use super::{Conflict, Prediction, SpeedProfile, TimedPath, TrafficConfig, first_conflict};
@@ -73,7 +74,22 @@ pub enum BodyHold {
         at: Point2<f64>,
         /// When it was last seen, seconds.
         last_seen_s: f64,
+        /// Why it is believed at the body.
+        why: LostMover,
     },
+}
+
+/// Why a mover none sees is believed at the standing vehicle's body (what a pilot call for it
+/// says).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LostMover {
+    /// Held at the body, then its track dropped without it being seen away.
+    AtBody,
+    /// Predicted out of view towards the standing vehicle when its track dropped.
+    Coasting,
+    /// Lost from view standing, near enough to have walked to the body since.
+    Standing,
 }
 
 /// The rules' decision about movers for one plan.
@@ -103,6 +119,25 @@ pub(super) struct AtBody {
     pub(super) at: Point2<f64>,
     /// When it was last seen, seconds.
     pub(super) seen_s: f64,
+    /// Its largest extent, metres, and the levels it was hit in (bit `l`: level `l`).
+    pub(super) extent_m: f64,
+    pub(super) levels: u32,
+    /// Why it is held once lost.
+    pub(super) why: LostMover,
+}
+
+impl AtBody {
+    /// Track `t` at the body, held for `why` once lost.
+    pub(super) fn of(t: &TrackState, why: LostMover) -> Self {
+        AtBody {
+            id: t.id,
+            at: t.position,
+            seen_s: t.t_s,
+            extent_m: t.extent_m,
+            levels: t.levels,
+            why,
+        }
+    }
 }
 
 /// A track seen and predicted as a mover on consecutive plans.
@@ -153,6 +188,9 @@ pub struct TrafficRules {
     pub(super) lost_standing: Vec<TrackState>,
     /// The tracks seen moving as movers for `MOVER_FOR_S` on end at some time.
     pub(super) walked: Vec<u32>,
+    /// Where and when each of the movers was first given to the rules (metres, seconds): a
+    /// track that starts where a mover lost at the body could have gone is that mover.
+    pub(super) first_seen: Vec<(u32, Point2<f64>, f64)>,
     /// The person standing the last plan stopped short of (see `short_of_walkers`): where, and
     /// when last seen, seconds.
     pub(super) walker_stop: Option<(Point2<f64>, f64)>,
@@ -176,6 +214,7 @@ impl TrafficRules {
             streaks: Vec::new(),
             lost_standing: Vec::new(),
             walked: Vec::new(),
+            first_seen: Vec::new(),
             walker_stop: None,
         }
     }
@@ -191,6 +230,7 @@ impl TrafficRules {
         self.streaks.clear();
         self.lost_standing.clear();
         self.walked.clear();
+        self.first_seen.clear();
         self.hold = None;
     }
 

@@ -82,6 +82,18 @@ fn mover_streak(id: u32, mover_s: f64) -> MoverStreak {
     }
 }
 
+/// Track 13, of `extent_m` in level 0, held at the fuselage and last seen there at 1 s.
+fn lost_at_the_fuselage(extent_m: f64) -> AtBody {
+    AtBody {
+        id: 13,
+        at: Point2::new(4.0, 1.8),
+        seen_s: 1.0,
+        extent_m,
+        levels: 0b01,
+        why: LostMover::AtBody,
+    }
+}
+
 /// A van crossing from the right at 3 m/s, 30 m ahead of a vehicle at 5 m/s (the space-time
 /// check's own test case).
 fn crossing_van(id: u32) -> TrackState {
@@ -458,17 +470,14 @@ fn a_mover_at_the_fuselage_holds_the_jet_until_seen_away() {
         ),
         Some(BodyHold::Lost {
             at: Point2::new(4.0, 1.8),
-            last_seen_s: 1.0
+            last_seen_s: 1.0,
+            why: LostMover::AtBody,
         })
     );
     // Another such mover, seen again away from the body: let go.
     let mut r = rules();
     r.streaks.push(mover_streak(13, 1.0));
-    r.at_body.push(AtBody {
-        id: 13,
-        at: Point2::new(4.0, 1.8),
-        seen_s: 1.0,
-    });
+    r.at_body.push(lost_at_the_fuselage(0.6));
     let away = [track(13, 2.0, (4.0, -8.0), (0.0, 0.0), 0b01)];
     assert_eq!(
         r.movers_at_body(
@@ -482,6 +491,56 @@ fn a_mover_at_the_fuselage_holds_the_jet_until_seen_away() {
         None
     );
     assert!(r.at_body.is_empty());
+}
+
+/// A person who walked on into the standing jet out of view and out past it (variants 27 and
+/// 32 of `traffic_jet.toml`: a fuel truck and a van lost as they crossed ahead, waited for as
+/// lost at the body until the pilot was called): lost at the fuselage, then a track starts
+/// where the mover could have gone by then and moves off - the mover, seen elsewhere under a
+/// new number: let go. Not a track that started farther than it could have gone, nor one much
+/// larger or smaller, nor one in another level, nor one that started long before it was lost.
+#[test]
+fn a_mover_lost_at_the_fuselage_and_seen_going_off_under_a_new_number_is_let_go() {
+    let config = AutonomyConfig::default();
+    let (cfg, hidden_after_s) = (&config.traffic, config.hidden_after_s);
+    let pose = Isometry2::identity();
+    let held = |new: TrackState, first_s: f64| {
+        let mut r = rules();
+        r.streaks.push(mover_streak(13, 1.0));
+        r.at_body.push(lost_at_the_fuselage(2.0));
+        // First given to the rules at `first_s` where it is, seen moving off at 5 s.
+        let first = TrackState {
+            t_s: first_s,
+            ..new.clone()
+        };
+        r.movers_at_body(&[first], &pose, first_s, true, cfg, hidden_after_s);
+        let seen = TrackState {
+            t_s: 5.0,
+            position: new.position + Vector2::new(0.0, -1.4),
+            ..new
+        };
+        r.movers_at_body(&[seen], &pose, 5.0, true, cfg, hidden_after_s)
+    };
+    let walker = |(x, y): (f64, f64), levels| track(14, 4.0, (x, y), (0.0, -1.4), levels);
+    // 7.8 m from where it was lost, 3 s after: within 2 + 2 m of extents and 1.5 m/s.
+    assert_eq!(held(walker((4.0, -6.0), 0b01), 4.0), None);
+    // 13.8 m from it 1 s after: another mover.
+    let far = held(walker((4.0, -12.0), 0b01), 2.0);
+    assert!(matches!(far, Some(BodyHold::Lost { .. })), "{far:?}");
+    // A track in another level, or one of 6.5 m (a truck, not a person) or 0.5 m.
+    let high = held(walker((4.0, -6.0), 0b10), 4.0);
+    assert!(matches!(high, Some(BodyHold::Lost { .. })), "{high:?}");
+    for extent_m in [6.5, 0.5] {
+        let other = TrackState {
+            extent_m,
+            ..walker((4.0, -6.0), 0b01)
+        };
+        let kept = held(other, 4.0);
+        assert!(matches!(kept, Some(BodyHold::Lost { .. })), "{kept:?}");
+    }
+    // One that was tracked from 2 s before the mover was lost.
+    let older = held(walker((4.0, -6.0), 0b01), -1.0);
+    assert!(matches!(older, Some(BodyHold::Lost { .. })), "{older:?}");
 }
 
 /// The whole decision for a van crossing ahead of the vehicle at 5 m/s (`jet_meets_crossing_vehicle`):
@@ -596,7 +655,8 @@ fn a_mover_that_coasted_out_of_view_towards_the_standing_jet_is_waited_for_once_
         r.movers_at_body(&[], &pose, 12.5, true, cfg, hidden_after_s),
         Some(BodyHold::Lost {
             at: Point2::new(4.0, -13.0),
-            last_seen_s: 10.0
+            last_seen_s: 10.0,
+            why: LostMover::Coasting,
         })
     );
     // ... and for good: not seen away.
@@ -621,4 +681,27 @@ fn a_mover_that_coasted_out_of_view_towards_the_standing_jet_is_waited_for_once_
         r.movers_at_body(&[], &pose, 11.0, true, cfg, hidden_after_s),
         None
     );
+    // A part of another mover, seen now, tracked apart (variants 27 and 32 of
+    // `traffic_jet.toml`): that one was 1.5 m from it when it was last seen, going off
+    // crosswise at 5 m/s - let go; 5 m from it (beyond both extents), or a much smaller one
+    // (a person), or one in another level: the van is waited for.
+    let other = |(dx, dy): (f64, f64), extent_m: f64, levels: u32| TrackState {
+        extent_m,
+        ..track(22, 12.5, (4.0 + dx + 12.5, -13.0 + dy), (5.0, 0.0), levels)
+    };
+    let mut r = coasting(4.0);
+    let seen = [other((1.5, 0.0), 2.0, 0b01)];
+    assert_eq!(
+        r.movers_at_body(&seen, &pose, 12.5, true, cfg, hidden_after_s),
+        None
+    );
+    for o in [
+        other((5.0, 0.0), 2.0, 0b01),
+        other((1.5, 0.0), 0.6, 0b01),
+        other((1.5, 0.0), 2.0, 0b10),
+    ] {
+        let mut r = coasting(4.0);
+        let held = r.movers_at_body(&[o], &pose, 12.5, true, cfg, hidden_after_s);
+        assert!(matches!(held, Some(BodyHold::Lost { .. })), "{held:?}");
+    }
 }
