@@ -55,6 +55,10 @@ pub struct TrackState {
     /// shadow of a wing seems to slow as its visible part shrinks, and is lost at that lower
     /// speed.
     pub peak_speed_m_s: f64,
+    /// When the tracker first saw it under this id, seconds.
+    pub born_s: f64,
+    /// Where it was then (the centre of its hits), metres.
+    pub origin: Point2<f64>,
 }
 
 impl TrackState {
@@ -141,6 +145,8 @@ impl Tracker {
             open_top_m: t.open_top_m.map(f64::from),
             confirmed: t.moving,
             travel_m: (t.last - t.origin).norm(),
+            born_s: t.born_s,
+            origin: t.origin,
             peak_speed_m_s: t
                 .recent_speeds
                 .iter()

@@ -52,6 +52,8 @@ pub(super) struct Track {
     pub(super) smooth: bool,
     /// Cells it painted (some may since belong to another track).
     pub(super) painted: Vec<WorldCell>,
+    /// When it was created or given a new id, seconds.
+    pub(super) born_s: f64,
 }
 
 impl Tracker {
@@ -83,6 +85,7 @@ impl Tracker {
             moving: false,
             smooth: false,
             painted: Vec::new(),
+            born_s: t_s,
         });
         self.next_id = self.next_id.wrapping_add(1);
         self.tracks.len() - 1
@@ -123,6 +126,7 @@ impl Tracker {
             if another {
                 track.id = self.next_id;
                 self.next_id = self.next_id.wrapping_add(1);
+                track.born_s = t_s;
                 track.origin = cluster.center;
                 track.moving = false;
                 track.predictable = false;

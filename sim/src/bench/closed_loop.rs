@@ -137,6 +137,8 @@ fn traffic_figures(samples: usize) -> Vec<Figure> {
                 bbox: ((0, 0), (22, 8)),
                 size_m: [4.6, 1.8],
                 peak_speed_m_s: if i % 3 == 0 { 3.0 } else { 2.0 },
+                born_s: -8.0,
+                origin: Point2::new(2.0 * i as f64, side * (35.0 + i as f64)),
             }
         })
         .collect();

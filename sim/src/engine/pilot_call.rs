@@ -2,7 +2,8 @@
 //! stack believed it (an obstacle it saw, one it lost from view, a mover it yielded to, ground it
 //! never saw), and - from ground truth, for the judge only - whether anything was really there.
 //! A call is **needless** when no object stood near any point that held the vehicle in the last
-//! [`NEEDLESS_WINDOW_S`] seconds, and none that struck the vehicle stands against it.
+//! [`NEEDLESS_WINDOW_S`] seconds, and - when it waited for a mover it believed at its body -
+//! none that struck the vehicle stands against it.
 
 use std::collections::VecDeque;
 
@@ -110,8 +111,9 @@ pub struct PilotCallReport {
     /// Where that was, metres.
     pub at_m: Option<[f64; 2]>,
     /// Ground truth, for the judge: the object nearest any point that held the vehicle in the
-    /// last [`NEEDLESS_WINDOW_S`] s (for unseen ground: any cell of it), or to the vehicle's
-    /// parts of one that struck it, and how far, metres.
+    /// last [`NEEDLESS_WINDOW_S`] s (for unseen ground: any cell of it), or - waiting for a
+    /// mover believed at the body - to the vehicle's parts of one that struck it, and how far,
+    /// metres.
     pub nearest_object: Option<(String, f64)>,
     /// Nothing stood within [`REAL_WITHIN_M`] of any of them: the call was needless.
     pub needless: bool,
@@ -151,9 +153,15 @@ impl HoldLog {
         if matches!(call, PilotCall::WalkAround) {
             points.extend(unseen.unwrap_or_default());
         }
-        // An object that struck the vehicle and stands against it holds it too, wherever the
-        // stack last saw it: a person who walked on into the nose out of view.
+        // Waiting for a mover it believes at its body: one that struck the vehicle and stands
+        // against it is that mover, wherever the stack last saw it (a person who walked on into
+        // the nose out of view).
+        let for_a_mover = matches!(
+            last,
+            Some((_, Hold::LostObstacle { mover: Some(_), .. }, _))
+        );
         let pressed = (0..world.scene().solids.len())
+            .filter(|_| for_a_mover)
             .filter(|&i| {
                 let id = &world.scene().solids[i].id;
                 world.contacts().iter().any(|c| &c.object == id)

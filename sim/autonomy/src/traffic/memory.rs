@@ -44,10 +44,11 @@ const LOST_STANDING_WALK_M_S: f64 = 1.5;
 const LOST_STANDING_FOR_S: f64 = 60.0;
 pub(super) const LOST_STANDING_EXTENT_M: f64 = 2.0;
 
-/// A mover lost at the body is the same mover as a track that started within this many seconds
-/// after it was lost ...
+/// A mover lost at the body is the same mover as a track the tracker started within this many
+/// seconds after it was last seen ...
 const ELSEWHERE_WITHIN_S: f64 = 10.0;
-/// ... where it could have gone by then at its peak speed, or at least this, m/s (a brisk walk).
+/// ... where it could have gone by then at its own peak speed, or at least this, m/s (a brisk
+/// walk).
 const ELSEWHERE_M_S: f64 = 1.5;
 
 impl TrafficRules {
@@ -69,8 +70,8 @@ impl TrafficRules {
             return None;
         }
         self.note_streaks(now_s);
-        self.note_first_seen(movers);
         self.note_lost_standing(movers, now_s, cfg);
+        self.claimed.retain(|id| movers.iter().any(|t| t.id == *id));
         // A mover arriving at the body, or one held there before and not seen away.
         let mut body: Vec<AtBody> = movers
             .iter()
@@ -94,12 +95,12 @@ impl TrafficRules {
             .filter(|r| !movers.iter().any(|t| t.id == r.id))
             .copied()
             .collect();
-        let mut claimed = Vec::new();
         for r in lost {
-            match self.seen_elsewhere(&r, movers, pose, now_s, cfg, &claimed) {
+            match self.seen_elsewhere(&r, movers, pose, now_s, cfg) {
                 Some(id) => {
-                    claimed.push(id);
+                    self.claimed.push(id);
                     self.lost_standing.retain(|l| l.id != r.id);
+                    self.coasting.retain(|l| l.id != r.id);
                 }
                 None => body.push(r),
             }
@@ -163,24 +164,15 @@ impl TrafficRules {
         })
     }
 
-    /// Notes where and when each of `movers` was first given to the rules; forgets those gone.
-    fn note_first_seen(&mut self, movers: &[TrackState]) {
-        self.first_seen
-            .retain(|(id, ..)| movers.iter().any(|t| t.id == *id));
-        for t in movers {
-            if !self.first_seen.iter().any(|(id, ..)| *id == t.id) {
-                self.first_seen.push((t.id, t.position, t.t_s));
-            }
-        }
-    }
-
-    /// The track of `movers` (not one of `claimed`) that is `lost` - a mover lost from view
-    /// at the body of the vehicle at `pose` - seen again under a new number, if any: seen now,
-    /// away from the body ([`at_body`]), moved beyond its own extent, hit in a level `lost` was,
-    /// no smaller than half its extent nor larger by 2 m, and first given to the rules within
-    /// [`ELSEWHERE_WITHIN_S`] after `lost` was last seen (or a second before: a track may split
-    /// as it is renumbered), where it could have gone by then at its peak speed (at least
-    /// [`ELSEWHERE_M_S`]). The nearest to where `lost` was, when several are.
+    /// The track of `movers` that is `lost` - a mover held at the body of the vehicle at `pose`
+    /// and lost there, or lost standing near enough to have walked to it, not one that coasted
+    /// out of view - seen again under a new number, if any: seen now, away from the body
+    /// ([`at_body`]), moved beyond its own extent, hit in a level `lost` was, no smaller than
+    /// half its extent nor larger by 2 m, started by the tracker within [`ELSEWHERE_WITHIN_S`]
+    /// after `lost` was last seen (or a second before: a track may split as it is renumbered)
+    /// where `lost` could have gone by then at its peak speed (at least [`ELSEWHERE_M_S`]), and
+    /// not already taken for another (`claimed`). The nearest to where `lost` was, when several
+    /// are.
     fn seen_elsewhere(
         &self,
         lost: &AtBody,
@@ -188,20 +180,19 @@ impl TrafficRules {
         pose: &Isometry2<f64>,
         now_s: f64,
         cfg: &TrafficConfig,
-        claimed: &[u32],
     ) -> Option<u32> {
+        if lost.why == LostMover::Coasting {
+            return None;
+        }
         let started_where_it_went = |t: &TrackState| {
-            let Some(&(_, from, since)) = self.first_seen.iter().find(|f| f.0 == t.id) else {
-                return false;
-            };
-            let dt = since - lost.seen_s;
-            let speed = t.peak_speed_m_s.max(ELSEWHERE_M_S);
+            let dt = t.born_s - lost.seen_s;
+            let speed = lost.peak_m_s.max(ELSEWHERE_M_S);
             (-1.0..=ELSEWHERE_WITHIN_S).contains(&dt)
-                && (from - lost.at).norm() <= lost.extent_m + t.extent_m + speed * dt.max(0.0)
+                && (t.origin - lost.at).norm() <= lost.extent_m + t.extent_m + speed * dt.max(0.0)
         };
         movers
             .iter()
-            .filter(|t| t.id != lost.id && !claimed.contains(&t.id))
+            .filter(|t| t.id != lost.id && !self.claimed.contains(&t.id))
             .filter(|t| {
                 now_s - t.t_s <= 0.25
                     && t.levels & lost.levels != 0
@@ -325,8 +316,8 @@ impl TrafficRules {
 }
 
 /// Whether `t`, a track dropped, lay when last seen within the extent of another of `movers`,
-/// seen now, no smaller than half of it and hit in a level it was, where that one's motion puts
-/// it then: a part of it tracked apart, or the same object tracked twice - a fuel truck's
+/// seen now, no smaller than it and hit in a level it was, where that one's motion puts it
+/// then: a part of it tracked apart, or the same object tracked twice - a fuel truck's
 /// split-off part that seemed to move the other way, a van's front (variants 27 and 32 of
 /// `traffic_jet.toml`, waited for as lost until the pilot was called). Two vans in convoy
 /// closer than their length would be taken for one.
@@ -336,7 +327,7 @@ fn part_of_another(t: &TrackState, movers: &[TrackState], now_s: f64) -> bool {
         o.id != t.id
             && now_s - o.t_s <= 0.25
             && o.levels & t.levels != 0
-            && o.extent_m >= 0.5 * t.extent_m
-            && (then - t.position).norm() <= o.extent_m.max(t.extent_m)
+            && o.extent_m >= t.extent_m
+            && (then - t.position).norm() <= o.extent_m
     })
 }

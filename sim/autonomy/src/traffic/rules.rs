@@ -119,9 +119,12 @@ pub(super) struct AtBody {
     pub(super) at: Point2<f64>,
     /// When it was last seen, seconds.
     pub(super) seen_s: f64,
-    /// Its largest extent, metres, and the levels it was hit in (bit `l`: level `l`).
+    /// Its largest extent, metres.
     pub(super) extent_m: f64,
+    /// The levels it was hit in (bit `l`: level `l`).
     pub(super) levels: u32,
+    /// The fastest it was seen moving lately, m/s.
+    pub(super) peak_m_s: f64,
     /// Why it is held once lost.
     pub(super) why: LostMover,
 }
@@ -135,6 +138,7 @@ impl AtBody {
             seen_s: t.t_s,
             extent_m: t.extent_m,
             levels: t.levels,
+            peak_m_s: t.peak_speed_m_s,
             why,
         }
     }
@@ -176,7 +180,7 @@ pub struct TrafficRules {
     /// when the conflict was last found.
     pub(super) hold: Option<(u32, f64, f64)>,
     /// The movers at the vehicle's body ([`super::at_body`]): released once seen away from the
-    /// body, kept for good once lost.
+    /// body; once lost, kept until seen elsewhere under a new number (not one lost coasting).
     pub(super) at_body: Vec<AtBody>,
     /// Movers predicted out of view at the last plan (see `movers_at_body`): one whose track
     /// drops while predicted to reach the standing vehicle's body is waited for.
@@ -188,9 +192,9 @@ pub struct TrafficRules {
     pub(super) lost_standing: Vec<TrackState>,
     /// The tracks seen moving as movers for `MOVER_FOR_S` on end at some time.
     pub(super) walked: Vec<u32>,
-    /// Where and when each of the movers was first given to the rules (metres, seconds): a
-    /// track that starts where a mover lost at the body could have gone is that mover.
-    pub(super) first_seen: Vec<(u32, Point2<f64>, f64)>,
+    /// The tracks taken for movers lost at the body seen again (see `seen_elsewhere`): each
+    /// lets go of one only.
+    pub(super) claimed: Vec<u32>,
     /// The person standing the last plan stopped short of (see `short_of_walkers`): where, and
     /// when last seen, seconds.
     pub(super) walker_stop: Option<(Point2<f64>, f64)>,
@@ -214,7 +218,7 @@ impl TrafficRules {
             streaks: Vec::new(),
             lost_standing: Vec::new(),
             walked: Vec::new(),
-            first_seen: Vec::new(),
+            claimed: Vec::new(),
             walker_stop: None,
         }
     }
@@ -230,7 +234,7 @@ impl TrafficRules {
         self.streaks.clear();
         self.lost_standing.clear();
         self.walked.clear();
-        self.first_seen.clear();
+        self.claimed.clear();
         self.hold = None;
     }
 

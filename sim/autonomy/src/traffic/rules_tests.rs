@@ -40,6 +40,8 @@ fn track(id: u32, t_s: f64, (x, y): (f64, f64), (vx, vy): (f64, f64), levels: u3
         ),
         size_m: [1.0, 1.0],
         peak_speed_m_s: vx.hypot(vy),
+        born_s: t_s - 10.0,
+        origin: Point2::new(x - 10.0 * vx, y - 10.0 * vy),
     }
 }
 
@@ -90,6 +92,7 @@ fn lost_at_the_fuselage(extent_m: f64) -> AtBody {
         seen_s: 1.0,
         extent_m,
         levels: 0b01,
+        peak_m_s: 1.2,
         why: LostMover::AtBody,
     }
 }
@@ -493,54 +496,97 @@ fn a_mover_at_the_fuselage_holds_the_jet_until_seen_away() {
     assert!(r.at_body.is_empty());
 }
 
-/// A person who walked on into the standing jet out of view and out past it (variants 27 and
-/// 32 of `traffic_jet.toml`: a fuel truck and a van lost as they crossed ahead, waited for as
-/// lost at the body until the pilot was called): lost at the fuselage, then a track starts
-/// where the mover could have gone by then and moves off - the mover, seen elsewhere under a
-/// new number: let go. Not a track that started farther than it could have gone, nor one much
-/// larger or smaller, nor one in another level, nor one that started long before it was lost.
+/// A person who walked on into the standing jet out of view and out past it: held at the
+/// fuselage and lost there (its track gone), then a track the tracker started where the person
+/// could have walked by then (at 1.5 m/s, its own peak being lower) moves off - the person,
+/// seen elsewhere under a new number: let go. Not for a track that started farther than that,
+/// or more than 10 s later, or more than a second before the person was last seen; nor one much
+/// larger or smaller, nor one in another level, nor one still at the body; nor a track already
+/// taken for another mover lost there; nor for a mover lost coasting (a van may drive far).
 #[test]
 fn a_mover_lost_at_the_fuselage_and_seen_going_off_under_a_new_number_is_let_go() {
     let config = AutonomyConfig::default();
     let (cfg, hidden_after_s) = (&config.traffic, config.hidden_after_s);
     let pose = Isometry2::identity();
-    let held = |new: TrackState, first_s: f64| {
+    let lost = |why| AtBody {
+        why,
+        ..lost_at_the_fuselage(2.0)
+    };
+    let held_as = |why, new: &[TrackState]| {
         let mut r = rules();
         r.streaks.push(mover_streak(13, 1.0));
-        r.at_body.push(lost_at_the_fuselage(2.0));
-        // First given to the rules at `first_s` where it is, seen moving off at 5 s.
-        let first = TrackState {
-            t_s: first_s,
-            ..new.clone()
-        };
-        r.movers_at_body(&[first], &pose, first_s, true, cfg, hidden_after_s);
-        let seen = TrackState {
-            t_s: 5.0,
-            position: new.position + Vector2::new(0.0, -1.4),
-            ..new
-        };
-        r.movers_at_body(&[seen], &pose, 5.0, true, cfg, hidden_after_s)
+        r.at_body.push(lost(why));
+        r.movers_at_body(new, &pose, 5.0, true, cfg, hidden_after_s)
     };
-    let walker = |(x, y): (f64, f64), levels| track(14, 4.0, (x, y), (0.0, -1.4), levels);
-    // 7.8 m from where it was lost, 3 s after: within 2 + 2 m of extents and 1.5 m/s.
-    assert_eq!(held(walker((4.0, -6.0), 0b01), 4.0), None);
-    // 13.8 m from it 1 s after: another mover.
-    let far = held(walker((4.0, -12.0), 0b01), 2.0);
-    assert!(matches!(far, Some(BodyHold::Lost { .. })), "{far:?}");
+    let held = |new: TrackState| held_as(LostMover::AtBody, &[new]);
+    // Born at `born_s` at (4, y), seen moving off at 5 s 1.4 m on.
+    let walker = |born_s: f64, y: f64| TrackState {
+        born_s,
+        origin: Point2::new(4.0, y),
+        ..track(14, 5.0, (4.0, y - 1.4), (0.0, -1.4), 0b01)
+    };
+    // 7.8 m from where it was lost, born 3 s after: within 2 + 2 m of extents and 1.5 m/s.
+    assert_eq!(held(walker(4.0, -6.0)), None);
+    // Born a second before it was last seen, within the extents of where it was: a track
+    // split as it was renumbered.
+    let split = TrackState {
+        born_s: 0.0,
+        origin: Point2::new(4.0, -1.9),
+        ..walker(0.0, -6.0)
+    };
+    assert_eq!(held(split), None);
+    let kept = |h: Option<BodyHold>| matches!(h, Some(BodyHold::Lost { .. }));
+    // 13.8 m from it 1 s after; born 2 s before it was last seen; born 12 s after (14 m/s
+    // would be far beyond it: 1.5 m/s over 11 s).
+    assert!(kept(held(walker(2.0, -12.0))));
+    assert!(kept(held(walker(-1.5, -6.0))));
+    assert!(kept(held(walker(12.0, -6.0))));
     // A track in another level, or one of 6.5 m (a truck, not a person) or 0.5 m.
-    let high = held(walker((4.0, -6.0), 0b10), 4.0);
-    assert!(matches!(high, Some(BodyHold::Lost { .. })), "{high:?}");
+    assert!(kept(held(TrackState {
+        levels: 0b10,
+        ..walker(4.0, -6.0)
+    })));
     for extent_m in [6.5, 0.5] {
-        let other = TrackState {
+        assert!(kept(held(TrackState {
             extent_m,
-            ..walker((4.0, -6.0), 0b01)
-        };
-        let kept = held(other, 4.0);
-        assert!(matches!(kept, Some(BodyHold::Lost { .. })), "{kept:?}");
+            ..walker(4.0, -6.0)
+        })));
     }
-    // One that was tracked from 2 s before the mover was lost.
-    let older = held(walker((4.0, -6.0), 0b01), -1.0);
-    assert!(matches!(older, Some(BodyHold::Lost { .. })), "{older:?}");
+    // One at the body still (beside the fuselage, 1.8 m off).
+    assert!(kept(held(TrackState {
+        position: Point2::new(6.0, -1.8),
+        bbox: ((6, -2), (6, -2)),
+        ..walker(4.0, -3.0)
+    })));
+    // A mover lost coasting is not let go so.
+    assert!(kept(held_as(LostMover::Coasting, &[walker(4.0, -6.0)])));
+    // Two lost at the fuselage, one track: it lets go of one of them, for good.
+    let mut r = rules();
+    r.streaks.push(mover_streak(13, 1.0));
+    r.at_body.push(lost(LostMover::AtBody));
+    r.at_body.push(AtBody {
+        id: 12,
+        ..lost(LostMover::AtBody)
+    });
+    let one = [walker(4.0, -6.0)];
+    assert!(kept(r.movers_at_body(
+        &one,
+        &pose,
+        5.0,
+        true,
+        cfg,
+        hidden_after_s
+    )));
+    assert_eq!(r.at_body.len(), 1);
+    assert!(kept(r.movers_at_body(
+        &one,
+        &pose,
+        5.1,
+        true,
+        cfg,
+        hidden_after_s
+    )));
+    assert_eq!((r.at_body.len(), r.claimed.clone()), (1, vec![14]));
 }
 
 /// The whole decision for a van crossing ahead of the vehicle at 5 m/s (`jet_meets_crossing_vehicle`):
@@ -683,8 +729,8 @@ fn a_mover_that_coasted_out_of_view_towards_the_standing_jet_is_waited_for_once_
     );
     // A part of another mover, seen now, tracked apart (variants 27 and 32 of
     // `traffic_jet.toml`): that one was 1.5 m from it when it was last seen, going off
-    // crosswise at 5 m/s - let go; 5 m from it (beyond both extents), or a much smaller one
-    // (a person), or one in another level: the van is waited for.
+    // crosswise at 5 m/s - let go; 5 m from it (beyond its extent), or a smaller one, or one in
+    // another level: the van is waited for.
     let other = |(dx, dy): (f64, f64), extent_m: f64, levels: u32| TrackState {
         extent_m,
         ..track(22, 12.5, (4.0 + dx + 12.5, -13.0 + dy), (5.0, 0.0), levels)
@@ -698,6 +744,7 @@ fn a_mover_that_coasted_out_of_view_towards_the_standing_jet_is_waited_for_once_
     for o in [
         other((5.0, 0.0), 2.0, 0b01),
         other((1.5, 0.0), 0.6, 0b01),
+        other((1.5, 0.0), 1.5, 0b01),
         other((1.5, 0.0), 2.0, 0b10),
     ] {
         let mut r = coasting(4.0);

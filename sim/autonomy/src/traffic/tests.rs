@@ -51,6 +51,8 @@ fn mover(x: f64, y: f64, vx: f64, vy: f64, levels: u32) -> TrackState {
         ),
         size_m: [1.0, 1.0],
         peak_speed_m_s: vx.hypot(vy),
+        born_s: -10.0,
+        origin: Point2::new(x - 10.0 * vx, y - 10.0 * vy),
     }
 }
 
