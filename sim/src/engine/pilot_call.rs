@@ -79,19 +79,12 @@ impl Hold {
     pub fn name(&self) -> &'static str {
         match self {
             Hold::Obstacle { .. } => "obstacle",
-            Hold::LostObstacle { mover: None, .. } => "lost_obstacle",
-            Hold::LostObstacle {
-                mover: Some(LostMover::AtBody),
-                ..
-            } => "mover_lost_at_body",
-            Hold::LostObstacle {
-                mover: Some(LostMover::Coasting),
-                ..
-            } => "mover_lost_coasting",
-            Hold::LostObstacle {
-                mover: Some(LostMover::Standing),
-                ..
-            } => "mover_lost_standing",
+            Hold::LostObstacle { mover, .. } => match mover {
+                None => "lost_obstacle",
+                Some(LostMover::AtBody) => "mover_lost_at_body",
+                Some(LostMover::Coasting) => "mover_lost_coasting",
+                Some(LostMover::Standing) => "mover_lost_standing",
+            },
             Hold::Mover { .. } => "mover",
             Hold::UnseenGround { .. } => "unseen_ground",
         }
@@ -160,16 +153,10 @@ impl HoldLog {
             last,
             Some((_, Hold::LostObstacle { mover: Some(_), .. }, _))
         );
-        let pressed = (0..world.scene().solids.len())
-            .filter(|_| for_a_mover)
-            .filter(|&i| {
-                let id = &world.scene().solids[i].id;
-                world.contacts().iter().any(|c| &c.object == id)
-            })
-            .filter_map(|i| {
-                let d = world.distances_to(i).into_iter().reduce(f64::min)?;
-                Some((i, d))
-            });
+        let struck = |id: &str| world.contacts().iter().any(|c| c.object == id);
+        let pressed = (world.scene().solids.iter().enumerate())
+            .filter(|(_, s)| for_a_mover && struck(&s.id))
+            .filter_map(|(i, _)| Some((i, world.distances_to(i).into_iter().reduce(f64::min)?)));
         let nearest = points
             .iter()
             .filter_map(|p| world.nearest_object_to(p))
