@@ -4,7 +4,9 @@
 //! - On evidence ([`FreeSpaceStop::ScanHits`], the default): a free-space walk lowers an older
 //!   occupied cell only when a beam of its column crosses the cell within the span of heights
 //!   its obstacle was hit at ([`HitSpan`], recorded per level and world cell by the insertion;
-//!   [`WalkStops`] decides); otherwise the cell stops the walk. A beam over a cone or under a
+//!   [`WalkStops`] decides; a beam with no echo counts out to `no_echo_clears_within_m`, as
+//!   `cells_hit_only_above_the_sensor_are_cleared_in_the_open_by_beams_with_no_echo_within_30_m`
+//!   checks); otherwise the cell stops the walk. A beam over a cone or under a
 //!   deck is no evidence the obstacle left, and a cell no beam crosses keeps its state. Guarded
 //!   by `cells_an_obstacle_left_are_cleared_unless_walks_stop_at_any_occupied_cell` (in
 //!   `mapper/tests/it/map/forgetting.rs`) and, for overhangs kept in every level they reach,

@@ -7,13 +7,16 @@
 //! circle-by-circle test: `the_binned_test_answers_as_the_straightforward_one` in
 //! `self_hits.rs`), and each column is summarised per level: its farthest return the level
 //! considers and its nearest obstacle hit ([`ColumnLevel`]). Then one rayon task per level
-//! ([`LevelInsertion`]) - beside them the remission of level 0's ground returns:
+//! ([`LevelHits`], then [`LevelWalks`]) - beside them the remission of level 0's ground returns:
 //! - the hits first, so this scan's obstacles already stop its own walks. A column's beams up
 //!   one face mostly hit one cell: its consecutive hits in one cell are merged into one height
 //!   span before one lookup of the level's span table (a lookup is a cache miss in a table that
 //!   size; the tables are hashed with foldhash). The spans are what forgetting on evidence
 //!   reads (`forget.rs`);
-//! - then the free-space walks, coarse to fine ([`ColumnHierarchy`]): with
+//! - then the free-space walks, coarse to fine ([`ColumnHierarchy`]); an older occupied cell
+//!   they meet is lowered where a beam of the column crossed it where its obstacle was hit
+//!   (`forget.rs`), a beam with no echo counting within `MapConfig::no_echo_clears_within_m`
+//!   when it stays above the ground that far. With
 //!   [`FreeSpaceWalks::CoarseToFine`], the default, only every 2^j-th column walks near the
 //!   sensor, adding 2^j `l_free`, where stride 2^j keeps the walkers within half a cell
 //!   ([`COVER`]) of each other, and a column starts where its band begins or a cell before where
@@ -30,7 +33,7 @@ use super::classified::{Classified, DROPPED};
 use super::config::{FreeSpaceWalks, MapConfig};
 use super::distance::{TouchedCells, no_obstacle_at_or_below};
 use super::forget::{CLEAR_MARGIN_M, HitSpan, OccupiedCells, WalkStops};
-use super::open_top::{NO_CLAIM, beam_elevations, claim_open_tops};
+use super::open_top::{NO_CLAIM, beam_elevations, beam_rise, claim_open_tops};
 use super::walk::{Walk, walk_free};
 use super::{MultiHeightMap, WorldCell};
 use crate::collision::CollisionModel;
@@ -123,13 +126,20 @@ impl MultiHeightMap {
         self.classify(scan, vehicle, mask, &mut stats);
 
         let config = self.config;
-        let cell0 = self.window_cell0();
-        let levels = &self.levels;
-        let classified = &self.classified;
-        let column_levels = &self.column_levels;
         let geometry = self.geometry;
-        // The levels in parallel, and beside them the remission of the returns that are ground
-        // for level 0.
+        let ctx = ScanContext {
+            cell0: self.window_cell0(),
+            levels: &self.levels,
+            classified: &self.classified,
+            column_levels: &self.column_levels,
+            elevations: &self.elevations,
+            scan,
+            geometry: &geometry,
+            config: &config,
+        };
+        // The levels in parallel - each its hits, then its free-space walks, so this scan's
+        // obstacles already stop its own walks - and beside them the remission of the returns
+        // that are ground for level 0.
         let (results, ()) = rayon::join(
             || -> Vec<(usize, usize)> {
                 self.live
@@ -140,33 +150,32 @@ impl MultiHeightMap {
                     .zip(self.hit_spans.par_iter_mut())
                     .enumerate()
                     .map(|(k, ((((grid, occupied), touched), hit_cells), spans))| {
-                        let summary = ColumnsOfLevel {
-                            all: column_levels,
-                            levels: levels.count(),
+                        let hits = LevelHits {
                             k,
-                        };
-                        LevelInsertion {
-                            k,
-                            grid,
+                            ctx,
+                            grid: &mut *grid,
                             occupied,
+                            touched: &mut *touched,
+                            hit_cells: &mut *hit_cells,
+                            spans: &mut *spans,
+                        }
+                        .insert();
+                        let free = LevelWalks {
+                            k,
+                            ctx,
+                            grid,
                             touched,
                             hit_cells,
                             spans,
-                            cell0,
-                            levels,
-                            classified,
-                            summary,
-                            scan,
-                            geometry: &geometry,
-                            config: &config,
                         }
-                        .insert()
+                        .walk();
+                        (hits, free)
                     })
                     .collect()
             },
             || {
                 let rem = self.live_remission.data_mut();
-                for (c, r) in classified.iter().zip(scan.returns()) {
+                for (c, r) in ctx.classified.iter().zip(scan.returns()) {
                     if let (Some(r), false, true) = (r, c.obstacle, c.cell != DROPPED) {
                         rem[c.cell as usize].add(r.intensity);
                     }
@@ -227,6 +236,14 @@ impl MultiHeightMap {
             .collect();
         let n_levels = bands.len().max(1);
         let elevations = beam_elevations(scan);
+        if self.elevations.len() == elevations.len() {
+            for (known, e) in self.elevations.iter_mut().zip(&elevations) {
+                *known = e.or(*known);
+            }
+        } else {
+            self.elevations.clone_from(&elevations);
+        }
+        let elevations = &elevations;
         self.column_levels
             .resize(scan.columns().len() * n_levels, ColumnLevel::default());
         let counts: (usize, usize, usize, usize) = self
@@ -300,7 +317,7 @@ impl MultiHeightMap {
                     out[b] = c;
                     summarise(&bands, summary, &c, b);
                 }
-                claim_open_tops(out, returns, column, &elevations, params.ground_height_m);
+                claim_open_tops(out, returns, column, elevations, params.ground_height_m);
                 (n, self_hits, far, above)
             })
             .reduce(
@@ -342,12 +359,46 @@ impl ColumnsOfLevel<'_> {
     }
 }
 
-/// The insertion of one level of one scan: what it reads of the scan and the map, and what it
-/// updates - its grid, its occupied and touched cells, the cells this scan hit and the height
-/// spans of its hits.
-struct LevelInsertion<'a> {
+/// What every level's insertion of one scan reads: the scan, its classified returns and their
+/// per-column summaries, the window and the map's settings.
+#[derive(Clone, Copy)]
+struct ScanContext<'a> {
+    /// The world cell of the window's cell 0.
+    cell0: WorldCell,
+    /// The map's levels.
+    levels: &'a Levels,
+    /// Every return of the scan, classified.
+    classified: &'a [Classified],
+    /// Every level's summary of each column.
+    column_levels: &'a [ColumnLevel],
+    /// Each beam's elevation in the sensor frame (`None`: no echo in any scan yet).
+    elevations: &'a [Option<f64>],
+    /// The scan.
+    scan: &'a Scan,
+    /// The window.
+    geometry: &'a GridGeometry,
+    /// The map's configuration.
+    config: &'a MapConfig,
+}
+
+impl<'a> ScanContext<'a> {
+    /// Level `k`'s summary of each column.
+    fn summary(&self, k: usize) -> ColumnsOfLevel<'a> {
+        ColumnsOfLevel {
+            all: self.column_levels,
+            levels: self.levels.count(),
+            k,
+        }
+    }
+}
+
+/// Step 2 of the insertion for one level of one scan: what it updates - the level's grid, its
+/// occupied and touched cells, the cells this scan hit and the height spans of its hits.
+struct LevelHits<'a> {
     /// The level.
     k: usize,
+    /// The scan and the map's settings.
+    ctx: ScanContext<'a>,
     /// Its live log-odds.
     grid: &'a mut Grid<f32>,
     /// Its live cells that may be occupied.
@@ -358,49 +409,24 @@ struct LevelInsertion<'a> {
     hit_cells: &'a mut Vec<u32>,
     /// The height spans of its hits, by world cell.
     spans: &'a mut HashMap<WorldCell, HitSpan>,
-    /// The world cell of the window's cell 0.
-    cell0: WorldCell,
-    /// The map's levels.
-    levels: &'a Levels,
-    /// Every return of the scan, classified.
-    classified: &'a [Classified],
-    /// This level's summary of each column.
-    summary: ColumnsOfLevel<'a>,
-    /// The scan.
-    scan: &'a Scan,
-    /// The window.
-    geometry: &'a GridGeometry,
-    /// The map's configuration.
-    config: &'a MapConfig,
 }
 
-impl LevelInsertion<'_> {
-    /// Steps 2-4 of the insertion for one level. Returns (obstacle hits, free cells updated).
-    fn insert(mut self) -> (usize, usize) {
-        // Hits first, so this scan's obstacles already stop this scan's free-space walks.
-        let hits = self.insert_hits();
-        let free = self.walk_free_space();
-        (hits, free)
-    }
-
+impl LevelHits<'_> {
     /// Step 2 of the insertion for one level: its obstacle hits raise their cells (the column's
     /// nearest twice), are listed (this scan's hit cells, sorted) and their heights recorded.
     /// Returns the hits.
-    fn insert_hits(&mut self) -> usize {
-        let (beams, width) = (self.scan.beams(), self.geometry.width());
+    fn insert(self) -> usize {
+        let ctx = self.ctx;
+        let (beams, width) = (ctx.scan.beams(), ctx.geometry.width());
         let (h_lo, h_hi) = (
-            self.levels.heights_m()[self.k] as f32,
-            self.levels.upper_m(self.k) as f32,
+            ctx.levels.heights_m()[self.k] as f32,
+            ctx.levels.upper_m(self.k) as f32,
         );
-        let occ = self.config.occupancy;
+        let occ = ctx.config.occupancy;
         let data = self.grid.data_mut();
-        let (occupied, touched, hit_cells) = (
-            &mut *self.occupied,
-            &mut *self.touched,
-            &mut *self.hit_cells,
-        );
-        let (spans, cell0) = (&mut *self.spans, self.cell0);
-        let (classified, summary) = (self.classified, &self.summary);
+        let (occupied, touched, hit_cells) = (self.occupied, self.touched, self.hit_cells);
+        let (spans, cell0) = (self.spans, ctx.cell0);
+        let (classified, summary) = (ctx.classified, ctx.summary(self.k));
         let add = |v: &mut f32, delta: f32| {
             let cur = if v.is_nan() { 0.0 } else { *v };
             *v = (cur + delta).clamp(-occ.l_max, occ.l_max);
@@ -468,27 +494,47 @@ impl LevelInsertion<'_> {
         }
         hits
     }
+}
 
-    /// Steps 3-4 of the insertion for one level: the free-space walks, to the farthest return the
-    /// level considers in each column. Returns the free cells updated.
-    fn walk_free_space(&mut self) -> usize {
-        let (k, levels, scan, geometry, config) =
-            (self.k, self.levels, self.scan, self.geometry, self.config);
-        let summary = self.summary;
+/// Steps 3-4 of the insertion for one level of one scan, once its hits are in: the free-space
+/// walks update the level's grid and touched cells, and read the cells this scan hit and the
+/// height spans of the level's hits.
+struct LevelWalks<'a> {
+    /// The level.
+    k: usize,
+    /// The scan and the map's settings.
+    ctx: ScanContext<'a>,
+    /// Its live log-odds.
+    grid: &'a mut Grid<f32>,
+    /// Its cells whose obstacle state may have changed.
+    touched: &'a mut TouchedCells,
+    /// The cells this scan hit in the level (window indices, sorted).
+    hit_cells: &'a [u32],
+    /// The height spans of its hits, by world cell.
+    spans: &'a HashMap<WorldCell, HitSpan>,
+}
+
+impl LevelWalks<'_> {
+    /// The free-space walks, to the farthest return the level considers in each column. Returns
+    /// the free cells updated.
+    fn walk(self) -> usize {
+        let (k, ctx) = (self.k, self.ctx);
+        let (levels, scan, geometry, config) = (ctx.levels, ctx.scan, ctx.geometry, ctx.config);
+        let summary = ctx.summary(k);
         let beams = scan.beams();
         let occ = config.occupancy;
         let data = self.grid.data_mut();
         let n = scan.columns().len();
         let width = geometry.width();
-        let touched = &mut *self.touched;
+        let touched = self.touched;
         let watch = no_obstacle_at_or_below(config);
         // A beam crossing an older occupied cell where its obstacle was hit (or, with no span
         // recorded, below this height) is evidence the cell is free.
         let stops = WalkStops {
             rule: config.free_space_stop,
-            hit_cells: &self.hit_cells[..],
-            spans: &*self.spans,
-            cell0: self.cell0,
+            hit_cells: self.hit_cells,
+            spans: self.spans,
+            cell0: ctx.cell0,
             width,
             clear_below: levels.heights_m()[k] + CLEAR_MARGIN_M,
         };
@@ -499,7 +545,8 @@ impl LevelInsertion<'_> {
         // How far each column's walk got (metres from its sensor): where its finer neighbours start
         // at the latest.
         let mut reach = vec![0.0f64; n];
-        // (horizontal range, height) of a column's returns, reused from column to column.
+        // (horizontal range, height) of a column's beams' ends (returns, or no echo within
+        // `no_echo_clears_within_m`), reused from column to column.
         let mut ends: Vec<(f64, f64)> = Vec::with_capacity(beams);
         for (ci, depth) in hierarchy.order() {
             let sum = summary.get(ci);
@@ -527,8 +574,7 @@ impl LevelInsertion<'_> {
             );
             let total = (end_xy - sensor_xy).norm();
             // Whether a beam of the column crosses distance r (returns beyond it) at a height in
-            // [lo, hi]: each beam's height at r on its straight line from the sensor. Beams with no
-            // return (the sky) count for nothing: their elevation is not in the scan.
+            // [lo, hi]: each beam's height at r on its straight line from the sensor.
             let ground = config.obstacle_test.ground_height_m;
             let sensor_z = sensor.z - ground;
             // Gathered only if a walk meets an occupied cell (most never do).
@@ -538,15 +584,26 @@ impl LevelInsertion<'_> {
                     ends.clear();
                     // Every return of the column, those the map drops included (beyond the obstacle
                     // test's range, above the ceiling): each beam crossed what lies before it.
-                    ends.extend(
-                        scan.returns()[ci * beams..(ci + 1) * beams]
-                            .iter()
-                            .flatten()
-                            .map(|ret| {
-                                let p = ret.point_in_world;
-                                ((p.x - sensor.x).hypot(p.y - sensor.y), p.z - ground)
-                            }),
-                    );
+                    let column = &scan.returns()[ci * beams..(ci + 1) * beams];
+                    ends.extend(column.iter().flatten().map(|ret| {
+                        let p = ret.point_in_world;
+                        ((p.x - sensor.x).hypot(p.y - sensor.y), p.z - ground)
+                    }));
+                    // A beam with no echo that stays above the ground out to `no_echo` crossed
+                    // what lies before that: in the open, the only beams through an object's
+                    // cells hit at the sensor's height and above (a fuel truck's tank seen from
+                    // a nose sensor 1.55 m up: its trail held the jet for good). A beam dropped
+                    // at random (1.3 % on an HDL-32E) lowers a cell it did not hit by one
+                    // free-space update against 5.7 for each hit; a beam dead in every column
+                    // has no known elevation and counts for nothing. The elevations are those
+                    // of any revolution so far: in the open, the beams above the horizon echo
+                    // only now and then (a building, a lamp post, the vehicle's own tail).
+                    let no_echo = config.no_echo_clears_within_m;
+                    ends.extend(column.iter().zip(ctx.elevations).filter_map(|(ret, e)| {
+                        let rise = beam_rise(&scan.columns()[ci], &end.point_in_world, (*e)?);
+                        let z = sensor_z + no_echo * rise;
+                        (ret.is_none() && no_echo > 0.0 && z > 0.0).then_some((no_echo, z))
+                    }));
                     ends_ready = true;
                 }
                 ends.iter().any(|&(range, z)| {

@@ -102,6 +102,10 @@ pub struct MultiHeightMap {
     prior_store: Option<BlockStore>,
     live_store: Option<BlockStore>,
     classified: Vec<Classified>,
+    /// Each beam's elevation in the sensor frame, from its latest echo in any revolution so far
+    /// (`None`: no echo yet - a dead beam never has one); forgotten when the beams per column
+    /// change.
+    elevations: Vec<Option<f64>>,
     /// The vehicle's self-hit test, binned; rebuilt when the model or the margin changes.
     self_hits: Option<SelfHitFilter>,
     /// Per column, per level (column-major): the summary of the classification pass.
@@ -181,6 +185,7 @@ impl MultiHeightMap {
             prior_store,
             live_store,
             classified: Vec::new(),
+            elevations: Vec::new(),
             self_hits: None,
             column_levels: Vec::new(),
             occupied: vec![OccupiedCells::default(); n],

@@ -99,7 +99,7 @@ pub(super) fn claim_open_tops(
 
 /// The rise per horizontal metre, in the world, of the beam of `elevation` (sensor frame) in
 /// the azimuth of the return at `point`.
-fn beam_rise(column: &ScanColumn, point: &nalgebra::Point3<f64>, elevation: f64) -> f64 {
+pub(super) fn beam_rise(column: &ScanColumn, point: &nalgebra::Point3<f64>, elevation: f64) -> f64 {
     let s = column.world_from_sensor.inverse() * point;
     let azimuth = s.y.atan2(s.x);
     let d = column.world_from_sensor.rotation

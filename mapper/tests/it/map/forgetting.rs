@@ -183,3 +183,47 @@ fn forgetting_changes_exactly_the_cells_a_sweep_of_its_square_changes() {
     }
     assert!(total_changed > 1000, "{total_changed} cells faded in all");
 }
+
+/// An object hit only at and above the sensor's height (a fuel truck's tank seen from a nose
+/// sensor, its chassis hidden): in the open, the only beams through where it was hit have no
+/// echo. They clear its cells within 30 m once it has gone - a trail held the jet for good
+/// before, as it does with them turned off - and not beyond (a far echo-less beam is no
+/// evidence).
+#[test]
+fn cells_hit_only_above_the_sensor_are_cleared_in_the_open_by_beams_with_no_echo_within_30_m() {
+    let mount_z = mapper::synthetic::car_sensor_mount().translation.z;
+    let tank = |x: f64| Solid::Box {
+        min: nalgebra::Point3::new(x - 0.9, -2.0, mount_z + 0.05),
+        max: nalgebra::Point3::new(x + 0.9, 2.0, mount_z + 1.0),
+    };
+    for (x, no_echo_m, cleared) in [
+        (10.0, 30.0, true),
+        (25.0, 30.0, true),
+        (40.0, 30.0, false),
+        (10.0, 0.0, false),
+    ] {
+        let config = MapConfig {
+            no_echo_clears_within_m: no_echo_m,
+            ..Default::default()
+        };
+        let levels = Levels::cumulative(vec![0.0, 1.1]).unwrap();
+        let mut map = MultiHeightMap::new(config, levels, Point2::origin()).unwrap();
+        insert(&mut map, &scene(vec![tank(x)]), 3);
+        let face = Point2::new(x - 0.85, 0.0);
+        for k in 0..2 {
+            assert!(
+                map.probability_at(k, &face).unwrap() > 0.9,
+                "tank at {x} m, level {k}: mapped"
+            );
+        }
+        insert(&mut map, &scene(vec![]), 40);
+        for k in 0..2 {
+            let p = map.probability_at(k, &face).unwrap();
+            assert_eq!(
+                p < 0.5,
+                cleared,
+                "tank at {x} m, no echo within {no_echo_m} m, level {k}: p = {p} after it left"
+            );
+        }
+    }
+}

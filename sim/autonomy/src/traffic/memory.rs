@@ -5,7 +5,7 @@
 use mapper::TrackState;
 use nalgebra::Isometry2;
 
-use super::rules::{AtBody, BodyHold, LostMover, MoverStreak, TrafficRules};
+use super::rules::{AtBody, BodyHold, LostMover, MoverPath, MoverStreak, TrafficRules};
 use super::{
     TrafficConfig, at_body, may_have_walked_to, may_reach_body, moved_beyond_its_extent,
     surely_moving,
@@ -51,7 +51,32 @@ const ELSEWHERE_WITHIN_S: f64 = 10.0;
 /// walk).
 const ELSEWHERE_M_S: f64 = 1.5;
 
+/// How long the rules keep where each mover was seen, seconds: longer than a track coasts out
+/// of view before the tracker drops it.
+const PATH_KEPT_S: f64 = 15.0;
+
 impl TrafficRules {
+    /// Notes where each of `movers` was last seen, and forgets what is older than
+    /// [`PATH_KEPT_S`] or of tracks no longer held.
+    fn note_paths(&mut self, movers: &[TrackState], now_s: f64) {
+        self.paths.retain(|p| movers.iter().any(|t| t.id == p.id));
+        for t in movers {
+            let i = match self.paths.iter().position(|p| p.id == t.id) {
+                Some(i) => i,
+                None => {
+                    let seen = Vec::new();
+                    self.paths.push(MoverPath { id: t.id, seen });
+                    self.paths.len() - 1
+                }
+            };
+            let seen = &mut self.paths[i].seen;
+            if seen.last().is_none_or(|&(s, _)| t.t_s > s) {
+                seen.push((t.t_s, t.position));
+            }
+            seen.retain(|&(s, _)| now_s - s <= PATH_KEPT_S);
+        }
+    }
+
     /// The movers at the body now ([`at_body`]) joined to those lost there before; what holds
     /// the vehicle for them (`None`: nothing at the body): stopped for the one seen last, if
     /// seen within `hidden_after_s`, else waiting for one lost there, as for a hidden obstacle.
@@ -72,6 +97,7 @@ impl TrafficRules {
         self.note_streaks(now_s);
         self.note_lost_standing(movers, now_s, cfg);
         self.claimed.retain(|id| movers.iter().any(|t| t.id == *id));
+        self.note_paths(movers, now_s);
         // A mover arriving at the body, or one held there before and not seen away.
         let mut body: Vec<AtBody> = movers
             .iter()
@@ -114,7 +140,7 @@ impl TrafficRules {
                 .iter()
                 .filter(|t| !movers.iter().any(|m| m.id == t.id))
                 .filter(|t| !body.iter().any(|r| r.id == t.id) && now_s - t.t_s >= COASTED_S)
-                .filter(|t| !part_of_another(t, movers, now_s))
+                .filter(|t| !part_of_another(t, movers, &self.paths, now_s))
                 .filter(|t| {
                     let window = (now_s, now_s + DROPPED_AT_BODY_S);
                     may_reach_body(&self.model, pose, t, window, cfg)
@@ -316,14 +342,18 @@ impl TrafficRules {
 }
 
 /// Whether `t`, a track dropped, lay when last seen within the extent of another of `movers`,
-/// seen now, no smaller than it and hit in a level it was, where that one's motion puts it
-/// then: a part of it tracked apart, or the same object tracked twice - a fuel truck's
-/// split-off part that seemed to move the other way, a van's front (variants 27 and 32 of
-/// `traffic_jet.toml`, waited for as lost until the pilot was called). Two vans in convoy
-/// closer than their length would be taken for one.
-fn part_of_another(t: &TrackState, movers: &[TrackState], now_s: f64) -> bool {
+/// seen now, no smaller than it and hit in a level it was, where that one was then (where it
+/// was seen, else where its motion puts it): a part of it tracked apart, or the same object
+/// tracked twice - a fuel truck's split-off part that seemed to move the other way, a van's
+/// front (variants 27 and 32 of `traffic_jet.toml`, waited for as lost until the pilot was
+/// called), a follow-me car's front heading for the jet before the car backed aside (variant
+/// 41: its constant velocity, backing, put it 10.7 m from its front). Two vans in convoy closer
+/// than their length would be taken for one.
+fn part_of_another(t: &TrackState, movers: &[TrackState], paths: &[MoverPath], now_s: f64) -> bool {
     movers.iter().any(|o| {
-        let then = o.position + o.velocity * (t.t_s - o.t_s);
+        let then = (paths.iter().find(|p| p.id == o.id))
+            .and_then(|p| p.at(t.t_s))
+            .unwrap_or_else(|| o.position + o.velocity * (t.t_s - o.t_s));
         o.id != t.id
             && now_s - o.t_s <= 0.25
             && o.levels & t.levels != 0

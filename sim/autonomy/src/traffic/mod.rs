@@ -53,6 +53,8 @@ mod body;
 mod conflict;
 mod holds;
 mod memory;
+#[cfg(test)]
+mod memory_tests;
 mod predict;
 mod rules;
 #[cfg(test)]

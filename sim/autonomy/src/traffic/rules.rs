@@ -157,6 +157,29 @@ pub(super) struct MoverStreak {
     pub(super) mover_s: Option<f64>,
 }
 
+/// Where one mover was seen over the last `PATH_KEPT_S` (`memory.rs`): (when, its centre), oldest first.
+#[derive(Clone, Debug)]
+pub(super) struct MoverPath {
+    /// Its track.
+    pub(super) id: u32,
+    /// When and where it was seen.
+    pub(super) seen: Vec<(f64, Point2<f64>)>,
+}
+
+impl MoverPath {
+    /// Where it was at `t_s`: between the sightings around it, linearly (`None` before the
+    /// first kept or after the last).
+    pub(super) fn at(&self, t_s: f64) -> Option<Point2<f64>> {
+        let i = self.seen.partition_point(|&(s, _)| s <= t_s);
+        let &(s0, p0) = self.seen.get(i.checked_sub(1)?)?;
+        if s0 == t_s {
+            return Some(p0);
+        }
+        let &(s1, p1) = self.seen.get(i)?;
+        Some(p0 + (p1 - p0) * ((t_s - s0) / (s1 - s0)))
+    }
+}
+
 /// The rules about movers and their memory: lines held, movers seen at the body, lost
 /// standing, or seen moving lately.
 pub struct TrafficRules {
@@ -198,6 +221,8 @@ pub struct TrafficRules {
     /// The person standing the last plan stopped short of (see `short_of_walkers`): where, and
     /// when last seen, seconds.
     pub(super) walker_stop: Option<(Point2<f64>, f64)>,
+    /// Where each mover was seen lately (see `part_of_another`).
+    pub(super) paths: Vec<MoverPath>,
 }
 
 impl TrafficRules {
@@ -220,6 +245,7 @@ impl TrafficRules {
             walked: Vec::new(),
             claimed: Vec::new(),
             walker_stop: None,
+            paths: Vec::new(),
         }
     }
 
@@ -235,6 +261,7 @@ impl TrafficRules {
         self.lost_standing.clear();
         self.walked.clear();
         self.claimed.clear();
+        self.paths.clear();
         self.hold = None;
     }
 

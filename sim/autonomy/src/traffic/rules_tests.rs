@@ -9,8 +9,21 @@ use super::tests::model;
 use super::*;
 use crate::planner::{AutonomyConfig, stopping_distance_m};
 
-fn rules() -> TrafficRules {
+pub(super) fn rules() -> TrafficRules {
     TrafficRules::new(model(), 0.5)
+}
+
+/// Rules that saw `t` as a mover for the second up to when it was last seen, and predicted it.
+pub(super) fn rules_with_mover(t: &TrackState, cfg: &TrafficConfig) -> TrafficRules {
+    let mut r = rules();
+    r.streaks.push(MoverStreak {
+        id: t.id,
+        last_s: t.t_s,
+        since_s: t.t_s - 1.0,
+        mover_s: Some(t.t_s),
+    });
+    r.predictions = predict(std::slice::from_ref(t), t.t_s, cfg);
+    r
 }
 
 /// A straight route along x from the vehicle's origin, poses 0.5 m apart (60 m).
@@ -22,7 +35,13 @@ fn straight() -> Vec<Isometry2<f64>> {
 
 /// A confirmed track `id` last seen at `t_s` at (`x`, `y`) moving at (`vx`, `vy`) on `levels`:
 /// 2 m across, 10 m travelled, its hits the 1 m cell it stands in.
-fn track(id: u32, t_s: f64, (x, y): (f64, f64), (vx, vy): (f64, f64), levels: u32) -> TrackState {
+pub(super) fn track(
+    id: u32,
+    t_s: f64,
+    (x, y): (f64, f64),
+    (vx, vy): (f64, f64),
+    levels: u32,
+) -> TrackState {
     TrackState {
         id,
         t_s,
@@ -681,14 +700,7 @@ fn a_mover_that_coasted_out_of_view_towards_the_standing_jet_is_waited_for_once_
     // Seen last at 10 s, 12 m off the fuselage's side, heading for it at 4 m/s.
     let coasting = |vy: f64| {
         let van = track(21, 10.0, (4.0, -13.0), (0.0, vy), 0b01);
-        let mut r = rules();
-        r.streaks.push(MoverStreak {
-            id: 21,
-            last_s: 10.0,
-            since_s: 9.0,
-            mover_s: Some(10.0),
-        });
-        r.predictions = predict(std::slice::from_ref(&van), 10.0, cfg);
+        let mut r = rules_with_mover(&van, cfg);
         // Out of view for half a second: coasting, not at the body yet.
         let held = r.movers_at_body(&[van], &pose, 10.5, true, cfg, hidden_after_s);
         assert_eq!(held, None);
