@@ -33,7 +33,7 @@ use super::classified::{Classified, DROPPED};
 use super::config::{FreeSpaceWalks, MapConfig};
 use super::distance::{TouchedCells, no_obstacle_at_or_below};
 use super::forget::{CLEAR_MARGIN_M, HitSpan, OccupiedCells, WalkStops};
-use super::open_top::{NO_CLAIM, beam_elevations, beam_rise, claim_open_tops};
+use super::open_top::{NO_CLAIM, agreed_elevations, beam_elevations, beam_rise, claim_open_tops};
 use super::walk::{Walk, walk_free};
 use super::{MultiHeightMap, WorldCell};
 use crate::collision::CollisionModel;
@@ -236,12 +236,13 @@ impl MultiHeightMap {
             .collect();
         let n_levels = bands.len().max(1);
         let elevations = beam_elevations(scan);
-        if self.elevations.len() == elevations.len() {
-            for (known, e) in self.elevations.iter_mut().zip(&elevations) {
+        let agreed = agreed_elevations(scan, &elevations);
+        if self.elevations.len() == agreed.len() {
+            for (known, e) in self.elevations.iter_mut().zip(agreed) {
                 *known = e.or(*known);
             }
         } else {
-            self.elevations.clone_from(&elevations);
+            self.elevations = agreed;
         }
         let elevations = &elevations;
         self.column_levels
@@ -598,11 +599,19 @@ impl LevelWalks<'_> {
                     // has no known elevation and counts for nothing. The elevations are those
                     // of any revolution so far: in the open, the beams above the horizon echo
                     // only now and then (a building, a lamp post, the vehicle's own tail).
+                    // Only where the same beam of both neighbouring columns has no echo either:
+                    // one dropped at random beside echoes (off the airframe, a cart nearer
+                    // than the cell) is no look through what it would have hit.
                     let no_echo = config.no_echo_clears_within_m;
-                    ends.extend(column.iter().zip(ctx.elevations).filter_map(|(ret, e)| {
+                    let n = scan.columns().len();
+                    let open = |c: usize, b: usize| scan.returns()[c * beams + b].is_none();
+                    let sky = |b: usize| open((ci + n - 1) % n, b) && open((ci + 1) % n, b);
+                    let elevations = column.iter().zip(ctx.elevations).enumerate();
+                    ends.extend(elevations.filter_map(|(b, (ret, e))| {
                         let rise = beam_rise(&scan.columns()[ci], &end.point_in_world, (*e)?);
                         let z = sensor_z + no_echo * rise;
-                        (ret.is_none() && no_echo > 0.0 && z > 0.0).then_some((no_echo, z))
+                        (ret.is_none() && no_echo > 0.0 && z > 0.0 && sky(b))
+                            .then_some((no_echo, z))
                     }));
                     ends_ready = true;
                 }

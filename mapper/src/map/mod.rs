@@ -102,9 +102,10 @@ pub struct MultiHeightMap {
     prior_store: Option<BlockStore>,
     live_store: Option<BlockStore>,
     classified: Vec<Classified>,
-    /// Each beam's elevation in the sensor frame, from its latest echo in any revolution so far
-    /// (`None`: no echo yet - a dead beam never has one); forgotten when the beams per column
-    /// change.
+    /// Each beam's elevation in the sensor frame, from the latest revolution in which three of
+    /// its echoes agreed on it (`None`: none yet - a dead beam never has one); forgotten when
+    /// the beams per column change (two sensors of different beam counts feeding one map
+    /// remember nothing across revolutions).
     elevations: Vec<Option<f64>>,
     /// The vehicle's self-hit test, binned; rebuilt when the model or the margin changes.
     self_hits: Option<SelfHitFilter>,

@@ -48,6 +48,48 @@ pub(super) fn beam_elevations(scan: &Scan) -> Vec<Option<f64>> {
     elevation
 }
 
+/// How many returns of a beam must agree on its elevation, within [`AGREE_RAD`], for the map to
+/// remember it across revolutions ([`agreed_elevations`]).
+const AGREEING_RETURNS: usize = 3;
+/// Radians.
+const AGREE_RAD: f64 = 0.002;
+
+/// Each beam's elevation as [`beam_elevations`] read it (`first`), kept only where at least
+/// [`AGREEING_RETURNS`] returns of the beam in `scan` agree with it: what the map remembers of a
+/// beam's elevation across revolutions. A stray return (a fault's spurious one, placed level
+/// ahead of the sensor) on a dead beam does not give it an elevation for good.
+pub(super) fn agreed_elevations(scan: &Scan, first: &[Option<f64>]) -> Vec<Option<f64>> {
+    let beams = scan.beams();
+    let mut agree = vec![0usize; beams];
+    let mut pending = first.iter().filter(|e| e.is_some()).count();
+    for (c, column) in scan.columns().iter().enumerate() {
+        if pending == 0 {
+            break;
+        }
+        let sensor_from_world = column.world_from_sensor.inverse();
+        for (b, n) in agree.iter_mut().enumerate() {
+            let (Some(e0), Some(r)) = (first[b], scan.returns()[c * beams + b]) else {
+                continue;
+            };
+            if *n >= AGREEING_RETURNS {
+                continue;
+            }
+            let p = sensor_from_world * r.point_in_world;
+            if (p.z.atan2(p.x.hypot(p.y)) - e0).abs() <= AGREE_RAD {
+                *n += 1;
+                if *n == AGREEING_RETURNS {
+                    pending -= 1;
+                }
+            }
+        }
+    }
+    first
+        .iter()
+        .zip(&agree)
+        .map(|(e, &n)| e.filter(|_| n >= AGREEING_RETURNS))
+        .collect()
+}
+
 /// The open top of each obstacle return of one column (`Classified::open_top_m`, heights above
 /// `ground_m`): the beam above passing over the object (no echo, or an echo
 /// [`SAME_OBJECT_M`] or more beyond it) says its top there is below the beam's height at its
