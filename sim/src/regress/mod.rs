@@ -56,7 +56,7 @@ pub enum Status {
     Failed,
     /// A known problem that still ends as the file states (an expected failure).
     KnownProblem,
-    /// Not run in this tier (`[regress] full_only`).
+    /// Not run: in this tier (`[regress] full_only`), or a known problem skipped.
     NotRun,
     /// The file is not a valid scenario, or the run could not be made.
     Error,
@@ -191,6 +191,9 @@ pub struct Options<'a> {
     pub time_limit_s: Option<f64>,
     /// Write each case's golden numbers (`[regress] golden`) instead of comparing them.
     pub bless: bool,
+    /// Report the known problems (`[expectations] known_problem`) not run instead of running
+    /// them: CI's quick tier, whose budget goes to the cases that must pass.
+    pub skip_known_problems: bool,
     /// Set from outside (Ctrl-C): runs in flight end, cases not begun are not reported.
     pub stop: &'a AtomicBool,
     /// Told of every finished case.
@@ -284,10 +287,17 @@ fn run_case(
         Err(e) => return Some(error_result(case, opts.tier, e.to_string())),
     };
     let laps_in_file = scenario.laps;
-    if opts.tier == Tier::Quick && scenario.full_only {
+    let skipped = if opts.tier == Tier::Quick && scenario.full_only {
+        Some("full tier only (`[regress] full_only`): run with --full")
+    } else if opts.skip_known_problems && scenario.known_problem.is_some() {
+        Some("a known problem, not run (--skip-known-problems): run without it")
+    } else {
+        None
+    };
+    if let Some(why) = skipped {
         let mut r = blank(case, &scenario, opts.tier);
         r.status = Status::NotRun;
-        r.messages = vec!["full tier only (`[regress] full_only`): run with --full".into()];
+        r.messages = vec![why.into()];
         return Some(r);
     }
     scenario.laps = laps_in(&scenario, opts.tier);

@@ -130,7 +130,7 @@ fn test_case(r: &CaseResult) -> TestCase {
         Status::NotRun => {
             let mut s = TestCaseStatus::skipped();
             s.set_message(message.as_str());
-            s.set_type("not in this tier");
+            s.set_type("not run");
             s
         }
     };

@@ -3,7 +3,8 @@
 //! changed (both failures, as pytest's strict xfail), a file that is not a scenario (an error,
 //! the run going on), and a campaign file beside them (skipped). The four runs share one map.
 //! A copy of the low bar that allows no stop fails on `max_stops` with the count.
-//! Then golden numbers: written by `--bless`, the same run matches them, a changed line fails.
+//! Then golden numbers: written by `--bless`, the same run matches them, a changed line fails;
+//! and a known problem skipped on request is reported not run, never driven.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -46,6 +47,18 @@ fn run_dir(dir: &Path, tier: Tier) -> Vec<CaseResult> {
 }
 
 fn run_dir_blessing(dir: &Path, tier: Tier, bless: bool) -> Vec<CaseResult> {
+    run_dir_with(dir, tier, if bless { Mode::Bless } else { Mode::Check })
+}
+
+/// How `run_dir_with` runs the cases.
+#[derive(Clone, Copy, PartialEq)]
+enum Mode {
+    Check,
+    Bless,
+    SkipKnownProblems,
+}
+
+fn run_dir_with(dir: &Path, tier: Tier, mode: Mode) -> Vec<CaseResult> {
     let cases = discover(&[dir.to_path_buf()], None).unwrap();
     let maps = tempfile::tempdir().unwrap();
     let stop = AtomicBool::new(false);
@@ -57,7 +70,8 @@ fn run_dir_blessing(dir: &Path, tier: Tier, bless: bool) -> Vec<CaseResult> {
             maps_dir: maps.path().to_path_buf(),
             shard: None,
             time_limit_s: None,
-            bless,
+            bless: mode == Mode::Bless,
+            skip_known_problems: mode == Mode::SkipKnownProblems,
             stop: &stop,
             progress: &|_| {},
             started: &|_| {},
@@ -232,4 +246,33 @@ fn golden_numbers_are_blessed_then_matched_and_a_changed_line_fails_the_case() {
         ],
         "{m:?}"
     );
+}
+
+#[test]
+fn known_problems_skipped_on_request_are_reported_not_run_and_not_driven() {
+    let base = short_road();
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(
+        d.path().join("known.toml"),
+        mark(&expecting_deviation(&base), "end = \"completed\""),
+    )
+    .unwrap();
+    let rs = run_dir_with(d.path(), Tier::Quick, Mode::SkipKnownProblems);
+    assert_eq!(rs.len(), 1);
+    let r = &rs[0];
+    assert_eq!(r.status, Status::NotRun, "{r:#?}");
+    assert!(r.messages[0].contains("--skip-known-problems"), "{r:?}");
+    assert_eq!(
+        (r.end.as_deref(), r.sim_time_s),
+        (None, 0.0),
+        "driven: {r:?}"
+    );
+    assert!(
+        r.known_problem
+            .as_deref()
+            .unwrap()
+            .contains("the car passes under")
+    );
+    let xml = junit("r", &rs).to_string().unwrap();
+    assert!(xml.contains("<skipped") && xml.contains("not run"), "{xml}");
 }
