@@ -227,3 +227,71 @@ fn cells_hit_only_above_the_sensor_are_cleared_in_the_open_by_beams_with_no_echo
         }
     }
 }
+
+/// A beam with no echo counts as a look into the open only where the same beam of both
+/// neighbouring columns has no echo either. A tank hit only above the sensor is mapped; then a
+/// wing the map masks as the vehicle's own (a `SelfMask`) hides it, and every other column's
+/// beams on the wing are dropped, as a random drop-out takes them: beside their neighbours'
+/// echoes they are no look through the wing into the open, so no walk lowers the tank's face,
+/// which this revolution does not see (a parked jet's wing was lowered so before the rule).
+/// The same beams dropped in every column are a look into the open: the face is lowered.
+#[test]
+fn a_beam_with_no_echo_beside_echoes_is_no_look_past_what_it_would_have_hit() {
+    let mount_z = mapper::synthetic::car_sensor_mount().translation.z;
+    let slab = |x0: f64, x1: f64, z0: f64, z1: f64| Solid::Box {
+        min: nalgebra::Point3::new(x0, -3.0, mount_z + z0),
+        max: nalgebra::Point3::new(x1, 3.0, mount_z + z1),
+    };
+    let tank = slab(9.1, 10.9, 0.05, 1.0);
+    let wing = slab(3.0, 3.5, 0.02, 0.7);
+    let hidden = scan_from(&scene(vec![tank, wing]), 0.0, 0.0);
+    let beams = hidden.beams();
+    let on_wing = |r: &mapper::Return| r.point_in_world.x < 3.6 && r.point_in_world.z > mount_z;
+    let mask_ranges: Vec<Option<f64>> = hidden
+        .returns()
+        .iter()
+        .map(|r| r.filter(|r| on_wing(r)).map(|r| f64::from(r.range_m)))
+        .collect();
+    let wing_hits = mask_ranges.iter().flatten().count();
+    assert!(wing_hits > 200, "the wing is seen: {wing_hits} returns");
+    let mask = mapper::SelfMask::new(beams, &mask_ranges, 0.05).unwrap();
+    // The wing's returns dropped in the columns `drop(column)` picks.
+    let dropped = |drop: &dyn Fn(usize) -> bool| {
+        let returns = hidden
+            .returns()
+            .iter()
+            .enumerate()
+            .map(|(i, r)| r.filter(|r| !(drop(i / beams) && on_wing(r))))
+            .collect();
+        mapper::Scan::new(beams, hidden.columns().to_vec(), returns).unwrap()
+    };
+    let face = Point2::new(9.15, 0.0);
+    for (every_other, lowered) in [(true, false), (false, true)] {
+        let levels = Levels::cumulative(vec![0.0, 1.1]).unwrap();
+        let mut map = MultiHeightMap::new(MapConfig::default(), levels, Point2::origin()).unwrap();
+        insert(&mut map, &scene(vec![tank]), 3);
+        let before: Vec<f32> = (0..2)
+            .map(|k| map.probability_at(k, &face).unwrap())
+            .collect();
+        assert!(
+            before.iter().all(|&p| p > 0.9),
+            "the tank is mapped: {before:?}"
+        );
+        let scan = if every_other {
+            dropped(&|c| c % 2 == 1)
+        } else {
+            dropped(&|_| true)
+        };
+        for _ in 0..20 {
+            map.insert_scan_masked(&scan, None, Some(&mask)).unwrap();
+        }
+        for (k, &was) in before.iter().enumerate() {
+            let now = map.probability_at(k, &face);
+            assert_eq!(
+                now.is_none_or(|p| p < was),
+                lowered,
+                "every other column dropped: {every_other}, level {k}: face p {was} -> {now:?}"
+            );
+        }
+    }
+}
