@@ -43,11 +43,7 @@ fn mark(text: &str, today: &str) -> String {
 }
 
 fn run_dir(dir: &Path, tier: Tier) -> Vec<CaseResult> {
-    run_dir_blessing(dir, tier, false)
-}
-
-fn run_dir_blessing(dir: &Path, tier: Tier, bless: bool) -> Vec<CaseResult> {
-    run_dir_with(dir, tier, if bless { Mode::Bless } else { Mode::Check })
+    run_dir_with(dir, tier, Mode::Check)
 }
 
 /// How `run_dir_with` runs the cases.
@@ -198,7 +194,7 @@ fn golden_numbers_are_blessed_then_matched_and_a_changed_line_fails_the_case() {
     let blessing = d.path().join("bless");
     std::fs::create_dir(&blessing).unwrap();
     std::fs::write(blessing.join("g.toml"), with_golden(&base, "golden/g.json")).unwrap();
-    let rs = run_dir_blessing(&blessing, Tier::Quick, true);
+    let rs = run_dir_with(&blessing, Tier::Quick, Mode::Bless);
     assert_eq!(rs[0].status, Status::Passed, "{rs:#?}");
     let blessed = std::fs::read_to_string(blessing.join("golden/g.json")).unwrap();
     assert!(
