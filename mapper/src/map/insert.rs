@@ -33,7 +33,7 @@ use super::classified::{Classified, DROPPED};
 use super::config::{FreeSpaceWalks, MapConfig};
 use super::distance::{TouchedCells, no_obstacle_at_or_below};
 use super::forget::{CLEAR_MARGIN_M, HitSpan, OccupiedCells, WalkStops};
-use super::open_top::{NO_CLAIM, agreed_elevations, beam_elevations, beam_rise, claim_open_tops};
+use super::open_top::{BeamRises, NO_CLAIM, agreed_elevations, beam_elevations, claim_open_tops};
 use super::walk::{Walk, walk_free};
 use super::{MultiHeightMap, WorldCell};
 use crate::collision::CollisionModel;
@@ -127,12 +127,15 @@ impl MultiHeightMap {
 
         let config = self.config;
         let geometry = self.geometry;
+        let elevations: Vec<Option<(f64, f64)>> = (self.elevations.iter())
+            .map(|e| e.map(|e| (e.cos(), e.sin())))
+            .collect();
         let ctx = ScanContext {
             cell0: self.window_cell0(),
             levels: &self.levels,
             classified: &self.classified,
             column_levels: &self.column_levels,
-            elevations: &self.elevations,
+            elevations: &elevations,
             scan,
             geometry: &geometry,
             config: &config,
@@ -372,8 +375,9 @@ struct ScanContext<'a> {
     classified: &'a [Classified],
     /// Every level's summary of each column.
     column_levels: &'a [ColumnLevel],
-    /// Each beam's elevation in the sensor frame (`None`: no echo in any scan yet).
-    elevations: &'a [Option<f64>],
+    /// The cosine and sine of each beam's elevation in the sensor frame (`None`: no echo in
+    /// any scan yet).
+    elevations: &'a [Option<(f64, f64)>],
     /// The scan.
     scan: &'a Scan,
     /// The window.
@@ -606,9 +610,10 @@ impl LevelWalks<'_> {
                     let n = scan.columns().len();
                     let open = |c: usize, b: usize| scan.returns()[c * beams + b].is_none();
                     let sky = |b: usize| open((ci + n - 1) % n, b) && open((ci + 1) % n, b);
+                    let rises = BeamRises::new(&scan.columns()[ci], &end.point_in_world);
                     let elevations = column.iter().zip(ctx.elevations).enumerate();
                     ends.extend(elevations.filter_map(|(b, (ret, e))| {
-                        let rise = beam_rise(&scan.columns()[ci], &end.point_in_world, (*e)?);
+                        let rise = rises.rise((*e)?);
                         let z = sensor_z + no_echo * rise;
                         (ret.is_none() && no_echo > 0.0 && z > 0.0 && sky(b))
                             .then_some((no_echo, z))
