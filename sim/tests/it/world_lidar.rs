@@ -235,8 +235,39 @@ fn cluttered() -> Scene {
     scene(solids)
 }
 
-/// Distance from a point to the surface of a vertical cylinder or cone (apex up), metres.
+/// A parked aircraft's cylinder part: its frame (the axis along z) from the world's, its radius
+/// and half length.
+fn cylinder_part(solid: &Solid) -> Option<(Isometry3<f64>, f64, f64)> {
+    let SolidShape::Part {
+        shape:
+            aircraft::Shape::Cylinder {
+                radius_m,
+                half_length_m,
+            },
+        vehicle_from_part,
+    } = solid.shape
+    else {
+        return None;
+    };
+    let world_from_vehicle = Isometry3::new(
+        nalgebra::Vector3::new(solid.x_m, solid.y_m, 0.0),
+        nalgebra::Vector3::z() * solid.yaw_rad,
+    );
+    let frame = (world_from_vehicle * vehicle_from_part).inverse();
+    Some((frame, radius_m, half_length_m))
+}
+
+/// Distance from a point to the surface of a vertical cylinder or cone (apex up), or of a
+/// parked aircraft's cylinder part, metres.
 fn surface_residual(solid: &Solid, p: &nalgebra::Point3<f64>) -> f64 {
+    if let Some((frame, r, half)) = cylinder_part(solid) {
+        let q = frame * p;
+        let (radial, along) = (q.x.hypot(q.y), q.z.abs());
+        // On the side (within its length) or on a cap (within its disc).
+        let side = (radial - r).abs().max((along - half).max(0.0));
+        let cap = (along - half).abs().max((radial - r).max(0.0));
+        return side.min(cap);
+    }
     let radial = (p.x - solid.x_m).hypot(p.y - solid.y_m);
     match solid.shape {
         SolidShape::Cylinder { radius_m, height_m } => {
@@ -250,8 +281,15 @@ fn surface_residual(solid: &Solid, p: &nalgebra::Point3<f64>) -> f64 {
     }
 }
 
-/// Distance from a point to a vertical cylinder or cone (0 inside), metres: a bound for grazes.
+/// Distance from a point to a vertical cylinder or cone, or a parked aircraft's cylinder part
+/// (0 inside), metres: a bound for grazes.
 fn surface_distance(solid: &Solid, p: &nalgebra::Point3<f64>) -> f64 {
+    if let Some((frame, r, half)) = cylinder_part(solid) {
+        let q = frame * p;
+        return (q.x.hypot(q.y) - r)
+            .max(0.0)
+            .hypot((q.z.abs() - half).max(0.0));
+    }
     let radial = (p.x - solid.x_m).hypot(p.y - solid.y_m);
     let (r, h) = match solid.shape {
         SolidShape::Cylinder { radius_m, height_m } => (radius_m, height_m),
@@ -266,8 +304,14 @@ fn surface_distance(solid: &Solid, p: &nalgebra::Point3<f64>) -> f64 {
 
 /// The fast path equals the generic cast: same hits, same owners, ranges within 1 mm - except
 /// on cylinders and cones, which parry casts by GJK iterations (a few mm off) and the fast path
-/// in closed form: there the fast hit must lie on the true surface (within 0.1 mm).
-fn assert_same(a: &sim::world::LidarScan, b: &sim::world::LidarScan, scene: &Scene) {
+/// in closed form: there the fast hit must lie on the true surface (within 0.1 mm). Returns the
+/// hits, those more than 1 mm apart and the grazes (one path hit a round solid's edge, the
+/// other passed it).
+fn assert_same(
+    a: &sim::world::LidarScan,
+    b: &sim::world::LidarScan,
+    scene: &Scene,
+) -> (usize, usize, usize) {
     let mut hits = 0;
     let mut gjk_differences = 0;
     let mut grazes = 0;
@@ -294,14 +338,19 @@ fn assert_same(a: &sim::world::LidarScan, b: &sim::world::LidarScan, scene: &Sce
                         x.range_m,
                         y.range_m
                     );
-                    assert!(
-                        (x.range_m - y.range_m).abs() < 0.02,
-                        "ray {i}: {} vs {}",
-                        x.range_m,
-                        y.range_m
+                    // GJK stops within a few millimetres of the surface: a ray that meets it
+                    // at a grazing angle (along a fuselage) can then differ by centimetres.
+                    let (rx, ry) = (
+                        surface_residual(solid, &x.point_in_world),
+                        surface_residual(solid, &y.point_in_world),
                     );
-                    let r = surface_residual(solid, &x.point_in_world);
-                    assert!(r < 1e-4, "ray {i}: the fast hit is {r} m off the surface");
+                    assert!(
+                        rx < 1e-4 && ry < 2e-3,
+                        "ray {i} on {}: {} vs {} m, {rx} and {ry} m off its surface",
+                        solid.id,
+                        x.range_m,
+                        y.range_m,
+                    );
                     gjk_differences += 1;
                 }
                 hits += 1;
@@ -312,6 +361,12 @@ fn assert_same(a: &sim::world::LidarScan, b: &sim::world::LidarScan, scene: &Sce
             _ => panic!("ray {i}: {ra:?} vs {rb:?} ({oa:?} / {ob:?})"),
         }
     }
+    (hits, gjk_differences, grazes)
+}
+
+/// [`assert_same`] on the cluttered scene: nearly every ray within 1 mm, few grazes.
+fn assert_same_cluttered(a: &sim::world::LidarScan, b: &sim::world::LidarScan, scene: &Scene) {
+    let (hits, gjk_differences, grazes) = assert_same(a, b, scene);
     assert!(hits > 40_000, "{hits} hits");
     assert!(
         gjk_differences < hits / 100,
@@ -328,7 +383,7 @@ fn the_fast_path_equals_the_generic_cast() {
     let world = World::with_obstacles(&scene, &v, &pose);
     let lidar = Lidar::new(noiseless(), mount(&v)).unwrap();
     let sweep = SweepPoses::still(pose);
-    assert_same(
+    assert_same_cluttered(
         &lidar.scan(&world, &sweep, 3, 9),
         &lidar.scan_generic(&world, &sweep, 3, 9),
         &scene,
@@ -350,7 +405,7 @@ fn the_fast_path_equals_the_generic_cast() {
         moving.scan(&world, &sweep, 3, 9),
         moving.scan_generic(&world, &sweep, 3, 9),
     );
-    assert_same(&fast, &generic, &scene);
+    assert_same_cluttered(&fast, &generic, &scene);
     let first = fast.scan.columns()[0].world_from_vehicle.translation.vector;
     let last = fast.scan.columns()[2186]
         .world_from_vehicle
@@ -360,6 +415,63 @@ fn the_fast_path_equals_the_generic_cast() {
         (first - pose.translation.vector).norm() < 1e-9
             && (last - Vector2::new(2.0, -1.5)).norm() < 0.01
     );
+}
+
+/// Parked A320s around the car, their fuselages, engines and fin cylinders at angles (one rolled
+/// a little, as no real one is, to leave no axis special): the fast path casts their cylinder
+/// parts in closed form, onto the true surface, and agrees with the generic cast everywhere else.
+#[test]
+fn parked_aircrafts_cylinders_are_cast_onto_their_surface() {
+    let a320 = Vehicle::shipped("a320").unwrap();
+    let mut solids = Vec::new();
+    for (k, (x, y, yaw)) in [(18.0, 4.0, 0.3), (-6.0, 22.0, 1.9), (-25.0, -14.0, -2.6)]
+        .into_iter()
+        .enumerate()
+    {
+        for (i, part) in a320.parts.iter().enumerate() {
+            let roll = nalgebra::Isometry3::rotation(nalgebra::Vector3::x() * 0.01 * k as f64);
+            let shape = SolidShape::Part {
+                shape: part.shape,
+                vehicle_from_part: roll * part.vehicle_from_part,
+            };
+            let mut s = solid(
+                &format!("a320_{k}/{i}"),
+                ObjectKind::ParkedAircraft,
+                shape,
+                x,
+                y,
+                yaw,
+            );
+            s.z_min_m = 0.0;
+            solids.push(s);
+        }
+    }
+    let scene = scene(solids);
+    let v = car();
+    let pose = Isometry2::new(Vector2::new(1.0, -2.0), 0.4);
+    let world = World::with_obstacles(&scene, &v, &pose);
+    let lidar = Lidar::new(noiseless(), mount(&v)).unwrap();
+    let sweep = SweepPoses::still(pose);
+    let fast = lidar.scan(&world, &sweep, 3, 9);
+    let (hits, _, grazes) = assert_same(&fast, &lidar.scan_generic(&world, &sweep, 3, 9), &scene);
+    // Every fast hit on a cylinder part lies on its surface, and there are many.
+    let mut on_cylinders = 0;
+    for (i, owner) in fast.owners.iter().enumerate() {
+        if let Some(Owner::Object(o)) = owner
+            && cylinder_part(&scene.solids[*o]).is_some()
+        {
+            let p = fast.scan.returns()[i].unwrap().point_in_world;
+            let r = surface_residual(&scene.solids[*o], &p);
+            assert!(r < 1e-4, "ray {i}: {r} m off {}", scene.solids[*o].id);
+            on_cylinders += 1;
+        }
+    }
+    assert!(
+        on_cylinders > 1_000,
+        "{on_cylinders} returns on cylinder parts"
+    );
+    assert!(hits > 40_000, "{hits} hits");
+    assert!(grazes < 30, "{grazes} grazes");
 }
 
 #[test]

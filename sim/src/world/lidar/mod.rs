@@ -13,7 +13,9 @@
 //! (bucketed per column) and elevation window, and a column's candidates are tried nearest first,
 //! stopping as soon as the current hit is nearer than the next candidate can be. Each candidate
 //! is cast with parry's own shape ray cast, so results equal Rapier's generic query
-//! ([`Lidar::scan_generic`], tested) to float precision. Columns run in parallel (rayon); noise
+//! ([`Lidar::scan_generic`], tested) to float precision - except cylinders and cones, upright
+//! or a parked aircraft's parts, cast in closed form (`round.rs`) onto their true surface where
+//! parry's GJK iterations stop a few millimetres off it. Columns run in parallel (rayon); noise
 //! comes from a generator seeded per (seed, scan, column), so a scan does not depend on the
 //! thread count.
 
@@ -27,7 +29,9 @@ use rayon::prelude::*;
 use super::physics::{Owner, World, planar_to_3d, to_pose};
 
 mod config;
+mod round;
 pub use config::LidarConfig;
+use round::Round;
 
 /// One revolution: the mapper's input plus what only the simulator knows.
 #[derive(Clone, Debug)]
@@ -83,8 +87,8 @@ pub struct Lidar {
 struct Candidate<'a> {
     owner: Owner,
     collider: &'a Collider,
-    /// Vertical cylinders and cones are cast analytically (parry casts them by GJK iterations).
-    analytic: Option<Vertical>,
+    /// Cylinders and cones are cast in closed form (parry casts them by GJK iterations).
+    analytic: Option<Round>,
     /// Horizontal distance from the sweep origin to the collider's bounding box, metres.
     d_min: f32,
     /// Sines of the elevation window seen from the sweep origin, compared with a direction's z
@@ -268,7 +272,7 @@ impl Lidar {
             let (el_top_max, _) = elev(hi.z + pad);
             let (_, el_bottom_min) = elev(lo.z - pad);
             let analytic = match owner {
-                Owner::Object(i) => world.scene().solids.get(i).and_then(Vertical::of),
+                Owner::Object(i) => world.scene().solids.get(i).and_then(Round::of),
                 _ => None,
             };
             let candidate = Candidate {
@@ -610,116 +614,6 @@ impl Lidar {
 fn sensor_yaw(vehicle_from_sensor: &Isometry3<f64>) -> f32 {
     let x = vehicle_from_sensor.rotation * Vector3::x();
     x.y.atan2(x.x) as f32
-}
-
-/// A vertical cylinder or cone (apex up), cast in closed form.
-#[derive(Clone, Copy, Debug)]
-struct Vertical {
-    cx: f64,
-    cy: f64,
-    radius: f64,
-    z0: f64,
-    z1: f64,
-    cone: bool,
-}
-
-impl Vertical {
-    fn of(s: &super::scene::Solid) -> Option<Self> {
-        let (radius, height, cone) = match s.shape {
-            super::scene::SolidShape::Cylinder { radius_m, height_m } => {
-                (radius_m, height_m, false)
-            }
-            super::scene::SolidShape::Cone { radius_m, height_m } => (radius_m, height_m, true),
-            super::scene::SolidShape::Box { .. } | super::scene::SolidShape::Part { .. } => {
-                return None;
-            }
-        };
-        Some(Vertical {
-            cx: s.x_m,
-            cy: s.y_m,
-            radius,
-            z0: s.z_min_m,
-            z1: s.z_min_m + height,
-            cone,
-        })
-    }
-
-    /// First time of impact along the ray within `max`, solid (an origin inside gives 0).
-    fn cast(&self, ray: &Ray, max: f32) -> Option<f32> {
-        let (ox, oy, oz) = (
-            ray.origin.x as f64 - self.cx,
-            ray.origin.y as f64 - self.cy,
-            ray.origin.z as f64,
-        );
-        let (dx, dy, dz) = (ray.dir.x as f64, ray.dir.y as f64, ray.dir.z as f64);
-        let max = max as f64;
-        // Radius of the solid at height z (a cone narrows to its apex).
-        let k = if self.cone {
-            self.radius / (self.z1 - self.z0)
-        } else {
-            0.0
-        };
-        let radius_at = |z: f64| {
-            if self.cone {
-                k * (self.z1 - z)
-            } else {
-                self.radius
-            }
-        };
-        if oz >= self.z0 && oz <= self.z1 && ox * ox + oy * oy <= radius_at(oz).powi(2) {
-            return Some(0.0);
-        }
-        let mut best: Option<f64> = None;
-        let mut consider = |t: f64| {
-            if t >= 0.0 && t <= max && best.is_none_or(|b| t < b) {
-                best = Some(t);
-            }
-        };
-        // Lateral surface: x^2 + y^2 = r(z)^2 with r(z) = R (cylinder) or k (z1 - z) (cone).
-        let (a, b, c) = if self.cone {
-            let zz = self.z1 - oz;
-            (
-                dx * dx + dy * dy - k * k * dz * dz,
-                2.0 * (ox * dx + oy * dy + k * k * zz * dz),
-                ox * ox + oy * oy - k * k * zz * zz,
-            )
-        } else {
-            (
-                dx * dx + dy * dy,
-                2.0 * (ox * dx + oy * dy),
-                ox * ox + oy * oy - self.radius * self.radius,
-            )
-        };
-        if a.abs() > 1e-12 {
-            let disc = b * b - 4.0 * a * c;
-            if disc >= 0.0 {
-                // Numerically stable roots.
-                let q = -0.5 * (b + b.signum() * disc.sqrt());
-                for t in [q / a, if q != 0.0 { c / q } else { f64::NAN }] {
-                    let z = oz + t * dz;
-                    if t.is_finite() && z >= self.z0 && z <= self.z1 {
-                        consider(t);
-                    }
-                }
-            }
-        }
-        // Caps: the top disc of a cylinder, the base disc of both.
-        if dz.abs() > 1e-12 {
-            let caps: &[f64] = if self.cone {
-                &[self.z0]
-            } else {
-                &[self.z0, self.z1]
-            };
-            for &zc in caps {
-                let t = (zc - oz) / dz;
-                let (x, y) = (ox + t * dx, oy + t * dy);
-                if x * x + y * y <= self.radius * self.radius {
-                    consider(t);
-                }
-            }
-        }
-        best.map(|t| t as f32)
-    }
 }
 
 /// SplitMix64 over (seed, scan, column): independent streams per column.
