@@ -11,6 +11,17 @@ use plotters::style::FontStyle;
 
 use crate::error::{Error, Result};
 
+/// The charts' series colours, in order (matplotlib's first seven, told apart in print).
+pub(crate) const PALETTE: [RGBColor; 7] = [
+    RGBColor(31, 119, 180),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(140, 86, 75),
+    RGBColor(23, 190, 207),
+];
+
 /// What a drawing closure returns: plotters' error as text.
 pub(crate) type DrawResult = std::result::Result<(), String>;
 

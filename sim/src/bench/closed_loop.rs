@@ -3,18 +3,42 @@
 
 use super::timing::{Figure, figure};
 
+/// Where the median sequential run's wall time went, per revolution (0.1 s of simulated time),
+/// by stage: what `bench loop --out DIR` draws ([`super::loop_chart::draw`]).
+#[derive(Clone, Debug)]
+pub struct StageSplit {
+    /// The scenario's file stem.
+    pub scenario: String,
+    /// The overlapped loop's real-time factor (the median run's).
+    pub real_time_factor: f64,
+    /// (stage, milliseconds per revolution), in the order of [`STAGES`].
+    pub ms_per_revolution: Vec<(&'static str, f64)>,
+}
+
+/// The stages of a run's `time_split_s`, as the figures and the picture name them.
+pub const STAGES: [&str; 6] = [
+    "lidar",
+    "mapping",
+    "distance_maps",
+    "planning",
+    "physics",
+    "localization",
+];
+
 /// The closed-loop figures: `samples` runs of `scenario` with each schedule, in alternation,
 /// for `laps` laps (0: the scenario's own; its offline map built first, in its default directory,
 /// when missing or stale): the median real-time factor of the overlapped loop against the
 /// sequential one's (each revolution mapped and planned the instant it is taken), and, from the
 /// median sequential run, the wall time per 0.1 s of simulated time spent in each stage. The
-/// figures' names say how many runs the medians are of.
+/// figures' names say how many runs the medians are of. With them, the stage split drawn by
+/// `--out`. (The traffic check's figures are [`traffic_figures`], apart: they do not depend on
+/// the scenario.)
 pub fn loop_figures(
     scenario: &std::path::Path,
     laps: u32,
     samples: usize,
     progress: &mut dyn FnMut(&str),
-) -> crate::Result<Vec<Figure>> {
+) -> crate::Result<(Vec<Figure>, StageSplit)> {
     let scenario = crate::scenario::Scenario::from_file(scenario)?;
     let config = crate::scenario::RunConfig::default();
     let map_dir = &crate::offline_map::default_map_dir(&scenario, &config);
@@ -60,15 +84,11 @@ pub fn loop_figures(
     } else {
         format!("median_of_{samples}")
     };
-    let name = |what: &str| {
-        format!(
-            "loop/{}/{what}/{runs}",
-            scenario
-                .path
-                .file_stem()
-                .map_or_else(String::new, |s| s.to_string_lossy().into_owned())
-        )
-    };
+    let stem = scenario
+        .path
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let name = |what: &str| format!("loop/{stem}/{what}/{runs}");
     // Where the time goes, from the sequential run: there each stage has both cores to itself.
     let s = &sequential.time_split_s;
     // A factor, not a time: the ratio is this over the baseline (> 1: this is faster).
@@ -90,26 +110,39 @@ pub fn loop_figures(
             target: None,
         },
     ];
-    for (what, seconds) in [
-        ("lidar_per_scan", s.lidar),
-        ("mapping_per_scan", s.mapping),
-        ("distance_maps_per_scan", s.distance_maps),
-        ("planning_per_scan", s.planning),
-        ("physics_per_scan", s.physics),
-        ("localization_per_scan", s.localization),
-    ] {
-        out.push(figure(&name(what), per_scan(seconds), "ms", None));
+    let seconds = [
+        s.lidar,
+        s.mapping,
+        s.distance_maps,
+        s.planning,
+        s.physics,
+        s.localization,
+    ];
+    for (stage, seconds) in STAGES.iter().zip(seconds) {
+        out.push(figure(
+            &name(&format!("{stage}_per_scan")),
+            per_scan(seconds),
+            "ms",
+            None,
+        ));
     }
-    progress("traffic: prediction and the space-time check");
-    out.extend(traffic_figures(samples.max(5)));
-    Ok(out)
+    let split = StageSplit {
+        scenario: stem.clone(),
+        real_time_factor: report.real_time_factor,
+        ms_per_revolution: STAGES
+            .iter()
+            .zip(seconds)
+            .map(|(stage, seconds)| (*stage, 1e3 * per_scan(seconds)))
+            .collect(),
+    };
+    Ok((out, split))
 }
 
 /// Prediction and the space-time check of one revolution: 20 movers around the 62-circle jet's
 /// 41.5 m path (its horizon at 10 m/s, 84 poses), none in conflict so every pose is checked for
 /// every mover - the worst case - against the same check of every circle at every pose, one
 /// thread each, in alternation.
-fn traffic_figures(samples: usize) -> Vec<Figure> {
+pub fn traffic_figures(samples: usize) -> Vec<Figure> {
     use autonomy::traffic::{
         SpeedProfile, TimedPath, TrafficConfig, first_conflict, first_conflict_straightforward,
         predict,

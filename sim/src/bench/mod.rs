@@ -12,11 +12,12 @@ pub mod campaign;
 mod closed_loop;
 mod lidar;
 pub mod localization;
+pub mod loop_chart;
 mod mapper;
 mod sensors;
 mod timing;
 
-pub use closed_loop::loop_figures;
+pub use closed_loop::{STAGES, StageSplit, loop_figures, traffic_figures};
 pub use lidar::{lidar_figures, lidar_scene};
 pub use mapper::mapper_figures;
 pub use sensors::vehicle_figures;

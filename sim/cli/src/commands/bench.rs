@@ -22,9 +22,11 @@ pub struct BenchArgs {
     /// schedule, in alternation, default 1 - it then says it ran once).
     #[arg(long)]
     pub samples: Option<usize>,
-    /// Scenario of `bench loop`, `bench blocks` and `bench localization` (default
-    /// `scenarios/parking_lot.toml`); `bench representations`: the scenes, repeatable (default:
-    /// the parking lot, the aerodrome, the low bridge, the footbridge and the parked jet).
+    /// Scenario of `bench blocks` and `bench localization` (default
+    /// `scenarios/parking_lot.toml`); `bench loop`: the scenarios, repeatable, one after the
+    /// other (default: the parking lot); `bench representations`: the scenes, repeatable
+    /// (default: the parking lot, the aerodrome, the low bridge, the footbridge and the parked
+    /// jet).
     #[arg(long)]
     pub scenario: Vec<PathBuf>,
     /// `bench loop`: the scenario with this vehicle (a shipped name or a sidecar) against its
@@ -50,7 +52,9 @@ pub struct BenchArgs {
     pub jobs: Option<usize>,
     /// `bench figures`: the working directory, for the maps built and each run's report and
     /// output (default: a new directory under the system's temporary directory, deleted at the
-    /// end unless `--keep`).
+    /// end unless `--keep`). `bench loop`: draw where a revolution's wall time goes, a bar per
+    /// scenario, as `loop_stages.svg` and `.png` here. `bench representations`: its tables,
+    /// JSON and pictures.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// `bench figures`: keep the offline maps built (default: deleted once measured).
@@ -123,11 +127,11 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             args.json,
         );
     }
-    let scenario = args
-        .scenario
-        .first()
-        .cloned()
-        .unwrap_or_else(|| PathBuf::from("scenarios/parking_lot.toml"));
+    let scenarios = if args.scenario.is_empty() {
+        vec![PathBuf::from("scenarios/parking_lot.toml")]
+    } else {
+        args.scenario.clone()
+    };
     let campaign = sim::bench::campaign::CampaignBench {
         campaign: &args.campaign,
         variants: args.variants,
@@ -141,18 +145,52 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         args.what,
         args.json,
         args.samples,
-        (&scenario, args.laps, args.vehicle.as_deref()),
+        (
+            &scenarios,
+            args.laps,
+            args.vehicle.as_deref(),
+            args.out.as_deref(),
+        ),
         &campaign,
     )
+}
+
+/// `bench loop` without `--vehicle`: each scenario's figures, then the traffic check's; with
+/// `out`, the picture of where a revolution's time goes.
+fn loop_figures(
+    scenarios: &[PathBuf],
+    laps: u32,
+    samples: usize,
+    out: Option<&std::path::Path>,
+    progress: &mut dyn FnMut(&str),
+) -> anyhow::Result<Vec<sim::bench::Figure>> {
+    let (mut figures, mut splits) = (Vec::new(), Vec::new());
+    for scenario in scenarios {
+        let (f, split) = sim::bench::loop_figures(scenario, laps, samples, progress)?;
+        figures.extend(f);
+        splits.push(split);
+    }
+    progress("traffic: prediction and the space-time check");
+    figures.extend(sim::bench::traffic_figures(samples.max(5)));
+    if let Some(dir) = out {
+        sim::bench::loop_chart::draw(&splits, dir)?;
+        eprintln!(
+            "drew {}",
+            dir.join(format!("{}.svg", sim::bench::loop_chart::STEM))
+                .display()
+        );
+    }
+    Ok(figures)
 }
 
 fn bench(
     what: BenchTarget,
     json: bool,
     samples: Option<usize>,
-    (scenario, laps, vehicle): (&std::path::Path, u32, Option<&str>),
+    (scenarios, laps, vehicle, out): (&[PathBuf], u32, Option<&str>, Option<&std::path::Path>),
     campaign: &sim::bench::campaign::CampaignBench<'_>,
 ) -> anyhow::Result<()> {
+    let scenario = scenarios[0].as_path();
     let progress = ProgressBar::new_spinner();
     let mut report = |what: &str| progress.set_message(format!("measuring {what}"));
     let figures = match what {
@@ -162,7 +200,7 @@ fn bench(
             Some(v) => {
                 sim::bench::vehicle_figures(scenario, v, laps, samples.unwrap_or(1), &mut report)?
             }
-            None => sim::bench::loop_figures(scenario, laps, samples.unwrap_or(1), &mut report)?,
+            None => loop_figures(scenarios, laps, samples.unwrap_or(1), out, &mut report)?,
         },
         BenchTarget::Campaign => sim::bench::campaign::campaign_figures(campaign, &mut report)?,
         BenchTarget::Blocks => sim::bench::blocks::figures_for(scenario, &mut report)?,

@@ -11,15 +11,7 @@ use super::SceneResult;
 use crate::chart::{DrawResult, both};
 use crate::error::Result;
 
-const COLOURS: [RGBColor; 7] = [
-    RGBColor(31, 119, 180),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(255, 127, 14),
-    RGBColor(140, 86, 75),
-    RGBColor(23, 190, 207),
-];
+const COLOURS: [RGBColor; 7] = crate::chart::PALETTE;
 
 /// Draws `<dir>/<stem>.svg` and `.png` for `scene`.
 pub fn draw(scene: &SceneResult, dir: &Path, stem: &str) -> Result<()> {
