@@ -132,6 +132,12 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     } else {
         args.scenario.clone()
     };
+    check_loop_options(
+        args.what,
+        scenarios.len(),
+        args.vehicle.as_deref(),
+        args.out.as_deref(),
+    )?;
     let campaign = sim::bench::campaign::CampaignBench {
         campaign: &args.campaign,
         variants: args.variants,
@@ -153,6 +159,30 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         ),
         &campaign,
     )
+}
+
+/// What only `bench loop` without `--vehicle` takes - several scenarios, a picture (`--out`) -
+/// refused elsewhere rather than ignored.
+fn check_loop_options(
+    what: BenchTarget,
+    scenarios: usize,
+    vehicle: Option<&str>,
+    out: Option<&std::path::Path>,
+) -> anyhow::Result<()> {
+    let all_scenarios = matches!(what, BenchTarget::Loop) && vehicle.is_none();
+    if scenarios > 1 && !all_scenarios {
+        anyhow::bail!(
+            "--scenario: bench {what:?} measures one scenario ({scenarios} given); several \
+             are `bench loop` without --vehicle's (and `bench representations`')"
+        );
+    }
+    if out.is_some() && !all_scenarios {
+        anyhow::bail!(
+            "--out: bench {what:?} draws no picture (`bench loop` without --vehicle does, and \
+             `bench figures` and `bench representations` write there)"
+        );
+    }
+    Ok(())
 }
 
 /// `bench loop` without `--vehicle`: each scenario's figures, then the traffic check's; with
@@ -272,4 +302,27 @@ fn bridge(
         &scenario, &setup, domain, rounds, progress,
     )?);
     Ok(figures)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Several scenarios and a picture are `bench loop`'s (without `--vehicle`): elsewhere an
+    /// error naming the option, not a silent first scenario or no picture.
+    #[test]
+    fn loop_only_options_are_refused_elsewhere() {
+        let dir = Some(std::path::Path::new("docs"));
+        assert!(check_loop_options(BenchTarget::Loop, 3, None, dir).is_ok());
+        assert!(check_loop_options(BenchTarget::Loop, 1, Some("a320"), None).is_ok());
+        assert!(check_loop_options(BenchTarget::Blocks, 1, None, None).is_ok());
+        let two = check_loop_options(BenchTarget::Localization, 2, None, None).unwrap_err();
+        assert!(two.to_string().starts_with("--scenario:"), "{two}");
+        let vehicle = check_loop_options(BenchTarget::Loop, 2, Some("a320"), None).unwrap_err();
+        assert!(vehicle.to_string().starts_with("--scenario:"), "{vehicle}");
+        let out = check_loop_options(BenchTarget::Loop, 1, Some("a320"), dir).unwrap_err();
+        assert!(out.to_string().starts_with("--out:"), "{out}");
+        let out = check_loop_options(BenchTarget::Mapper, 1, None, dir).unwrap_err();
+        assert!(out.to_string().contains("Mapper"), "{out}");
+    }
 }
