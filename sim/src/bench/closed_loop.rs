@@ -11,8 +11,8 @@ pub struct StageSplit {
     pub scenario: String,
     /// The overlapped loop's real-time factor (the median run's).
     pub real_time_factor: f64,
-    /// (stage, milliseconds per revolution), in the order of [`STAGES`].
-    pub ms_per_revolution: Vec<(&'static str, f64)>,
+    /// Milliseconds per revolution of each stage of [`STAGES`], in its order.
+    pub ms_per_revolution: [f64; STAGES.len()],
 }
 
 /// The stages of a run's `time_split_s`, as the figures and the picture name them.
@@ -129,11 +129,7 @@ pub fn loop_figures(
     let split = StageSplit {
         scenario: stem.clone(),
         real_time_factor: report.real_time_factor,
-        ms_per_revolution: STAGES
-            .iter()
-            .zip(seconds)
-            .map(|(stage, seconds)| (*stage, 1e3 * per_scan(seconds)))
-            .collect(),
+        ms_per_revolution: seconds.map(|seconds| 1e3 * per_scan(seconds)),
     };
     Ok((out, split))
 }
