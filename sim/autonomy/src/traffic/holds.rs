@@ -10,10 +10,12 @@ use super::rules::{BodyHold, MoverInputs, TrafficRules};
 use super::{Conflict, TimedPath, TrafficConfig, first_within_standing_reach, surely_moving};
 
 impl TrafficRules {
-    /// A known mover of `movers` arriving lately (seen predicted for a second within the last
-    /// six, beyond its own extent: not a static object's sliding parts) and standing now (not
-    /// [`surely_moving`]) within its reach of the vehicle at `pose`
-    /// ([`first_within_standing_reach`]), as what stops the vehicle; `None` with traffic off.
+    /// A known mover of `movers` - arriving lately (seen predicted for a second within the last
+    /// six, beyond its own extent: not a static object's sliding parts), or one that drove up
+    /// longer ago (`drove_up`: a van that stood at the nose longer than six seconds, variant 6
+    /// of `traffic_jet_speed_profiles.toml`) - standing now (not [`surely_moving`]) within its
+    /// reach of the vehicle at `pose` ([`first_within_standing_reach`]), as what stops the
+    /// vehicle; `None` with traffic off.
     pub(super) fn standing_at(
         &self,
         movers: &[TrackState],
@@ -27,7 +29,7 @@ impl TrafficRules {
         movers
             .iter()
             .filter(|t| {
-                !surely_moving(t, cfg) && (self.arriving(t, now_s, cfg) || self.is_walker(t, cfg))
+                !surely_moving(t, cfg) && (self.arriving(t, now_s, cfg) || self.drove_up(t))
             })
             .find(|t| {
                 first_within_standing_reach(&self.model, std::slice::from_ref(pose), t, cfg)
@@ -37,6 +39,15 @@ impl TrafficRules {
                 at: t.position,
                 last_seen_s: t.t_s,
             })
+    }
+
+    /// Whether `t` is a known mover that came where it stands: seen moving as a mover for
+    /// `MOVER_FOR_S` on end at some time and travelled more than twice its extent and 3 m (any
+    /// size: a person, a van), as one lost standing must have (`note_lost_standing`): a parked
+    /// car the offline map does not hold, whose visible part slides as the vehicle drives by,
+    /// seems to travel a few metres (`parking_lot_on_a_stale_map_movers_predicted`).
+    fn drove_up(&self, t: &TrackState) -> bool {
+        self.walked.contains(&t.id) && t.travel_m > 2.0 * t.extent_m + 3.0
     }
 
     /// Whether `t` is a person standing: a small known mover (up to

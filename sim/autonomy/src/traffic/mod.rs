@@ -31,6 +31,10 @@
 //! - **Caution**: a candidate mover - seen to travel a metre, not yet beyond what revealing a
 //!   static object explains - checked the same way caps the speed at `caution_speed_m_s`
 //!   instead of stopping the vehicle: slow for what may move, stop for what does.
+//! - **A map obstacle closing** (`closing`): the chosen path's first collision with the
+//!   map coming nearer along the route faster than `closing_speed_m_s` is something moving the
+//!   tracker does not follow; the vehicle closes on it no faster than the caution speed
+//!   together and stops short of where it will be by the time the vehicle stands.
 //! - **A mover at the body** ([`at_body`]): one seen, or predicted while out of view, whose box
 //!   of hits, grown by what of it may be hidden, comes within `at_body_m` of a circle of a level
 //!   it occupies is where the map cannot hold it (returns within the map's self-hit margin of
@@ -46,10 +50,13 @@
 //! The files, by job: `predict` (the movers' footprints over the horizon), `conflict` (the
 //! space-time check of the path, where to stand clear), `body` (movers at or reaching the
 //! vehicle's body) - pure functions of tracks and poses - and the rules that keep memory from
-//! plan to plan ([`TrafficRules`], in `rules`, `speed_cap`, `holds` and `memory`): one call a
+//! plan to plan ([`TrafficRules`], in `rules`, `speed_cap`, `closing`, `holds` and `memory`): one call a
 //! plan ([`TrafficRules::decide`]) turns the plan's inputs into its decision about movers.
 
 mod body;
+mod closing;
+#[cfg(test)]
+mod closing_tests;
 mod conflict;
 mod holds;
 mod memory;
@@ -126,6 +133,13 @@ pub struct TrafficConfig {
     /// move off, metres. Default 3 (two seconds of a brisk walk; a van from rest at 1.5
     /// m/s^2).
     pub standing_reach_m: f64,
+    /// The first obstacle of the map on the path coming nearer along the route faster than
+    /// this, over a second and a half of plans, is something moving towards the vehicle that
+    /// the tracker does not follow (a towed train seen as a mover only in flashes): the speed
+    /// is capped at `caution_speed_m_s` and the vehicle stops short of where the obstacle will
+    /// be by the time it stands, m/s. Default 0.8 (a static object met on a replanned path
+    /// jitters by the path's pose spacing, 0.5 m).
+    pub closing_speed_m_s: f64,
 }
 
 impl Default for TrafficConfig {
@@ -144,6 +158,7 @@ impl Default for TrafficConfig {
             at_body_m: 1.0,
             caution_speed_m_s: 3.0,
             standing_reach_m: 3.0,
+            closing_speed_m_s: 0.8,
         }
     }
 }
@@ -164,6 +179,7 @@ impl TrafficConfig {
             ("at_body_m", self.at_body_m),
             ("caution_speed_m_s", self.caution_speed_m_s),
             ("standing_reach_m", self.standing_reach_m),
+            ("closing_speed_m_s", self.closing_speed_m_s),
         ];
         positive
             .into_iter()

@@ -4,7 +4,8 @@
 //!
 //! In the order [`TrafficRules::decide`] applies them:
 //! 1. caution ([`speed_cap`](super::speed_cap)): a candidate mover's motion meeting the path,
-//!    or a known mover standing near it, caps the speed;
+//!    or a known mover standing near it, caps the speed; so does a map obstacle closing on the
+//!    vehicle ([`closing`](super::closing)), whose stop is moved short of where it will be;
 //! 2. the space-time check against the predicted movers (here): the conflict, dropped when the
 //!    vehicle is too close to stop short and clears the mover with the committed margin;
 //! 3. the stop lines ([`holds`](super::holds)): the hold line for the conflict, short of the
@@ -16,6 +17,7 @@ use mapper::{CollisionModel, TrackState};
 use nalgebra::{Isometry2, Point2};
 use serde::Serialize;
 
+use super::closing::Closing;
 use super::predict::predict_keeping;
 use super::{Conflict, Prediction, SpeedProfile, TimedPath, TrafficConfig, first_conflict};
 
@@ -223,6 +225,8 @@ pub struct TrafficRules {
     pub(super) walker_stop: Option<(Point2<f64>, f64)>,
     /// Where each mover was seen lately (see `part_of_another`).
     pub(super) paths: Vec<MoverPath>,
+    /// The plans' first collisions with the map, to find one closing on the vehicle.
+    pub(super) closing: Closing,
 }
 
 impl TrafficRules {
@@ -246,6 +250,7 @@ impl TrafficRules {
             claimed: Vec::new(),
             walker_stop: None,
             paths: Vec::new(),
+            closing: Closing::default(),
         }
     }
 
@@ -262,6 +267,7 @@ impl TrafficRules {
         self.walked.clear();
         self.claimed.clear();
         self.paths.clear();
+        self.closing.clear();
         self.hold = None;
     }
 
@@ -269,7 +275,8 @@ impl TrafficRules {
     /// lines (the plan's own stop moved short of movers), and the body hold.
     pub fn decide(&mut self, i: &MoverInputs<'_>) -> MoverDecision {
         let (s, v0, now_s, cfg) = (i.s_m, i.speed_m_s, i.now_s, i.traffic);
-        let wanted = self.caution(i);
+        let (closing_cap_m_s, closing_short_m) = self.closing_obstacle(i);
+        let wanted = self.caution(i).min(closing_cap_m_s);
         let mut conflict = self.traffic_conflict(i, wanted, false);
         if conflict.is_some_and(|c| i.stopping_m >= c.zone_m) {
             // Too late to stop short of the mover's path: standing in it is the worst choice.
@@ -279,7 +286,9 @@ impl TrafficRules {
                 conflict = None;
             }
         }
-        let mut stop_at_m = i.stop_at_m;
+        // A map obstacle closing on the vehicle: stop short of where it will be by the time
+        // the vehicle stands.
+        let mut stop_at_m = i.stop_at_m.map(|at| (at - closing_short_m).max(0.0));
         if let Some(stop_at) = self.hold_line(conflict.as_ref(), s, i.stopping_m, now_s, cfg) {
             stop_at_m = Some(stop_at_m.map_or(stop_at, |c| c.min(stop_at)));
         }

@@ -1,5 +1,6 @@
 //! Caution: slow for what may move, stop for what does. A candidate mover's motion meeting the
-//! path, or the path passing near a known mover standing, caps the speed at the caution speed.
+//! path, or the path passing near a known mover standing, caps the speed at the caution speed;
+//! a map obstacle closing on the vehicle (`closing`) caps it lower and moves the stop short.
 
 use super::rules::{MoverInputs, TrafficRules};
 use super::{TimedPath, first_conflict, first_within_standing_reach, predict, surely_moving};
@@ -56,4 +57,35 @@ impl TrafficRules {
             wanted
         }
     }
+
+    /// The speed cap and how far short to move the map's stop for a map obstacle closing on
+    /// the vehicle of plan `i` ([`super::closing`]): no faster than the caution speed together
+    /// (a third of it at least), stopping short of where it will be by the time the vehicle
+    /// stands; (infinite, 0) when none closes, or with traffic off. Closing also holds the
+    /// caution speed for `conflict_memory_s`, like a candidate mover meeting the path.
+    pub(super) fn closing_obstacle(&mut self, i: &MoverInputs<'_>) -> (f64, f64) {
+        let cfg = i.traffic;
+        if !cfg.enabled {
+            return (f64::INFINITY, 0.0);
+        }
+        let at = i.stop_at_m.map(|a| i.s_m + a);
+        let closing_m_s =
+            self.closing
+                .observe(i.now_s, at, cfg.closing_speed_m_s, cfg.conflict_memory_s);
+        if closing_m_s <= 0.0 {
+            return (f64::INFINITY, 0.0);
+        }
+        self.last_caution_s = Some(i.now_s);
+        let together = (cfg.caution_speed_m_s - closing_m_s).max(cfg.caution_speed_m_s / 3.0);
+        (together, closing_m_s * time_to_stop_s(i))
+    }
+}
+
+/// How long the vehicle of `i` takes to stand from its speed now, seconds: its stopping
+/// distance without the buffer, at the mean speed of a steady braking (0 standing).
+fn time_to_stop_s(i: &MoverInputs<'_>) -> f64 {
+    if i.speed_m_s < 0.05 {
+        return 0.0;
+    }
+    2.0 * (i.stopping_m - i.stop_buffer_m).max(0.0) / i.speed_m_s
 }

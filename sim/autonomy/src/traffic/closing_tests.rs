@@ -1,0 +1,48 @@
+//! The rules about a map obstacle closing on the vehicle (`closing`, `speed_cap`) through
+//! [`TrafficRules::decide`](super::TrafficRules::decide), on a straight route.
+
+use super::rules_tests::{inputs, rules, straight};
+use super::{MoverDecision, MoverInputs, TrafficConfig};
+use crate::planner::AutonomyConfig;
+
+/// The decisions of plans every 0.2 s for 1.6 s, the vehicle at 3 m/s, the first collision
+/// at route position `at(t)`: the last one.
+fn decide_closing(at: impl Fn(f64) -> f64) -> (MoverDecision, f64) {
+    let config = AutonomyConfig::default();
+    let poses = straight();
+    let mut r = rules();
+    let mut last = None;
+    for k in 0..=8 {
+        let t = 0.2 * k as f64;
+        let s = 3.0 * t;
+        // (The planner's collisions fall on its poses, 0.5 m apart: the jitter this gives
+        // is `a_static_object_met_on_jittering_poses_is_not_closing`'s.)
+        let stop = at(t) - s;
+        let i = MoverInputs {
+            s_m: s,
+            stop_at_m: Some(stop),
+            ..inputs(&poses, &[], &[], t, 3.0, &config)
+        };
+        last = Some((r.decide(&i), stop));
+    }
+    last.expect("plans")
+}
+
+/// A tug train seen as a mover only in flashes meets the slowing nose
+/// (`tests/found/tug_train_meets_the_slowing_nose.toml`): its cells, static to the map,
+/// close on the path at 1.7 m/s; the vehicle slows so that the two close at the caution
+/// speed, and stops short of where the train will be when it stands.
+#[test]
+fn a_map_obstacle_closing_slows_the_vehicle_and_moves_its_stop_short() {
+    let (d, stop) = decide_closing(|t| 40.0 - 1.7 * t);
+    let cfg = TrafficConfig::default();
+    let together = cfg.caution_speed_m_s - 1.7;
+    assert!((d.wanted_m_s - together).abs() < 0.2, "{d:?}");
+    let moved = stop - d.stop_at_m.expect("a stop");
+    // 3 m/s stops in about 2 s (the planner's reaction and deceleration): 1.7 m/s of it.
+    assert!(moved > 2.5 && moved < 6.0, "{moved} {d:?}");
+    // A static object met the same way: the speed wanted, the stop where the map has it.
+    let (d, stop) = decide_closing(|_| 40.0);
+    assert_eq!(d.wanted_m_s, 5.0);
+    assert_eq!(d.stop_at_m, Some(stop));
+}
