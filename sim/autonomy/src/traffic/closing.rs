@@ -25,15 +25,20 @@ const JUMP_M: f64 = 1.5;
 pub(super) struct Closing {
     /// (when, the first collision's route position), seconds and metres, oldest first.
     seen: Vec<(f64, f64)>,
-    /// The last closing speed found and when, m/s and seconds.
-    last: Option<(f64, f64)>,
+    /// The closing speeds found and when, m/s and seconds, within the memory, oldest first.
+    found: Vec<(f64, f64)>,
 }
 
 impl Closing {
     /// Forgets every plan (a new lap).
     pub(super) fn clear(&mut self) {
         self.seen.clear();
-        self.last = None;
+        self.found.clear();
+    }
+
+    /// Whether the last plan taken, at `now_s`, found a closing speed itself (not one held).
+    pub(super) fn found_at(&self, now_s: f64) -> bool {
+        self.found.last().is_some_and(|&(_, t)| t == now_s)
     }
 
     /// Takes the plan at `now_s` whose first collision is at route position `at_m` (`None`:
@@ -61,12 +66,10 @@ impl Closing {
             }
         }
         if let Some(c) = closing_speed(&self.seen).filter(|&c| c > min_m_s) {
-            let held = self.last.filter(|&(_, t)| now_s - t < memory_s);
-            self.last = Some((held.map_or(c, |(h, _)| h.max(c)), now_s));
+            self.found.push((c, now_s));
         }
-        self.last
-            .filter(|&(_, t)| now_s - t < memory_s)
-            .map_or(0.0, |(c, _)| c)
+        self.found.retain(|&(_, t)| now_s - t < memory_s);
+        self.found.iter().map(|&(c, _)| c).fold(0.0, f64::max)
     }
 }
 
@@ -120,9 +123,26 @@ mod tests {
         };
         let found = observe_all(&mut c, 0.0, 10, at);
         assert!((found - 1.7).abs() < 0.2, "{found}");
-        // Nothing in the path for a second: still held (memory 2 s); then let go.
+        // Nothing in the path 0.6 s later: still held (memory 2 s); then let go.
         assert!(c.observe(2.4, None, 0.8, 2.0) > 1.5);
         assert_eq!(c.observe(4.0, None, 0.8, 2.0), 0.0);
+    }
+
+    #[test]
+    fn a_faster_closing_is_held_only_for_the_memory() {
+        // 3 m/s for 1.6 s, then 1.5 m/s for 4 s: the fastest found within the last 2 s.
+        let mut c = Closing::default();
+        let at = |t: f64| {
+            Some(if t < 1.6 {
+                200.0 - 3.0 * t
+            } else {
+                195.2 - 1.5 * (t - 1.6)
+            })
+        };
+        assert!((observe_all(&mut c, 0.0, 9, at) - 3.0).abs() < 1e-9);
+        let found = observe_all(&mut c, 1.8, 20, at);
+        assert!((found - 1.5).abs() < 1e-9, "{found}");
+        assert!(c.found_at(1.8 + 0.2 * 19.0));
     }
 
     #[test]

@@ -11,8 +11,8 @@ use super::{Conflict, TimedPath, TrafficConfig, first_within_standing_reach, sur
 
 impl TrafficRules {
     /// A known mover of `movers` - arriving lately (seen predicted for a second within the last
-    /// six, beyond its own extent: not a static object's sliding parts), or one that drove up
-    /// longer ago (`drove_up`: a van that stood at the nose longer than six seconds, variant 6
+    /// six, beyond its own extent: not a static object's sliding parts), a person standing
+    /// (`is_walker`), or one that drove up longer ago (`drove_up`: a van that stood at the nose longer than six seconds, variant 6
     /// of `traffic_jet_speed_profiles.toml`) - standing now (not [`surely_moving`]) within its
     /// reach of the vehicle at `pose` ([`first_within_standing_reach`]), as what stops the
     /// vehicle; `None` with traffic off.
@@ -29,7 +29,8 @@ impl TrafficRules {
         movers
             .iter()
             .filter(|t| {
-                !surely_moving(t, cfg) && (self.arriving(t, now_s, cfg) || self.drove_up(t))
+                !surely_moving(t, cfg)
+                    && (self.arriving(t, now_s, cfg) || self.is_walker(t, cfg) || self.drove_up(t))
             })
             .find(|t| {
                 first_within_standing_reach(&self.model, std::slice::from_ref(pose), t, cfg)

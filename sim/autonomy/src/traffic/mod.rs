@@ -134,11 +134,13 @@ pub struct TrafficConfig {
     /// m/s^2).
     pub standing_reach_m: f64,
     /// The first obstacle of the map on the path coming nearer along the route faster than
-    /// this, over a second and a half of plans, is something moving towards the vehicle that
-    /// the tracker does not follow (a towed train seen as a mover only in flashes): the speed
-    /// is capped at `caution_speed_m_s` and the vehicle stops short of where the obstacle will
-    /// be by the time it stands, m/s. Default 0.8 (a static object met on a replanned path
-    /// jitters by the path's pose spacing, 0.5 m).
+    /// this, fitted over a second and a half of plans, is something moving towards the vehicle
+    /// that the tracker does not follow (a towed train seen as a mover only in flashes): the
+    /// vehicle closes on it no faster than `caution_speed_m_s` together (a third of it at
+    /// least) and stops short of where it will be by the time it stands, m/s. Default 0.8. The
+    /// fit must also have fallen 1 m from its first half to its second (a static object met on
+    /// a replanned path jitters by the path's pose spacing, 0.5 m), which at 10 plans a second
+    /// takes about 1.25 m/s: slower closing is not found.
     pub closing_speed_m_s: f64,
 }
 

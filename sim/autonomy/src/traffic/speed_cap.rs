@@ -72,17 +72,20 @@ impl TrafficRules {
         let closing_m_s =
             self.closing
                 .observe(i.now_s, at, cfg.closing_speed_m_s, cfg.conflict_memory_s);
+        if self.closing.found_at(i.now_s) {
+            self.last_caution_s = Some(i.now_s);
+        }
         if closing_m_s <= 0.0 {
             return (f64::INFINITY, 0.0);
         }
-        self.last_caution_s = Some(i.now_s);
         let together = (cfg.caution_speed_m_s - closing_m_s).max(cfg.caution_speed_m_s / 3.0);
         (together, closing_m_s * time_to_stop_s(i))
     }
 }
 
-/// How long the vehicle of `i` takes to stand from its speed now, seconds: its stopping
-/// distance without the buffer, at the mean speed of a steady braking (0 standing).
+/// How long the vehicle of `i` takes to stand from its speed now, seconds (0 standing): its
+/// stopping distance without the buffer at the mean speed of a steady braking - an upper bound,
+/// since the reaction's distance, driven at full speed, is counted at half of it too.
 fn time_to_stop_s(i: &MoverInputs<'_>) -> f64 {
     if i.speed_m_s < 0.05 {
         return 0.0;
