@@ -113,6 +113,21 @@ impl Tracker {
     /// revealing a static object's parts explains. A long truck crossing slowly along its own
     /// length takes seconds to get there; what may move is worth slowing for meanwhile.
     pub fn candidate_movers(&self) -> Vec<TrackState> {
+        self.steady_unpredictable(self.config.max_object_m, true)
+    }
+
+    /// The tracks seen this revolution, steadily for `predict_after_revolutions`, no larger
+    /// than `max_extent_m`, that are neither predictable nor candidate movers: small objects
+    /// standing - with an offline map, ones it does not hold (a person waiting beside the
+    /// path, a cone left out). Nothing says they will not walk on.
+    pub fn standing_objects(&self, max_extent_m: f64) -> Vec<TrackState> {
+        self.steady_unpredictable(max_extent_m, false)
+    }
+
+    /// The tracks seen this revolution, steadily for `predict_after_revolutions`, no larger
+    /// than `max_extent_m`, not predictable, whose centre is (`travelled`) or is not yet
+    /// `predict_min_travel_m` from where it was first seen.
+    fn steady_unpredictable(&self, max_extent_m: f64, travelled: bool) -> Vec<TrackState> {
         let cfg = &self.config;
         self.tracks
             .iter()
@@ -120,8 +135,8 @@ impl Tracker {
                 !t.predictable
                     && t.bbox.is_some()
                     && t.steady >= cfg.predict_after_revolutions
-                    && t.max_extent_m <= cfg.max_object_m
-                    && (t.last - t.first).norm() >= cfg.predict_min_travel_m
+                    && t.max_extent_m <= max_extent_m
+                    && ((t.last - t.first).norm() >= cfg.predict_min_travel_m) == travelled
             })
             .map(|t| self.state(t))
             .collect()

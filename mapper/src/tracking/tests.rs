@@ -229,6 +229,44 @@ fn a_long_slow_truck_is_a_candidate_mover_seconds_before_it_is_predicted() {
     assert!((42..=50).contains(&mover), "a mover at revolution {mover}");
 }
 
+/// A person standing (0.6 m) is a standing object from the fifth revolution on, and stops
+/// being one once it walks (a candidate, then a mover); a 3 m cart standing never is one
+/// at a 2 m bound.
+#[test]
+fn a_person_standing_is_a_standing_object_until_they_walk() {
+    let mut t = Tracker::new(TrackerConfig::default(), 0.2);
+    let person = |k: i64| block(k, 0, 3, 3);
+    let cart = block(40, 40, 15, 5);
+    let mut first = None;
+    for k in 0..30 {
+        let hits: Vec<WorldCell> = person(0).into_iter().chain(cart.clone()).collect();
+        t.update(k as f64 * 0.1, &hits);
+        let standing = t.standing_objects(2.0);
+        assert!(
+            standing.iter().all(|s| s.extent_m <= 2.0),
+            "{k}: {standing:?}"
+        );
+        if !standing.is_empty() {
+            first.get_or_insert(k);
+        }
+        assert_eq!(standing.len(), usize::from(k >= 4), "{k}: {standing:?}");
+    }
+    assert_eq!(first, Some(4));
+    // It walks on at 2 m/s along x: standing no more once seen a metre from where it stood.
+    let mut left = None;
+    for k in 1..30 {
+        let hits: Vec<WorldCell> = person(k).into_iter().chain(cart.clone()).collect();
+        t.update(3.0 + k as f64 * 0.1, &hits);
+        if t.standing_objects(2.0).is_empty() {
+            left.get_or_insert(k);
+        } else {
+            assert!(left.is_none(), "{k}: standing again");
+        }
+    }
+    assert_eq!(left, Some(5), "standing until {left:?}");
+    assert_eq!(t.standing_objects(4.0).len(), 1, "the cart at a 4 m bound");
+}
+
 /// A van seen at 4 m/s that seems to slow to 1 m/s (its visible part shrinking as it goes into
 /// the shadow of a wing) keeps its peak speed for about [`PEAK_SPEED_S`]; then the peak gives
 /// way to the speed measured since.

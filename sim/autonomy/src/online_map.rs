@@ -277,6 +277,13 @@ impl OnlineMap {
             .collect()
     }
 
+    /// The small objects standing that the offline map does not hold, up to `max_extent_m`
+    /// ([`mapper::Tracker::standing_objects`]), as of the last revolution: a person waiting
+    /// beside the path is one, seen only standing.
+    pub fn standing_objects(&self, max_extent_m: f64) -> Vec<mapper::TrackState> {
+        self.tracker.standing_objects(max_extent_m)
+    }
+
     /// The multi-height map (occupancy and distance maps per level).
     pub fn map(&self) -> &MultiHeightMap {
         &self.map

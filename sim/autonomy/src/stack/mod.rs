@@ -224,6 +224,7 @@ impl Driver {
         // The tracker's movers, once a plan: the rules about movers read them.
         let movers = map.movers();
         let candidates = map.candidate_movers();
+        let standing = map.standing_objects(config.traffic.standing_object_max_m);
         let v0 = self.last_odometry.map_or(0.0, |o| o.speed_m_s.max(0.0));
         let decision = self.traffic.decide(&MoverInputs {
             poses: &p.chosen().poses,
@@ -231,6 +232,7 @@ impl Driver {
             stop_at_m: p.chosen().collision_at_m,
             movers: &movers,
             candidates: &candidates,
+            standing: &standing,
             wanted_m_s: wanted,
             pose: estimate.world_from_vehicle,
             now_s: estimate.t_s,

@@ -1,9 +1,12 @@
-//! The rules about a map obstacle closing on the vehicle (`closing`, `speed_cap`) through
-//! [`TrafficRules::decide`](super::TrafficRules::decide), on a straight route.
+//! The speed caps of `speed_cap` - a map obstacle closing on the vehicle (`closing`), a small
+//! object seen only standing - through [`TrafficRules::decide`](super::TrafficRules::decide),
+//! on a straight route.
 
-use super::rules_tests::{inputs, rules, straight};
+use super::conflict::reach_of;
+use super::rules_tests::{inputs, rules, straight, track};
 use super::{MoverDecision, MoverInputs, TrafficConfig};
 use crate::planner::{AutonomyConfig, stopping_distance_m};
+use mapper::TrackState;
 
 /// The decisions of plans every 0.2 s for 1.6 s, the vehicle at 3 m/s, the first collision
 /// at route position `at(t)`: the last one.
@@ -48,4 +51,39 @@ fn a_map_obstacle_closing_slows_the_vehicle_and_moves_its_stop_short() {
     let (d, stop) = decide_closing(|_| 40.0);
     assert_eq!(d.wanted_m_s, 5.0);
     assert_eq!(d.stop_at_m, Some(stop));
+}
+
+/// A person who stood beside the path walks on into the nose
+/// (`tests/found/person_walks_on_into_the_slowing_nose.toml`): a small object seen only
+/// standing, hit on both levels, within its reach of the path caps the speed at the caution
+/// speed; a little farther off, on the ground level alone (a cone), or with the rule off, it
+/// does not.
+#[test]
+fn a_small_object_seen_only_standing_beside_the_path_caps_the_speed() {
+    let poses = straight();
+    let config = AutonomyConfig::default();
+    let cfg = &config.traffic;
+    let object = |y: f64, levels: u32| {
+        let mut t = track(3, 0.0, (30.0, y), (0.0, 0.0), levels);
+        (t.confirmed, t.travel_m, t.extent_m) = (false, 0.0, 0.8);
+        t
+    };
+    // The test model's ground circles: radius 1 m on the route's line.
+    let person = |y: f64| object(y, 0b11);
+    let edge_m = 1.0 + reach_of(&person(0.0), cfg.standing_object_reach_m, cfg);
+    let wanted_for = |t: TrackState, config: &AutonomyConfig| {
+        let standing = [t];
+        let i = MoverInputs {
+            standing: &standing,
+            ..inputs(&poses, &[], &[], 0.0, 5.0, config)
+        };
+        rules().decide(&i).wanted_m_s
+    };
+    let wanted = |y: f64, config: &AutonomyConfig| wanted_for(person(y), config);
+    assert_eq!(wanted(-(edge_m - 0.1), &config), cfg.caution_speed_m_s);
+    assert_eq!(wanted(-(edge_m + 0.1), &config), 5.0);
+    assert_eq!(wanted_for(object(-(edge_m - 0.1), 0b01), &config), 5.0);
+    let mut off = config.clone();
+    off.traffic.standing_object_max_m = 0.0;
+    assert_eq!(wanted(-(edge_m - 0.1), &off), 5.0);
 }

@@ -5,15 +5,21 @@ use aircraft::footprint::segment_distance;
 use mapper::{CollisionModel, TrackState};
 use nalgebra::{Isometry2, Point2};
 
-use super::predict::{Footprint, swept};
+use super::predict::{Footprint, came_there, swept};
 use super::{Conflict, Prediction, TimedPath, TrafficConfig};
 
 /// How near a known mover standing, `t`, the vehicle's circles may not come: its footprint's
 /// larger half, `cfg.standing_reach_m` (how far it may walk or drive on without warning) and
 /// `cfg.margin_m`, metres from its centre beyond a circle's radius.
 pub(super) fn standing_reach(t: &TrackState, cfg: &TrafficConfig) -> f64 {
+    reach_of(t, cfg.standing_reach_m, cfg)
+}
+
+/// Its footprint's larger half, `reach_m` and `cfg.margin_m`: how near `t` the vehicle's
+/// circles may come, metres from its centre beyond a circle's radius.
+pub(super) fn reach_of(t: &TrackState, reach_m: f64, cfg: &TrafficConfig) -> f64 {
     let f = Footprint::of(t, cfg);
-    f.half_length_m.max(f.half_width_m) + cfg.standing_reach_m + cfg.margin_m
+    f.half_length_m.max(f.half_width_m) + reach_m + cfg.margin_m
 }
 
 /// Whether any of `poses` comes within [`standing_reach`] of a known mover standing in
@@ -39,10 +45,20 @@ pub fn first_within_standing_reach(
     t: &TrackState,
     cfg: &TrafficConfig,
 ) -> Option<usize> {
-    let reach = standing_reach(t, cfg);
+    first_within(model, poses, t, standing_reach(t, cfg))
+}
+
+/// The first of `poses` whose circles, on a level `t` occupies, come within `reach_m` of its
+/// centre beyond their radii.
+pub(super) fn first_within(
+    model: &CollisionModel,
+    poses: &[Isometry2<f64>],
+    t: &TrackState,
+    reach_m: f64,
+) -> Option<usize> {
     poses
         .iter()
-        .position(|pose| touches(model, pose, t.levels, &t.position, &t.position, reach))
+        .position(|pose| touches(model, pose, t.levels, &t.position, &t.position, reach_m))
 }
 
 /// Whether any circle of `model` at `pose` on a level in `levels` comes within `reach_m` (plus
@@ -151,14 +167,39 @@ fn conflict_with(
     best
 }
 
+/// Where a mover may be, for [`stand_clear`]: a capsule.
+struct Zone {
+    /// Its axis's ends, metres.
+    axis: (Point2<f64>, Point2<f64>),
+    /// Its reach beyond the circles' radii, metres.
+    reach_m: f64,
+    /// The levels it occupies.
+    levels: u32,
+    /// The reach of a standing mover that came where it stands ([`came_there`]), not a
+    /// predicted one's sweep nor a static object's sliding parts.
+    came_there: bool,
+}
+
+impl Zone {
+    /// Whether the circles of `model` at `pose` on its levels come within its reach.
+    fn touches(&self, model: &CollisionModel, pose: &Isometry2<f64>) -> bool {
+        let (a, b) = &self.axis;
+        touches(model, pose, self.levels, a, b, self.reach_m)
+    }
+}
+
 /// Where the vehicle about to stop `stop_at_m` along `path` (it stands `stand_back_m` before
 /// that) should stop instead, so that it does not stand where a mover is predicted to pass
 /// within the horizon, nor within `cfg.standing_reach_m` of a known mover standing
 /// (`standing`: it may walk on into the airframe, as a person waiting beside the nose did):
 /// before the first pose such a zone touches, when that lies beyond `stopping_m` (the vehicle
 /// can still stop short of it). A stop for one mover, or for an obstacle in the map, must not
-/// leave the tail across another's path. `None`: standing there is clear of every mover, or it
-/// is too late to stop short.
+/// leave the tail across another's path. Too late to stop short of the reach of a standing
+/// mover that came there ([`came_there`]), it stops as short as it can (`stopping_m`, when that
+/// is over a pose step short of the stop), not deeper within the reach: a van standing at
+/// the path's edge may drive on into the nose going by
+/// (`tests/found/van_stopping_at_the_edge_goes_on_into_the_nose.toml`). `None`: standing
+/// there is clear of every mover, or it is too late to stop short of a predicted one.
 #[allow(clippy::too_many_arguments)]
 pub fn stand_clear(
     path: &TimedPath<'_>,
@@ -171,16 +212,22 @@ pub fn stand_clear(
     cfg: &TrafficConfig,
 ) -> Option<f64> {
     let last = path.poses.len().checked_sub(1)?;
-    // Each zone: its capsule's axis, its reach beyond the circles' radii, its levels.
-    let zones: Vec<(Point2<f64>, Point2<f64>, f64, u32)> = predictions
+    let zones: Vec<Zone> = predictions
         .iter()
         .map(|p| {
             let (a, b, radius) = swept(&p.track, path.now_s, path.now_s + cfg.horizon_s, cfg);
-            (a, b, radius + cfg.margin_m, p.track.levels)
+            Zone {
+                axis: (a, b),
+                reach_m: radius + cfg.margin_m,
+                levels: p.track.levels,
+                came_there: false,
+            }
         })
-        .chain(standing.iter().map(|t| {
-            let reach = standing_reach(t, cfg);
-            (t.position, t.position, reach, t.levels)
+        .chain(standing.iter().map(|t| Zone {
+            axis: (t.position, t.position),
+            reach_m: standing_reach(t, cfg),
+            levels: t.levels,
+            came_there: came_there(t),
         }))
         .collect();
     let mut at_m = stop_at_m;
@@ -190,24 +237,22 @@ pub fn stand_clear(
         let stand = (((at_m - stand_back_m) / path.step_m).floor().max(0.0) as usize).min(last);
         let earliest = zones
             .iter()
-            .filter(|(a, b, reach, levels)| {
-                touches(model, &path.poses[stand], *levels, a, b, *reach)
-            })
-            .map(|(a, b, reach, levels)| {
-                path.poses[..=stand]
+            .filter(|z| z.touches(model, &path.poses[stand]))
+            .map(|z| {
+                let zone_m = path.poses[..=stand]
                     .iter()
-                    .position(|pose| touches(model, pose, *levels, a, b, *reach))
+                    .position(|pose| z.touches(model, pose))
                     .unwrap_or(stand) as f64
-                    * path.step_m
+                    * path.step_m;
+                (zone_m, z.came_there)
             })
-            .reduce(f64::min);
+            .reduce(|a, b| if b.0 < a.0 { b } else { a });
         match earliest {
-            Some(zone_m) if zone_m > stopping_m && zone_m < at_m => {
-                at_m = zone_m;
-                moved = true;
-            }
+            Some((zone_m, _)) if zone_m > stopping_m && zone_m < at_m => at_m = zone_m,
+            Some((_, true)) if stopping_m < at_m - path.step_m => at_m = stopping_m,
             _ => break,
         }
+        moved = true;
     }
     moved.then_some(at_m)
 }

@@ -7,13 +7,16 @@ use nalgebra::Isometry2;
 
 use super::memory::LOST_STANDING_EXTENT_M;
 use super::rules::{BodyHold, MoverInputs, TrafficRules};
-use super::{Conflict, TimedPath, TrafficConfig, first_within_standing_reach, surely_moving};
+use super::{
+    Conflict, TimedPath, TrafficConfig, came_there, first_within_standing_reach, surely_moving,
+};
 
 impl TrafficRules {
     /// A known mover of `movers` - arriving lately (seen predicted for a second within the last
     /// six, beyond its own extent: not a static object's sliding parts), a person standing
-    /// (`is_walker`), or one that drove up longer ago (`drove_up`: a van that stood at the nose longer than six seconds, variant 6
-    /// of `traffic_jet_speed_profiles.toml`) - standing now (not [`surely_moving`]) within its
+    /// (`is_walker`), or one that drove up longer ago (`drove_up`: a van that stood at the nose
+    /// longer than six seconds, variant 6 of `traffic_jet_speed_profiles.toml`) - standing now
+    /// (not [`surely_moving`]) within its
     /// reach of the vehicle at `pose` ([`first_within_standing_reach`]), as what stops the
     /// vehicle; `None` with traffic off.
     pub(super) fn standing_at(
@@ -43,12 +46,10 @@ impl TrafficRules {
     }
 
     /// Whether `t` is a known mover that came where it stands: seen moving as a mover for
-    /// `MOVER_FOR_S` on end at some time and travelled more than twice its extent and 3 m (any
-    /// size: a person, a van), as one lost standing must have (`note_lost_standing`): a parked
-    /// car the offline map does not hold, whose visible part slides as the vehicle drives by,
-    /// seems to travel a few metres (`parking_lot_on_a_stale_map_movers_predicted`).
+    /// `MOVER_FOR_S` on end at some time and [`came_there`], as one lost standing must have
+    /// (`note_lost_standing`).
     fn drove_up(&self, t: &TrackState) -> bool {
-        self.walked.contains(&t.id) && t.travel_m > 2.0 * t.extent_m + 3.0
+        self.walked.contains(&t.id) && came_there(t)
     }
 
     /// Whether `t` is a person standing: a small known mover (up to

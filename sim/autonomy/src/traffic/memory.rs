@@ -7,8 +7,8 @@ use nalgebra::Isometry2;
 
 use super::rules::{AtBody, BodyHold, LostMover, MoverPath, MoverStreak, TrafficRules};
 use super::{
-    TrafficConfig, at_body, may_have_walked_to, may_reach_body, moved_beyond_its_extent,
-    surely_moving,
+    TrafficConfig, at_body, came_there, may_have_walked_to, may_reach_body,
+    moved_beyond_its_extent, surely_moving,
 };
 
 /// A mover predicted out of view whose track drops while it may reach the standing vehicle's
@@ -273,7 +273,7 @@ impl TrafficRules {
                 && t.confirmed
                 && self.walked.contains(&t.id)
                 && t.extent_m <= LOST_STANDING_EXTENT_M
-                && t.travel_m > 2.0 * t.extent_m + 3.0
+                && came_there(t)
                 && !surely_moving(t, cfg)
         }) {
             match self.lost_standing.iter_mut().find(|l| l.id == t.id) {

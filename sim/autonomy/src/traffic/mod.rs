@@ -79,7 +79,7 @@ pub use conflict::{
     first_conflict, first_conflict_straightforward, first_within_standing_reach, passes_standing,
     stand_clear,
 };
-pub use predict::{moved_beyond_its_extent, predict, predict_keeping, surely_moving};
+pub use predict::{came_there, moved_beyond_its_extent, predict, predict_keeping, surely_moving};
 pub use rules::{BodyHold, LostMover, MoverDecision, MoverInputs, TrafficRules};
 
 /// How the stack predicts movers and checks its path against them.
@@ -142,6 +142,17 @@ pub struct TrafficConfig {
     /// a replanned path jitters by the path's pose spacing, 0.5 m), which at 10 plans a second
     /// takes about 1.25 m/s: slower closing is not found.
     pub closing_speed_m_s: f64,
+    /// A small object the offline map does not hold, seen only standing, no larger than this
+    /// ([`mapper::Tracker::standing_objects`]) and hit above the lowest level - a person
+    /// waiting beside the path, not a cone - may walk on before the tracker can predict it:
+    /// the vehicle passes within `standing_object_reach_m` of it no faster than
+    /// `caution_speed_m_s`, metres. Default 1 (a person's hits are 0.5-0.9 m across; the
+    /// parking lot's wheeled containers, 1.1-1.4 m, are not slowed for); 0 turns it off.
+    pub standing_object_max_m: f64,
+    /// How near a small object seen only standing (`standing_object_max_m`) the vehicle's
+    /// circles pass at the caution speed at most, beyond its footprint and `margin_m`, on a
+    /// level it occupies, metres. Default 6.
+    pub standing_object_reach_m: f64,
 }
 
 impl Default for TrafficConfig {
@@ -161,6 +172,8 @@ impl Default for TrafficConfig {
             caution_speed_m_s: 3.0,
             standing_reach_m: 3.0,
             closing_speed_m_s: 0.8,
+            standing_object_max_m: 1.0,
+            standing_object_reach_m: 6.0,
         }
     }
 }
@@ -182,6 +195,8 @@ impl TrafficConfig {
             ("caution_speed_m_s", self.caution_speed_m_s),
             ("standing_reach_m", self.standing_reach_m),
             ("closing_speed_m_s", self.closing_speed_m_s),
+            ("standing_object_max_m", self.standing_object_max_m),
+            ("standing_object_reach_m", self.standing_object_reach_m),
         ];
         positive
             .into_iter()

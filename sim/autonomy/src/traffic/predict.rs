@@ -70,6 +70,14 @@ pub fn moved_beyond_its_extent(t: &TrackState, cfg: &TrafficConfig) -> bool {
     t.travel_m > t.extent_m + cfg.hidden_m
 }
 
+/// Whether the tracked mover `t` came where it is: travelled more than twice its extent and
+/// 3 m since first seen (any size: a person, a van). A parked car the offline map does not hold,
+/// whose visible part slides as the vehicle drives by, seems to travel a few metres only
+/// (`parking_lot_on_a_stale_map_movers_predicted`).
+pub fn came_there(t: &TrackState) -> bool {
+    t.travel_m > 2.0 * t.extent_m + 3.0
+}
+
 /// A mover's shape as the check uses it.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Footprint {

@@ -35,6 +35,9 @@ pub struct MoverInputs<'a> {
     pub movers: &'a [TrackState],
     /// The tracker's candidate movers (seen to travel, not yet predictable).
     pub candidates: &'a [TrackState],
+    /// The small objects the tracker has seen only standing
+    /// (`crate::OnlineMap::standing_objects`).
+    pub standing: &'a [TrackState],
     /// The speed the vehicle wants before the movers are counted, m/s.
     pub wanted_m_s: f64,
     /// The vehicle's estimated pose.

@@ -80,6 +80,7 @@ pub(super) fn inputs<'a>(
         stop_at_m: None,
         movers,
         candidates,
+        standing: &[],
         wanted_m_s: 5.0,
         pose: Isometry2::identity(),
         now_s,
@@ -264,7 +265,7 @@ fn a_vehicle_stopping_anyway_stops_short_of_the_caution_line() {
 
 /// A van stopping at the edge goes on into the nose (`van_stopping_at_the_edge_goes_on_into_the_nose`):
 /// a vehicle about to stop beside a mover standing (not predicted) stops short of its reach
-/// when it can; too late, or with traffic off, where it would.
+/// when it can; too late, as short as it can; with traffic off, where it would.
 #[test]
 fn a_stop_beside_a_van_standing_is_moved_short_of_its_reach() {
     let config = AutonomyConfig::default();
@@ -277,11 +278,12 @@ fn a_stop_beside_a_van_standing_is_moved_short_of_its_reach() {
         r.stand_clear(&inputs(&poses, &van, &[], 0.0, 0.0, &config), 40.0),
         30.0
     );
-    // At 12 m/s it stops in 6 + 24 + 3 m, beyond 30 m: too late, the stop stays.
-    assert_eq!(
-        r.stand_clear(&inputs(&poses, &van, &[], 0.0, 12.0, &config), 40.0),
-        40.0
-    );
+    // At 12 m/s it stops in 6 + 24 + 3 m, beyond 30 m: too late, it stops in 33 m, not 40;
+    // a stop nearer than that stays.
+    let fast = inputs(&poses, &van, &[], 0.0, 12.0, &config);
+    assert_eq!(fast.stopping_m, 33.0);
+    assert_eq!(r.stand_clear(&fast, 40.0), 33.0);
+    assert_eq!(r.stand_clear(&fast, 32.0), 32.0);
     let mut off = AutonomyConfig::default();
     off.traffic.enabled = false;
     assert_eq!(

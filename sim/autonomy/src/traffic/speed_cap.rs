@@ -2,6 +2,7 @@
 //! path, or the path passing near a known mover standing, caps the speed at the caution speed;
 //! a map obstacle closing on the vehicle (`closing`) caps it lower and moves the stop short.
 
+use super::conflict::{first_within, reach_of};
 use super::rules::{MoverInputs, TrafficRules};
 use super::{TimedPath, first_conflict, first_within_standing_reach, predict, surely_moving};
 
@@ -45,6 +46,7 @@ impl TrafficRules {
             .iter()
             .filter(|t| !surely_moving(t, traffic))
             .any(|t| first_within_standing_reach(&self.model, poses, t, traffic).is_some())
+            || self.passes_standing_object(i)
         {
             self.last_caution_s = Some(now_s);
         }
@@ -56,6 +58,20 @@ impl TrafficRules {
         } else {
             wanted
         }
+    }
+
+    /// Whether the path of `i` passes within `standing_object_reach_m` of a small object seen
+    /// only standing (`standing_object_max_m`) and hit above the lowest level (a person, not
+    /// a cone): one who stood beside the path and walks on is predicted only after a second or
+    /// so of walking, by when a vehicle at 8 m/s could no longer stop short of them (variant 66
+    /// of `traffic_jet_speed_profiles.toml`).
+    fn passes_standing_object(&self, i: &MoverInputs<'_>) -> bool {
+        let cfg = i.traffic;
+        cfg.standing_object_max_m > 0.0
+            && i.standing.iter().filter(|t| t.levels > 1).any(|t| {
+                let reach = reach_of(t, cfg.standing_object_reach_m, cfg);
+                first_within(&self.model, i.poses, t, reach).is_some()
+            })
     }
 
     /// The speed cap and how far short to move the map's stop for a map obstacle closing on

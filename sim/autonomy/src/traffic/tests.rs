@@ -115,7 +115,8 @@ fn a_stop_is_moved_short_of_another_movers_path() {
     };
     assert!(!touches_at(at - 3.0));
     assert!(touches_at(at));
-    // Too late to stop short of it: the line stays (driving on is the avoider's call).
+    // Too late to stop short of it: the line stays (driving on is the avoider's call; standing
+    // sooner in its path would be no better).
     assert_eq!(clear(&truck, at + 0.5), None);
     // A mover predicted to stay 30 m off: standing at the line is clear.
     assert_eq!(clear(&mover(22.0, -40.0, 0.0, 1.1, 0b11), 2.0), None);
@@ -149,8 +150,24 @@ fn a_mover_standing_is_kept_at_its_reach() {
     let clear =
         |stopping_m: f64| stand_clear(&path, &model(), &[], &person, 40.0, 3.0, stopping_m, &cfg);
     assert_eq!(clear(5.0), Some(30.0));
-    // Too late to stop short of the reach: the line stays.
-    assert_eq!(clear(31.0), None);
+    // Too late to stop short of the reach: as short as it can, not deeper; unless it stops
+    // nearer anyway.
+    assert_eq!(clear(31.0), Some(31.0));
+    // Within a pose step (0.5 m) of the stop: left where it is.
+    assert_eq!(clear(39.6), None);
+    assert_eq!(clear(40.0), None);
+    // A static object's parts that slid 3 m as it came into view (not beyond twice its extent
+    // and 3 m): too late, the stop stays (a ground power unit under the wing).
+    let slid = [TrackState {
+        travel_m: 3.0,
+        ..person[0].clone()
+    }];
+    assert_eq!(
+        stand_clear(&path, &model(), &[], &slid, 40.0, 3.0, 31.0, &cfg),
+        None
+    );
+    // (A mover predicted through the stop, too late: the stop stays,
+    // `a_stop_is_moved_short_of_another_movers_path`.)
 }
 
 #[test]
