@@ -18,7 +18,8 @@ pub struct MovingObject {
     pub travel_m: f64,
 }
 
-/// A tracked object's state: what [`Tracker::movers`] and [`Tracker::candidate_movers`] give.
+/// A tracked object's state: what [`Tracker::movers`], [`Tracker::candidate_movers`] and
+/// [`Tracker::standing_objects`] give.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrackState {
     /// Track id.

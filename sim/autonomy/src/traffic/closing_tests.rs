@@ -2,7 +2,6 @@
 //! object seen only standing - through [`TrafficRules::decide`](super::TrafficRules::decide),
 //! on a straight route.
 
-use super::conflict::reach_of;
 use super::rules_tests::{inputs, rules, straight, track};
 use super::{MoverDecision, MoverInputs, TrafficConfig};
 use crate::planner::{AutonomyConfig, stopping_distance_m};
@@ -68,9 +67,11 @@ fn a_small_object_seen_only_standing_beside_the_path_caps_the_speed() {
         (t.confirmed, t.travel_m, t.extent_m) = (false, 0.0, 0.8);
         t
     };
-    // The test model's ground circles: radius 1 m on the route's line.
     let person = |y: f64| object(y, 0b11);
-    let edge_m = 1.0 + reach_of(&person(0.0), cfg.standing_object_reach_m, cfg);
+    // The test model's ground circles are 1 m in radius on the route's line; the reach is 6 m
+    // beyond half the person's footprint (0.5 m and 1 m hidden) and the 0.5 m margin.
+    let edge_m = 1.0 + 1.5 + cfg.standing_object_reach_m + cfg.margin_m;
+    assert_eq!(edge_m, 9.0);
     let wanted_for = |t: TrackState, config: &AutonomyConfig| {
         let standing = [t];
         let i = MoverInputs {

@@ -175,6 +175,8 @@ struct Zone {
     reach_m: f64,
     /// The levels it occupies.
     levels: u32,
+    /// A predicted mover's sweep over the horizon.
+    predicted: bool,
     /// The reach of a standing mover that came where it stands ([`came_there`]), not a
     /// predicted one's sweep nor a static object's sliding parts.
     came_there: bool,
@@ -196,10 +198,11 @@ impl Zone {
 /// can still stop short of it). A stop for one mover, or for an obstacle in the map, must not
 /// leave the tail across another's path. Too late to stop short of the reach of a standing
 /// mover that came there ([`came_there`]), it stops as short as it can (`stopping_m`, when that
-/// is over a pose step short of the stop), not deeper within the reach: a van standing at
-/// the path's edge may drive on into the nose going by
-/// (`tests/found/van_stopping_at_the_edge_goes_on_into_the_nose.toml`). `None`: standing
-/// there is clear of every mover, or it is too late to stop short of a predicted one.
+/// is over a pose step short of the stop and not in a predicted mover's sweep), not deeper
+/// within the reach: a van standing at the path's edge may drive on into the nose going by
+/// (`tests/found/van_stopping_at_the_edge_goes_on_into_the_nose.toml`). Standing, that is where
+/// it stands (the stop buffer): it does not creep on within the reach. `None`: standing there
+/// is clear of every mover, or it is too late to stop short of a predicted one.
 #[allow(clippy::too_many_arguments)]
 pub fn stand_clear(
     path: &TimedPath<'_>,
@@ -220,6 +223,7 @@ pub fn stand_clear(
                 axis: (a, b),
                 reach_m: radius + cfg.margin_m,
                 levels: p.track.levels,
+                predicted: true,
                 came_there: false,
             }
         })
@@ -227,14 +231,22 @@ pub fn stand_clear(
             axis: (t.position, t.position),
             reach_m: standing_reach(t, cfg),
             levels: t.levels,
+            predicted: false,
             came_there: came_there(t),
         }))
         .collect();
+    // The pose the vehicle stands at, stopping `at_m` ahead.
+    let stand_at =
+        |at_m: f64| (((at_m - stand_back_m) / path.step_m).floor().max(0.0) as usize).min(last);
+    let in_a_sweep = |at_m: f64| {
+        let pose = &path.poses[stand_at(at_m)];
+        zones.iter().any(|z| z.predicted && z.touches(model, pose))
+    };
     let mut at_m = stop_at_m;
     let mut moved = false;
     // Each earlier line may stand in a third mover's path: at most one step per zone.
     for _ in 0..zones.len() {
-        let stand = (((at_m - stand_back_m) / path.step_m).floor().max(0.0) as usize).min(last);
+        let stand = stand_at(at_m);
         let earliest = zones
             .iter()
             .filter(|z| z.touches(model, &path.poses[stand]))
@@ -246,10 +258,13 @@ pub fn stand_clear(
                     * path.step_m;
                 (zone_m, z.came_there)
             })
-            .reduce(|a, b| if b.0 < a.0 { b } else { a });
+            // The earliest; of two as early, the one of a mover that came there.
+            .reduce(|a, b| if (b.0, !b.1) < (a.0, !a.1) { b } else { a });
         match earliest {
             Some((zone_m, _)) if zone_m > stopping_m && zone_m < at_m => at_m = zone_m,
-            Some((_, true)) if stopping_m < at_m - path.step_m => at_m = stopping_m,
+            Some((_, true)) if stopping_m < at_m - path.step_m && !in_a_sweep(stopping_m) => {
+                at_m = stopping_m
+            }
             _ => break,
         }
         moved = true;

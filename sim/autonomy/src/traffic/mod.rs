@@ -20,7 +20,8 @@
 //!   fast), it drives on if it clears the mover by `committed_margin_s`, and stops before the
 //!   conflict itself only if it does not. Wherever it stops - for a mover or for the map - it
 //!   stops short of any other mover's predicted path when it can ([`stand_clear`]): a stop for
-//!   one must not leave the tail across another's. A mover predicted to pass before the
+//!   one must not leave the tail across another's; too late to stop short of the reach of a
+//!   mover standing that came there, it stops as short as it can. A mover predicted to pass before the
 //!   vehicle arrives (or after it has gone) is no conflict, so it does not stop the vehicle.
 //!   While yielding, the margin after grows by `resume_margin_s`, so the vehicle does not creep
 //!   off and stop again.
@@ -30,7 +31,9 @@
 //!   the rest of it).
 //! - **Caution**: a candidate mover - seen to travel a metre, not yet beyond what revealing a
 //!   static object explains - checked the same way caps the speed at `caution_speed_m_s`
-//!   instead of stopping the vehicle: slow for what may move, stop for what does.
+//!   instead of stopping the vehicle: slow for what may move, stop for what does. So does a
+//!   person-sized object seen only standing within `standing_object_reach_m` of the path
+//!   ([`mapper::Tracker::standing_objects`]): it may walk on before it can be predicted.
 //! - **A map obstacle closing** (`closing`): the chosen path's first collision with the
 //!   map coming nearer along the route faster than `closing_speed_m_s` is something moving the
 //!   tracker does not follow; the vehicle closes on it no faster than the caution speed
@@ -144,14 +147,17 @@ pub struct TrafficConfig {
     pub closing_speed_m_s: f64,
     /// A small object the offline map does not hold, seen only standing, no larger than this
     /// ([`mapper::Tracker::standing_objects`]) and hit above the lowest level - a person
-    /// waiting beside the path, not a cone - may walk on before the tracker can predict it:
-    /// the vehicle passes within `standing_object_reach_m` of it no faster than
-    /// `caution_speed_m_s`, metres. Default 1 (a person's hits are 0.5-0.9 m across; the
-    /// parking lot's wheeled containers, 1.1-1.4 m, are not slowed for); 0 turns it off.
+    /// waiting beside the path - may walk on before the tracker can predict it: the vehicle
+    /// passes within `standing_object_reach_m` of it no faster than `caution_speed_m_s`,
+    /// metres. Default 1 (a person's hits are 0.5-0.9 m across). By footprint and levels alone:
+    /// a cone is left out under the Praetor-like jet's 1.1 m level but not under the
+    /// A320-like airliner's 0.55 m one; the parking lot's 1.1 m container, seen end-on 0.9-1.0 m
+    /// across, is slowed for; a one-level vehicle never slows for one. 0 turns it off.
     pub standing_object_max_m: f64,
     /// How near a small object seen only standing (`standing_object_max_m`) the vehicle's
-    /// circles pass at the caution speed at most, beyond its footprint and `margin_m`, on a
-    /// level it occupies, metres. Default 6.
+    /// circles pass at the caution speed at most, beyond its footprint (half its box, grown by
+    /// `hidden_m`) and `margin_m`, on a level it occupies, metres. Default 6 (for a person, 8 m
+    /// from the centre of their hits beyond a circle's radius).
     pub standing_object_reach_m: f64,
 }
 

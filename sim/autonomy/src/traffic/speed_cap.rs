@@ -1,6 +1,7 @@
 //! Caution: slow for what may move, stop for what does. A candidate mover's motion meeting the
-//! path, or the path passing near a known mover standing, caps the speed at the caution speed;
-//! a map obstacle closing on the vehicle (`closing`) caps it lower and moves the stop short.
+//! path, the path passing near a known mover standing or a person-sized object seen only
+//! standing, caps the speed at the caution speed; a map obstacle closing on the vehicle
+//! (`closing`) caps it lower and moves the stop short.
 
 use super::conflict::{first_within, reach_of};
 use super::rules::{MoverInputs, TrafficRules};
@@ -10,7 +11,8 @@ impl TrafficRules {
     /// The wanted speed of `i` capped at the caution speed while the motion so far of a
     /// candidate mover (one not yet predictable, [`mapper::Tracker::candidate_movers`]) would
     /// meet its path, or the path passes near a known mover standing
-    /// ([`super::passes_standing`]), and for `conflict_memory_s` after: by the time a candidate
+    /// ([`super::passes_standing`]) or a person-sized object seen only standing
+    /// (`passes_standing_object`), and for `conflict_memory_s` after: by the time a candidate
     /// is confirmed, or the one standing has walked on, the vehicle can stop short of it; if it
     /// was a static object's parts coming into view, it only slowed. Where the candidate's
     /// motion meets the path is kept as the caution line (`short_of_caution_line`).

@@ -156,14 +156,24 @@ fn a_mover_standing_is_kept_at_its_reach() {
     // Within a pose step (0.5 m) of the stop: left where it is.
     assert_eq!(clear(39.6), None);
     assert_eq!(clear(40.0), None);
-    // A static object's parts that slid 3 m as it came into view (not beyond twice its extent
-    // and 3 m): too late, the stop stays (a ground power unit under the wing).
-    let slid = [TrackState {
-        travel_m: 3.0,
-        ..person[0].clone()
-    }];
+    // A static object's parts that slid as it came into view, not beyond twice its extent
+    // and 3 m (7 m): too late, the stop stays (a ground power unit under the wing).
+    let travelled = |travel_m: f64| {
+        let t = [TrackState {
+            travel_m,
+            ..person[0].clone()
+        }];
+        stand_clear(&path, &model(), &[], &t, 40.0, 3.0, 31.0, &cfg)
+    };
+    assert_eq!(travelled(7.0), None);
+    assert_eq!(travelled(7.1), Some(31.0));
+    // Standing at 31 m would put it in a crossing truck's sweep (at x = 30 m, across the
+    // path): the stop stays rather.
+    let truck = predict(&[mover(30.0, -20.0, 0.0, 3.0, 0b11)], 0.0, &cfg);
+    let at_40 = stand_clear(&path, &model(), &truck, &[], 40.0, 3.0, 5.0, &cfg);
+    assert_eq!(at_40, None, "standing at 37 m is clear of its sweep");
     assert_eq!(
-        stand_clear(&path, &model(), &[], &slid, 40.0, 3.0, 31.0, &cfg),
+        stand_clear(&path, &model(), &truck, &person, 40.0, 3.0, 31.0, &cfg),
         None
     );
     // (A mover predicted through the stop, too late: the stop stays,
