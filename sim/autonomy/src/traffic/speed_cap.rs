@@ -63,10 +63,10 @@ impl TrafficRules {
     }
 
     /// Whether the path of `i` passes within `standing_object_reach_m` of a small object seen
-    /// only standing (`standing_object_max_m`) and hit above the lowest level (a person, not
-    /// a cone): one who stood beside the path and walks on is predicted only after a second or
-    /// so of walking, by when a vehicle at 8 m/s could no longer stop short of them (variant 66
-    /// of `traffic_jet_speed_profiles.toml`).
+    /// only standing (`standing_object_max_m`) and hit above the lowest level (a person; a cone
+    /// too where that level starts low): one who stood beside the path and walks on is
+    /// predicted only after a second or so of walking, by when a vehicle at 8 m/s could no
+    /// longer stop short of them (variant 66 of `traffic_jet_speed_profiles.toml`).
     fn passes_standing_object(&self, i: &MoverInputs<'_>) -> bool {
         let cfg = i.traffic;
         cfg.standing_object_max_m > 0.0
