@@ -16,9 +16,8 @@ impl TrafficRules {
     /// six, beyond its own extent: not a static object's sliding parts), a person standing
     /// (`is_walker`), or one that drove up longer ago (`drove_up`: a van that stood at the nose
     /// longer than six seconds, variant 6 of `traffic_jet_speed_profiles.toml`) - standing now
-    /// (not [`surely_moving`]) within its
-    /// reach of the vehicle at `pose` ([`first_within_standing_reach`]), as what stops the
-    /// vehicle; `None` with traffic off.
+    /// (not [`surely_moving`]) within its reach of the vehicle at `pose`
+    /// ([`first_within_standing_reach`]), as what stops the vehicle; `None` with traffic off.
     pub(super) fn standing_at(
         &self,
         movers: &[TrackState],
