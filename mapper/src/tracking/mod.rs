@@ -49,6 +49,10 @@ use track::Track;
 /// seconds.
 pub const PEAK_SPEED_S: f64 = 3.0;
 
+/// ... of the velocities within this of its heading now, radians (45 degrees): not a speed it
+/// had going another way.
+pub const PEAK_HEADING_RAD: f64 = std::f64::consts::FRAC_PI_4;
+
 /// Who painted a cell last, and when a revolution last hit it.
 #[derive(Clone, Copy, Debug)]
 struct CellRecord {

@@ -52,9 +52,11 @@ pub struct TrackState {
     /// That box's size along x and y, metres.
     pub size_m: [f64; 2],
     /// The fastest its velocity was over about the last [`PEAK_SPEED_S`](super::PEAK_SPEED_S)
-    /// seconds it was seen moving steadily (at least its speed now), m/s: a mover going into the
-    /// shadow of a wing seems to slow as its visible part shrinks, and is lost at that lower
-    /// speed.
+    /// seconds it was seen moving steadily, going the way it goes now (within
+    /// [`PEAK_HEADING_RAD`](super::PEAK_HEADING_RAD); at least its speed now), m/s: a mover going into the shadow of a
+    /// wing seems to slow as its visible part shrinks, and is lost at that lower speed. Not a
+    /// speed it had going another way: a train's cars bunching up as it stops seem to push
+    /// its centre back, and it would be read as about to come back at its cruising speed.
     pub peak_speed_m_s: f64,
     /// When the tracker first saw it under this id, seconds.
     pub born_s: f64,
@@ -163,11 +165,21 @@ impl Tracker {
             travel_m: (t.last - t.origin).norm(),
             born_s: t.born_s,
             origin: t.origin,
-            peak_speed_m_s: t
-                .recent_speeds
-                .iter()
-                .map(|&(_, v)| v)
-                .fold(t.motion.velocity().norm(), f64::max),
+            peak_speed_m_s: peak_speed_m_s(t.motion.velocity(), &t.recent_velocities),
         }
     }
+}
+
+/// The fastest of `recent` velocities within [`PEAK_HEADING_RAD`](super::PEAK_HEADING_RAD) of `now`, and at least
+/// `now`'s speed, m/s.
+fn peak_speed_m_s(
+    now: Vector2<f64>,
+    recent: &std::collections::VecDeque<(f64, Vector2<f64>)>,
+) -> f64 {
+    (recent.iter())
+        .filter(|(_, v)| {
+            now.norm() > 0.0 && v.norm() > 0.0 && v.angle(&now) <= super::PEAK_HEADING_RAD
+        })
+        .map(|(_, v)| v.norm())
+        .fold(now.norm(), f64::max)
 }

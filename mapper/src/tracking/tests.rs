@@ -295,6 +295,27 @@ fn a_movers_peak_speed_is_kept_for_a_few_seconds() {
     assert!(peaks.iter().all(|p| p.1 >= p.2 - 1e-12));
 }
 
+/// A mover's peak speed is one it had going the way it goes now: a van seen at 4 m/s whose
+/// centre then comes back at 1 m/s (a train's cars bunching up as it stops) is read at about
+/// 1 m/s, not 4.
+#[test]
+fn a_movers_peak_speed_is_one_it_had_going_its_way() {
+    let mut t = Tracker::new(TrackerConfig::default(), 0.2);
+    let mut y: f64 = 0.0;
+    let mut last = None;
+    for k in 0..70 {
+        y += if k < 40 { 0.4 } else { -0.1 };
+        t.update(k as f64 * 0.1, &block(0, (y / 0.2).round() as i64, 9, 22));
+        last = t.movers().first().map(|m| (m.peak_speed_m_s, m.velocity));
+    }
+    let (peak, velocity) = last.expect("still a mover");
+    assert!(velocity.y < -0.5, "{velocity:?}");
+    assert!(
+        peak < 1.5 && peak >= velocity.norm(),
+        "{peak} at {velocity:?}"
+    );
+}
+
 /// A parked car revealed from one end (its visible part grows over 3 s, as a vehicle
 /// driving by sees more of it), and one seen from every side, are never offered as movers.
 #[test]

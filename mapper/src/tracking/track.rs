@@ -24,9 +24,9 @@ pub(super) struct Track {
     pub(super) last_t_s: f64,
     /// Sum of the centre's steps, metres.
     pub(super) path_m: f64,
-    /// Its speed on each revolution of the last [`PEAK_SPEED_S`] it was seen moving steadily, as
-    /// (time, m/s), oldest first.
-    pub(super) recent_speeds: std::collections::VecDeque<(f64, f64)>,
+    /// Its velocity on each revolution of the last [`PEAK_SPEED_S`] it was seen moving
+    /// steadily, as (time, m/s), oldest first.
+    pub(super) recent_velocities: std::collections::VecDeque<(f64, Vector2<f64>)>,
     /// Largest extent (bounding-box diagonal) it was seen with, metres.
     pub(super) max_extent_m: f64,
     /// Its cells this revolution: bounding box (world cells), when seen.
@@ -67,7 +67,7 @@ impl Tracker {
             last: cluster.center,
             last_t_s: t_s,
             path_m: 0.0,
-            recent_speeds: std::collections::VecDeque::new(),
+            recent_velocities: std::collections::VecDeque::new(),
             max_extent_m: 0.0,
             bbox: None,
             last_bbox: cluster.bbox,
@@ -137,7 +137,7 @@ impl Tracker {
             }
             track.first = cluster.center;
             track.path_m = 0.0;
-            track.recent_speeds.clear();
+            track.recent_velocities.clear();
             track.motion = Motion::new(
                 cluster.center,
                 if another { Vector2::zeros() } else { velocity },
@@ -152,14 +152,14 @@ impl Tracker {
         }
         if track.smooth {
             track.steady += 1;
-            let speed = track.motion.velocity().norm();
-            track.recent_speeds.push_back((t_s, speed));
+            let velocity = track.motion.velocity();
+            track.recent_velocities.push_back((t_s, velocity));
             while track
-                .recent_speeds
+                .recent_velocities
                 .front()
                 .is_some_and(|&(t, _)| t_s - t > PEAK_SPEED_S)
             {
-                track.recent_speeds.pop_front();
+                track.recent_velocities.pop_front();
             }
         }
         track.seen += 1;

@@ -3,7 +3,7 @@
 //! view towards it, and those lost from view while standing.
 
 use mapper::TrackState;
-use nalgebra::Isometry2;
+use nalgebra::{Isometry2, Point2};
 
 use super::rules::{AtBody, BodyHold, LostMover, MoverPath, MoverStreak, TrafficRules};
 use super::{
@@ -51,13 +51,24 @@ const ELSEWHERE_WITHIN_S: f64 = 10.0;
 /// walk).
 const ELSEWHERE_M_S: f64 = 1.5;
 
+/// A mover lost at the body has left where it was last seen once another mover's centre,
+/// seen after it, came within this of it, metres, and is seen away from there now: two objects
+/// do not stand in one place (the carts of a train, each followed by the next along one path).
+const DRIVEN_THROUGH_M: f64 = 0.75;
+
+/// ... or once a mover as large or larger whose box held that place then goes on the way it
+/// was going: both at this speed or more, m/s ...
+const CARRIED_ON_M_S: f64 = 1.0;
+/// ... in directions at most this far apart, radians (30 degrees).
+const CARRIED_ON_RAD: f64 = 0.52;
+
 /// How long the rules keep where each mover was seen, seconds: longer than a track coasts out
 /// of view before the tracker drops it.
 const PATH_KEPT_S: f64 = 15.0;
 
 impl TrafficRules {
     /// Notes where each of `movers` was last seen, and forgets what is older than
-    /// [`PATH_KEPT_S`] or of tracks no longer held.
+    /// [`PATH_KEPT_S`] or of tracks not among them.
     fn note_paths(&mut self, movers: &[TrackState], now_s: f64) {
         self.paths.retain(|p| movers.iter().any(|t| t.id == p.id));
         for t in movers {
@@ -97,7 +108,13 @@ impl TrafficRules {
         self.note_streaks(now_s);
         self.note_lost_standing(movers, now_s, cfg);
         self.claimed.retain(|id| movers.iter().any(|t| t.id == *id));
-        self.note_paths(movers, now_s);
+        // The movers, and the candidates that were movers lately (their paths kept): what
+        // tells where a lost track went.
+        let others: Vec<TrackState> = (movers.iter())
+            .chain((self.candidates.iter()).filter(|c| self.paths.iter().any(|p| p.id == c.id)))
+            .cloned()
+            .collect();
+        self.note_paths(&others, now_s);
         // A mover arriving at the body, or one held there before and not seen away.
         let mut body: Vec<AtBody> = movers
             .iter()
@@ -116,19 +133,22 @@ impl TrafficRules {
         // One lost (its track gone) is waited for for good, as a hidden obstacle: the pilot is
         // called. Its cells reading free would prove nothing - within the map's self-hit margin
         // of the body nothing is ever mapped. Unless it is seen elsewhere under a new number
-        // (`seen_elsewhere`): it walked or drove on out of the blind zone.
+        // (`seen_elsewhere`): it walked or drove on out of the blind zone; or it left with
+        // others (`left_with_others`: not claimed - the other track is not the lost one).
         let lost: Vec<AtBody> = (self.at_body.iter())
             .filter(|r| !movers.iter().any(|t| t.id == r.id))
             .copied()
             .collect();
         for r in lost {
-            match self.seen_elsewhere(&r, movers, pose, now_s, cfg) {
-                Some(id) => {
-                    self.claimed.push(id);
-                    self.lost_standing.retain(|l| l.id != r.id);
-                    self.coasting.retain(|l| l.id != r.id);
-                }
-                None => body.push(r),
+            let seen = self.seen_elsewhere(&r, movers, pose, now_s, cfg);
+            if let Some(id) = seen {
+                self.claimed.push(id);
+            }
+            if seen.is_some() || self.left_with_others(&r, &others, now_s, cfg) {
+                self.lost_standing.retain(|l| l.id != r.id);
+                self.coasting.retain(|l| l.id != r.id);
+            } else {
+                body.push(r);
             }
         }
         // A mover that coasted out of view toward a standing vehicle and whose track was then
@@ -140,7 +160,7 @@ impl TrafficRules {
                 .iter()
                 .filter(|t| !movers.iter().any(|m| m.id == t.id))
                 .filter(|t| !body.iter().any(|r| r.id == t.id) && now_s - t.t_s >= COASTED_S)
-                .filter(|t| !part_of_another(t, movers, &self.paths, now_s))
+                .filter(|t| !part_of_another(t, &others, &self.paths, now_s))
                 .filter(|t| {
                     let window = (now_s, now_s + DROPPED_AT_BODY_S);
                     may_reach_body(&self.model, pose, t, window, cfg)
@@ -233,6 +253,50 @@ impl TrafficRules {
                 d(a).total_cmp(&d(b))
             })
             .map(|t| t.id)
+    }
+
+    /// Whether `lost` - a mover lost at the body itself, not one that coasted out of view nor
+    /// one lost standing elsewhere - has left where it was last seen, as another of `others`
+    /// (the movers, and the candidates that were movers lately) shows: one seen now, hit in a
+    /// level `lost` was, that moved beyond its own extent and, since `lost` was last seen,
+    /// - drove through that place: its centre came within [`DRIVEN_THROUGH_M`] of it and is
+    ///   farther now (two objects do not stand in one place: a train's cart lost under the nose
+    ///   as the next cart takes its place; a person hidden there would have been driven into);
+    /// - or carried it on: as large or larger, its box held that place then, and it goes on the
+    ///   way `lost` was going, both at [`CARRIED_ON_M_S`] or more (the carts of a train the
+    ///   tracker takes for one object, one of them lost as its hits join the train's track).
+    fn left_with_others(
+        &self,
+        lost: &AtBody,
+        others: &[TrackState],
+        now_s: f64,
+        cfg: &TrafficConfig,
+    ) -> bool {
+        if lost.why != LostMover::AtBody {
+            return false;
+        }
+        let near = |at: &Point2<f64>| (at - lost.at).norm() <= DRIVEN_THROUGH_M;
+        let going = lost.velocity.norm() >= CARRIED_ON_M_S;
+        others
+            .iter()
+            .filter(|o| o.id != lost.id && now_s - o.t_s <= 0.25 && o.levels & lost.levels != 0)
+            .filter(|o| moved_beyond_its_extent(o, cfg))
+            .any(|o| {
+                let path = self.paths.iter().find(|p| p.id == o.id);
+                let drove_through = !near(&o.position)
+                    && path.is_some_and(|p| {
+                        (p.seen.iter()).any(|(s, at)| *s > lost.seen_s && near(at))
+                    });
+                // Where it was then: on its kept path, else (a candidate then) as its motion says.
+                let then = (path.and_then(|p| p.at(lost.seen_s)))
+                    .unwrap_or_else(|| o.position + o.velocity * (lost.seen_s - o.t_s));
+                let carried_on = going
+                    && o.extent_m >= lost.extent_m
+                    && o.velocity.norm() >= CARRIED_ON_M_S
+                    && o.velocity.angle(&lost.velocity) <= CARRIED_ON_RAD
+                    && (then - lost.at).norm() <= o.extent_m;
+                drove_through || carried_on
+            })
     }
 
     /// Whether track `t` is a mover that may arrive at the body: one predicted on a streak
@@ -341,14 +405,16 @@ impl TrafficRules {
     }
 }
 
-/// Whether `t`, a track dropped, lay when last seen within the extent of another of `movers`,
-/// seen now, no smaller than it and hit in a level it was, where that one was then (where it
-/// was seen, else where its motion puts it): a part of it tracked apart, or the same object
+/// Whether `t`, a track dropped, lay when last seen within the extent of another of `movers`
+/// (the movers, and the candidates that were movers lately), seen now, no smaller than it and
+/// hit in a level it was, where that one was then (where it was seen, else where its motion
+/// puts it): a part of it tracked apart, or the same object
 /// tracked twice - a fuel truck's split-off part that seemed to move the other way, a van's
 /// front (variants 27 and 32 of `traffic_jet.toml`, waited for as lost until the pilot was
 /// called), a follow-me car's front heading for the jet before the car backed aside (variant
-/// 41: its constant velocity, backing, put it 10.7 m from its front). Two vans in convoy closer
-/// than their length would be taken for one.
+/// 41: its constant velocity, backing, put it 10.7 m from its front; variant 92: the car, slow
+/// as it backed, a candidate again). Two vans in convoy closer than their length would be taken
+/// for one.
 fn part_of_another(t: &TrackState, movers: &[TrackState], paths: &[MoverPath], now_s: f64) -> bool {
     movers.iter().any(|o| {
         let then = (paths.iter().find(|p| p.id == o.id))

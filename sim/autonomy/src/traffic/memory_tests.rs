@@ -2,9 +2,9 @@
 //! seen lately, and what that tells of a track dropped near it.
 
 use mapper::TrackState;
-use nalgebra::{Isometry2, Point2};
+use nalgebra::{Isometry2, Point2, Vector2};
 
-use super::rules_tests::{rules_with_mover, track};
+use super::rules_tests::{rules, rules_with_mover, track};
 use super::*;
 use crate::planner::AutonomyConfig;
 
@@ -69,4 +69,133 @@ fn a_movers_path_answers_between_its_sightings_only() {
     assert_eq!(p.at(1.25), Some(Point2::new(1.0, 0.5)));
     assert_eq!(p.at(2.0), Some(Point2::new(4.0, 2.0)));
     assert_eq!((p.at(0.9), p.at(2.1)), (None, None));
+}
+
+/// A cart of `extent_m` moving at (0, `vy`), held at the nose and lost there at 1 s (its track
+/// gone, at (4, 1.8)).
+fn cart_lost_at_the_nose(extent_m: f64, vy: f64) -> rules::AtBody {
+    rules::AtBody {
+        id: 13,
+        at: Point2::new(4.0, 1.8),
+        seen_s: 1.0,
+        extent_m,
+        levels: 0b01,
+        peak_m_s: vy.abs(),
+        velocity: Vector2::new(0.0, vy),
+        why: LostMover::AtBody,
+    }
+}
+
+/// Whether the rules, holding `lost` at the body, still hold the standing vehicle once they
+/// have seen `seen` (each plan's tracks, in time order; none of them arriving at the body).
+fn still_held(lost: rules::AtBody, seen: &[(f64, Vec<TrackState>)]) -> bool {
+    let config = AutonomyConfig::default();
+    let (cfg, hidden_after_s) = (&config.traffic, config.hidden_after_s);
+    let mut r = rules();
+    r.at_body.push(lost);
+    let mut held = None;
+    for (now_s, tracks) in seen {
+        let pose = Isometry2::identity();
+        held = r.movers_at_body(tracks, &pose, *now_s, true, cfg, hidden_after_s);
+    }
+    held.is_some()
+}
+
+/// A train's cart lost at the nose (`tug_2_car4`, variant 147 of the speed profiles): the
+/// next cart drives through where it was last seen - two objects do not stand in one place -,
+/// so it has gone. Not if that track passed a metre aside, was there only before the cart was
+/// last seen, is there still, or was hit in another level; nor for a mover lost coasting.
+#[test]
+fn a_cart_lost_at_the_nose_is_let_go_once_the_next_drives_through_where_it_was() {
+    let next = |y_then: f64, x: f64, y_now: f64, levels: u32| {
+        let at = |t_s: f64, y: f64| track(20, t_s, (x, y), (0.0, -3.0), levels);
+        vec![(2.0, vec![at(2.0, y_then)]), (3.0, vec![at(3.0, y_now)])]
+    };
+    let lost = cart_lost_at_the_nose(2.0, 0.0);
+    assert!(!still_held(lost, &next(2.2, 4.0, -1.0, 0b01)));
+    assert!(still_held(lost, &next(2.2, 5.0, -1.0, 0b01)));
+    assert!(still_held(lost, &next(2.2, 4.0, 1.6, 0b01)));
+    assert!(still_held(lost, &next(2.2, 4.0, -1.0, 0b10)));
+    let before = vec![
+        (0.5, vec![track(20, 0.5, (4.0, 1.8), (0.0, -3.0), 0b01)]),
+        (3.0, vec![track(20, 3.0, (4.0, -5.7), (0.0, -3.0), 0b01)]),
+    ];
+    assert!(still_held(lost, &before));
+    let coasting = rules::AtBody {
+        why: LostMover::Coasting,
+        ..lost
+    };
+    assert!(still_held(coasting, &next(2.2, 4.0, -1.0, 0b01)));
+}
+
+/// A cart lost at the nose as its hits join the track of the train it is part of (`tug_1`,
+/// variant 13 of the speed profiles): that track, as large or larger, held its place when it
+/// was last seen and goes on the way it went - it has gone on with it. Not if the train goes
+/// another way, is smaller than the cart, was beyond its extent of that place, or if the cart
+/// was standing.
+#[test]
+fn a_cart_lost_at_the_nose_is_let_go_once_its_train_carries_it_on() {
+    let train = |extent_m: f64, (x, y): (f64, f64), (vx, vy): (f64, f64)| {
+        let t = TrackState {
+            extent_m,
+            ..track(21, 3.0, (x, y), (vx, vy), 0b01)
+        };
+        vec![(3.0, vec![t])]
+    };
+    let lost = cart_lost_at_the_nose(2.0, -3.0);
+    // Then (by its motion) at (4, 2.0), 0.2 m from the cart.
+    assert!(!still_held(lost, &train(6.0, (4.0, -4.0), (0.0, -3.0))));
+    assert!(still_held(lost, &train(6.0, (4.0, -4.0), (3.0, 0.0))));
+    assert!(still_held(lost, &train(1.5, (4.0, -4.0), (0.0, -3.0))));
+    // Then at (4, -6.0), 7.8 m from the cart.
+    assert!(still_held(lost, &train(6.0, (4.0, -12.0), (0.0, -3.0))));
+    let standing = cart_lost_at_the_nose(2.0, 0.0);
+    assert!(still_held(standing, &train(6.0, (4.0, -4.0), (0.0, -3.0))));
+}
+
+/// The front of a follow-me car, lost coasting towards the standing jet, while the car backs
+/// aside so slowly that the tracker holds it only as a candidate again (variant 92 of
+/// `traffic_jet.toml`): the car was a mover lately, so its path is kept and tells that the
+/// front was part of it. A candidate that never was a mover tells nothing.
+#[test]
+fn a_part_of_a_car_seen_again_only_as_a_candidate_is_let_go_by_its_kept_path() {
+    let config = AutonomyConfig::default();
+    let (cfg, hidden_after_s) = (&config.traffic, config.hidden_after_s);
+    let pose = Isometry2::identity();
+    let front = track(21, 10.0, (4.0, -13.0), (0.0, 4.0), 0b01);
+    let car = |id: u32, t_s: f64, y: f64, vy: f64| TrackState {
+        extent_m: 3.0,
+        ..track(id, t_s, (4.0, y), (0.0, vy), 0b01)
+    };
+    let held = |id: u32| {
+        let mut r = rules_with_mover(&front, cfg);
+        let both = |c: TrackState| vec![front.clone(), c];
+        r.movers_at_body(
+            &both(car(22, 10.0, -14.0, -4.0)),
+            &pose,
+            10.0,
+            true,
+            cfg,
+            hidden_after_s,
+        );
+        r.movers_at_body(
+            &both(car(22, 10.5, -16.0, -4.0)),
+            &pose,
+            10.5,
+            true,
+            cfg,
+            hidden_after_s,
+        );
+        // The front dropped; the car backs at 0.3 m/s, 9 m from the front as last seen.
+        r.candidates = vec![car(id, 12.5, -22.0, -0.3)];
+        r.movers_at_body(&[], &pose, 12.5, true, cfg, hidden_after_s)
+    };
+    assert_eq!(held(22), None);
+    assert!(matches!(
+        held(23),
+        Some(BodyHold::Lost {
+            why: LostMover::Coasting,
+            ..
+        })
+    ));
 }

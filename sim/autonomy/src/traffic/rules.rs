@@ -14,7 +14,7 @@
 //!    known mover standing within its reach of a standing vehicle: the vehicle does not move.
 
 use mapper::{CollisionModel, TrackState};
-use nalgebra::{Isometry2, Point2};
+use nalgebra::{Isometry2, Point2, Vector2};
 use serde::Serialize;
 
 use super::closing::Closing;
@@ -130,6 +130,8 @@ pub(super) struct AtBody {
     pub(super) levels: u32,
     /// The fastest it was seen moving lately, m/s.
     pub(super) peak_m_s: f64,
+    /// Its velocity when last seen, m/s.
+    pub(super) velocity: Vector2<f64>,
     /// Why it is held once lost.
     pub(super) why: LostMover,
 }
@@ -144,6 +146,7 @@ impl AtBody {
             extent_m: t.extent_m,
             levels: t.levels,
             peak_m_s: t.peak_speed_m_s,
+            velocity: t.velocity,
             why,
         }
     }
@@ -226,8 +229,12 @@ pub struct TrafficRules {
     /// The person standing the last plan stopped short of (see `short_of_walkers`): where, and
     /// when last seen, seconds.
     pub(super) walker_stop: Option<(Point2<f64>, f64)>,
-    /// Where each mover was seen lately (see `part_of_another`).
+    /// Where each mover was seen lately (see `part_of_another`), and a mover since demoted to a
+    /// candidate (a car that stood, then backs slowly).
     pub(super) paths: Vec<MoverPath>,
+    /// The candidate movers of the last plan: one that was a mover lately (it has a kept
+    /// path) tells of a track lost that was part of it, as a mover does.
+    pub(super) candidates: Vec<TrackState>,
     /// The plans' first collisions with the map, to find one closing on the vehicle.
     pub(super) closing: Closing,
 }
@@ -253,6 +260,7 @@ impl TrafficRules {
             claimed: Vec::new(),
             walker_stop: None,
             paths: Vec::new(),
+            candidates: Vec::new(),
             closing: Closing::default(),
         }
     }
@@ -270,6 +278,7 @@ impl TrafficRules {
         self.walked.clear();
         self.claimed.clear();
         self.paths.clear();
+        self.candidates.clear();
         self.closing.clear();
         self.hold = None;
     }
@@ -304,6 +313,7 @@ impl TrafficRules {
             stop_at_m = Some(self.stand_clear(i, at));
         }
         stop_at_m = self.short_of_walkers(i, stop_at_m);
+        self.candidates = i.candidates.to_vec();
         let body = self.movers_at_body(i.movers, &i.pose, now_s, v0 < 0.05, cfg, i.hidden_after_s);
         // Standing beside a known mover standing within its reach: it may walk or drive on
         // into the airframe (or it touches it already): the vehicle does not move off.

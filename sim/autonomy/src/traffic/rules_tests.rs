@@ -113,6 +113,7 @@ fn lost_at_the_fuselage(extent_m: f64) -> AtBody {
         extent_m,
         levels: 0b01,
         peak_m_s: 1.2,
+        velocity: Vector2::zeros(),
         why: LostMover::AtBody,
     }
 }
