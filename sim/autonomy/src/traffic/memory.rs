@@ -3,7 +3,7 @@
 //! view towards it, and those lost from view while standing.
 
 use mapper::TrackState;
-use nalgebra::{Isometry2, Point2};
+use nalgebra::{Isometry2, Point2, Vector2};
 
 use super::rules::{AtBody, BodyHold, LostMover, MoverPath, MoverStreak, TrafficRules};
 use super::{
@@ -51,16 +51,19 @@ const ELSEWHERE_WITHIN_S: f64 = 10.0;
 /// walk).
 const ELSEWHERE_M_S: f64 = 1.5;
 
-/// A mover lost at the body has left where it was last seen once another mover's centre,
-/// seen after it, came within this of it, metres, and is seen away from there now: two objects
-/// do not stand in one place (the carts of a train, each followed by the next along one path).
+/// A mover lost at the body going at this speed or more, m/s (a slow walk; a train of carts at
+/// 1.2 m/s whose centre seemed to slow to 0.6 m/s as the airframe hid it), has left with
+/// another going its way at as much ([`TrafficRules::left_with_others`]) ...
+const LEFT_WITH_M_S: f64 = 0.5;
+/// ... within this of its direction, radians (30 degrees) ...
+const LEFT_WITH_RAD: f64 = 0.52;
+/// ... that drove through where it was last seen (its centre within this of it, metres) and on
+/// beyond it by as much: two objects do not stand in one place (a train's carts, each followed
+/// by the next along one path) ...
 const DRIVEN_THROUGH_M: f64 = 0.75;
-
-/// ... or once a mover as large or larger whose box held that place then goes on the way it
-/// was going: both at this speed or more, m/s ...
-const CARRIED_ON_M_S: f64 = 1.0;
-/// ... in directions at most this far apart, radians (30 degrees).
-const CARRIED_ON_RAD: f64 = 0.52;
+/// ... or that carried it on, where it was then read from its motion for at most this long,
+/// seconds, when its kept path does not reach back (a candidate then).
+const CARRIED_BACK_S: f64 = 3.0;
 
 /// How long the rules keep where each mover was seen, seconds: longer than a track coasts out
 /// of view before the tracker drops it.
@@ -128,7 +131,10 @@ impl TrafficRules {
                 }
                 self.arriving(t, now_s, cfg) && at()
             })
-            .map(|t| AtBody::of(t, LostMover::AtBody))
+            .map(|t| AtBody {
+                velocity: self.path_velocity(t),
+                ..AtBody::of(t, LostMover::AtBody)
+            })
             .collect();
         // One lost (its track gone) is waited for for good, as a hidden obstacle: the pilot is
         // called. Its cells reading free would prove nothing - within the map's self-hit margin
@@ -255,16 +261,19 @@ impl TrafficRules {
             .map(|t| t.id)
     }
 
-    /// Whether `lost` - a mover lost at the body itself, not one that coasted out of view nor
-    /// one lost standing elsewhere - has left where it was last seen, as another of `others`
-    /// (the movers, and the candidates that were movers lately) shows: one seen now, hit in a
-    /// level `lost` was, that moved beyond its own extent and, since `lost` was last seen,
-    /// - drove through that place: its centre came within [`DRIVEN_THROUGH_M`] of it and is
-    ///   farther now (two objects do not stand in one place: a train's cart lost under the nose
-    ///   as the next cart takes its place; a person hidden there would have been driven into);
-    /// - or carried it on: as large or larger, its box held that place then, and it goes on the
-    ///   way `lost` was going, both at [`CARRIED_ON_M_S`] or more (the carts of a train the
-    ///   tracker takes for one object, one of them lost as its hits join the train's track).
+    /// Whether `lost` - a mover lost at the body itself, going at [`LEFT_WITH_M_S`] or more when
+    /// last seen (not one standing, nor one that coasted out of view, nor one lost standing
+    /// elsewhere) - has left where it was last seen, as another of `others` (the movers, and the
+    /// candidates that were movers lately) shows: one seen now, hit in a level `lost` was, moved
+    /// beyond its own extent, going the way `lost` went (within [`LEFT_WITH_RAD`]) at
+    /// [`LEFT_WITH_M_S`] or more, that since `lost` was last seen
+    /// - drove through that place and on: its centre came within [`DRIVEN_THROUGH_M`] of it and
+    ///   is now beyond it by more than that, the way `lost` went (a train's next cart, where the
+    ///   lost one would have been driven into had it stopped there);
+    /// - or carried it on: as large or larger, tracked since before `lost` was last seen, its
+    ///   centre then within half its extent of that place (on its kept path, or within
+    ///   [`CARRIED_BACK_S`] as its motion says: a candidate then) - the carts of a train the
+    ///   tracker takes for one object, one of them lost as its hits join the train's track.
     fn left_with_others(
         &self,
         lost: &AtBody,
@@ -272,31 +281,40 @@ impl TrafficRules {
         now_s: f64,
         cfg: &TrafficConfig,
     ) -> bool {
-        if lost.why != LostMover::AtBody {
+        if lost.why != LostMover::AtBody || lost.velocity.norm() < LEFT_WITH_M_S {
             return false;
         }
+        let way = lost.velocity.normalize();
         let near = |at: &Point2<f64>| (at - lost.at).norm() <= DRIVEN_THROUGH_M;
-        let going = lost.velocity.norm() >= CARRIED_ON_M_S;
         others
             .iter()
             .filter(|o| o.id != lost.id && now_s - o.t_s <= 0.25 && o.levels & lost.levels != 0)
-            .filter(|o| moved_beyond_its_extent(o, cfg))
+            .filter(|o| moved_beyond_its_extent(o, cfg) && o.velocity.norm() >= LEFT_WITH_M_S)
+            .filter(|o| o.velocity.angle(&lost.velocity) <= LEFT_WITH_RAD)
             .any(|o| {
                 let path = self.paths.iter().find(|p| p.id == o.id);
-                let drove_through = !near(&o.position)
+                let drove_through = (o.position - lost.at).dot(&way) > DRIVEN_THROUGH_M
                     && path.is_some_and(|p| {
                         (p.seen.iter()).any(|(s, at)| *s > lost.seen_s && near(at))
                     });
-                // Where it was then: on its kept path, else (a candidate then) as its motion says.
-                let then = (path.and_then(|p| p.at(lost.seen_s)))
-                    .unwrap_or_else(|| o.position + o.velocity * (lost.seen_s - o.t_s));
-                let carried_on = going
-                    && o.extent_m >= lost.extent_m
-                    && o.velocity.norm() >= CARRIED_ON_M_S
-                    && o.velocity.angle(&lost.velocity) <= CARRIED_ON_RAD
-                    && (then - lost.at).norm() <= o.extent_m;
+                let then = (path.and_then(|p| p.at(lost.seen_s))).or_else(|| {
+                    ((o.t_s - lost.seen_s).abs() <= CARRIED_BACK_S)
+                        .then(|| o.position + o.velocity * (lost.seen_s - o.t_s))
+                });
+                let carried_on = o.extent_m >= lost.extent_m
+                    && o.born_s <= lost.seen_s
+                    && then.is_some_and(|p| (p - lost.at).norm() <= 0.5 * o.extent_m);
                 drove_through || carried_on
             })
+    }
+
+    /// The velocity of mover `t` over its kept path's last second, m/s (its filter's velocity
+    /// when the path is shorter): a track's velocity as it is lost can be far off (a train's
+    /// cart whose hits join the next one's seemed to go sideways at 1 m/s).
+    fn path_velocity(&self, t: &TrackState) -> Vector2<f64> {
+        (self.paths.iter().find(|p| p.id == t.id))
+            .and_then(|p| p.at(t.t_s - 1.0))
+            .map_or(t.velocity, |then| t.position - then)
     }
 
     /// Whether track `t` is a mover that may arrive at the body: one predicted on a streak

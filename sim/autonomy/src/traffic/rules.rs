@@ -130,7 +130,7 @@ pub(super) struct AtBody {
     pub(super) levels: u32,
     /// The fastest it was seen moving lately, m/s.
     pub(super) peak_m_s: f64,
-    /// Its velocity when last seen, m/s.
+    /// Its velocity when last seen, m/s (held at the body: over its kept path's last second).
     pub(super) velocity: Vector2<f64>,
     /// Why it is held once lost.
     pub(super) why: LostMover,
