@@ -134,7 +134,13 @@ impl Rig<'_> {
         self.holds.note(self.t_s, self.driver.status());
         let call = self.driver.calls_for_pilot(self.t_s)?;
         let unseen = self.driver.start_unseen_cells().map(|(cells, _)| cells);
-        self.pilot_call = Some(self.holds.report(self.t_s, call, &self.world, unseen));
+        let first = self.scenario.objects.len();
+        let movers: Vec<usize> = (self.scenario.obstacles.iter().enumerate())
+            .filter(|(_, o)| o.motion.is_some())
+            .map(|(k, _)| first + k)
+            .collect();
+        let report = (self.holds).report(self.t_s, call, &self.world, unseen, &movers);
+        self.pilot_call = Some(report);
         Some(match call {
             PilotCall::HiddenObstacle => EndReason::WaitingForHiddenObstacle,
             PilotCall::Blocked => EndReason::Blocked,

@@ -41,7 +41,7 @@ pub use observer::{
 pub use outcome::{
     AT_FAULT_SPEED_M_S, EndReason, Event, JudgedContact, ObstacleReport, Pass, PassOutcome, Stop,
 };
-pub use pilot_call::{Hold, NEEDLESS_WINDOW_S, PilotCallReport, REAL_WITHIN_M};
+pub use pilot_call::{AT_BODY_WITHIN_M, Hold, NEEDLESS_WINDOW_S, PilotCallReport, REAL_WITHIN_M};
 pub use pose_error::{
     ErrorLog, ErrorStats, LocalizationErrors, LocalizationReport, localization_misses,
 };

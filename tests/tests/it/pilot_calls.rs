@@ -2,7 +2,7 @@
 //! the vehicle as the stack believed it and where, and - from ground truth - whether an object
 //! stood there. A phantom that holds the car is a needless call; the cone a low LiDAR stops the
 //! jet for, the cone under the nose of a jet without a walk-around, and a person who walked on
-//! into the standing jet out of view, are not.
+//! into the standing jet out of view, or a train that stopped at its nose out of view, are not.
 
 use std::path::PathBuf;
 
@@ -16,6 +16,23 @@ fn file(path: &str) -> Scenario {
 
 fn run(s: &Scenario) -> sim::engine::RunReport {
     crate::common::run_with(s, RunConfig::for_scenario(s, None).unwrap())
+}
+
+/// The pilot call of the run of `path`, one for a mover the stack lost at its body.
+fn waits_for_a_mover_at_its_body(path: &str) -> sim::engine::PilotCallReport {
+    let call = run(&file(path)).pilot_call.expect("a pilot call");
+    assert_eq!(call.call, "hidden_obstacle");
+    assert!(
+        matches!(
+            call.hold,
+            Some(Hold::LostObstacle {
+                mover: Some(autonomy::traffic::LostMover::AtBody),
+                ..
+            })
+        ),
+        "{call:?}"
+    );
+    call
 }
 
 /// The degraded LiDAR's phantom at the start, as it was before beams with no echo cleared it.
@@ -73,20 +90,24 @@ fn a_cone_seen_in_the_path_or_in_the_unseen_ground_makes_a_call_that_was_needed(
 /// airframe, though over a metre from where the stack last saw them.
 #[test]
 fn a_person_who_walked_into_the_standing_jet_out_of_view_makes_a_call_that_was_needed() {
-    let s = file("found/person_walks_into_the_standing_jet.toml");
-    let call = run(&s).pilot_call.expect("a pilot call");
-    assert_eq!(call.call, "hidden_obstacle");
-    assert!(
-        matches!(
-            call.hold,
-            Some(Hold::LostObstacle {
-                mover: Some(autonomy::traffic::LostMover::AtBody),
-                ..
-            })
-        ),
-        "{call:?}"
-    );
+    let call = waits_for_a_mover_at_its_body("found/person_walks_into_the_standing_jet.toml");
     let (id, d) = call.nearest_object.clone().unwrap();
     assert_eq!(id, "person_1");
     assert!(d < 0.1 && !call.needless, "{call:?}");
+}
+
+/// A tug train gives way to the standing jet and stops 1.7 m from its nose, in the blind zone
+/// (`found/tug_train_stops_at_the_nose_out_of_view.toml`): the stack waits for the train lost
+/// at its body, last seen 3.4 m from where its nearest cart stands. More than a metre from
+/// that point, yet within `AT_BODY_WITHIN_M` of the airframe: the call was needed.
+#[test]
+fn a_train_standing_at_the_nose_out_of_view_makes_a_call_that_was_needed() {
+    let call = waits_for_a_mover_at_its_body("found/tug_train_stops_at_the_nose_out_of_view.toml");
+    let (id, d) = call.nearest_object.clone().unwrap();
+    assert!(id.starts_with("tug_2"), "{call:?}");
+    assert!(
+        d > sim::engine::REAL_WITHIN_M && d <= sim::engine::AT_BODY_WITHIN_M,
+        "{call:?}"
+    );
+    assert!(!call.needless, "{call:?}");
 }

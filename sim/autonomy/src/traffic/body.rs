@@ -53,20 +53,41 @@ fn box_at_body(
     shift: &Vector2<f64>,
     cfg: &TrafficConfig,
 ) -> bool {
+    let (lo, hi) = hit_box(t);
+    // What of it may lie beyond the box: `hidden_m`, or what it is seen smaller than its
+    // largest extent (a truck whose front a wing hides).
+    let hidden_m = cfg.hidden_m.max(t.extent_m - (hi - lo).norm());
+    box_gap_m(model, pose, t, shift) <= hidden_m + cfg.at_body_m
+}
+
+/// How far the box of the hits of `t` when last seen, moved by `shift`, lies from the body of
+/// the vehicle `model` at `pose`: from the nearest circle of a level it occupies, metres
+/// (negative within one; infinite when it occupies none of the model's levels).
+pub(super) fn box_gap_m(
+    model: &CollisionModel,
+    pose: &Isometry2<f64>,
+    t: &TrackState,
+    shift: &Vector2<f64>,
+) -> f64 {
+    let (lo, hi) = hit_box(t);
+    let (lo, hi) = (lo + shift, hi + shift);
+    (model.circles().iter())
+        .filter(|c| t.levels & (1u32 << c.level.min(31)) != 0)
+        .map(|c| {
+            let p = pose * Point2::new(c.x_m, c.y_m);
+            let out = (lo - p.coords).sup(&(p.coords - hi)).sup(&Vector2::zeros());
+            out.norm() - c.radius_m
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The corners of the box of the hits of `t` when last seen, metres.
+fn hit_box(t: &TrackState) -> (Vector2<f64>, Vector2<f64>) {
     let ((x0, y0), (x1, y1)) = t.bbox;
     let r = t.size_m[0] / (x1 - x0 + 1).max(1) as f64;
     let lo = Vector2::new(x0 as f64 * r, y0 as f64 * r);
     let hi = Vector2::new((x1 + 1) as f64 * r, (y1 + 1) as f64 * r);
-    // What of it may lie beyond the box: `hidden_m`, or what it is seen smaller than its
-    // largest extent (a truck whose front a wing hides).
-    let hidden_m = cfg.hidden_m.max(t.extent_m - (hi - lo).norm());
-    let (lo, hi) = (lo + shift, hi + shift);
-    model.circles().iter().any(|c| {
-        let p = pose * Point2::new(c.x_m, c.y_m);
-        let out = (lo - p.coords).sup(&(p.coords - hi)).sup(&Vector2::zeros());
-        t.levels & (1u32 << c.level.min(31)) != 0
-            && out.norm() <= c.radius_m + hidden_m + cfg.at_body_m
-    })
+    (lo, hi)
 }
 
 /// Whether mover `t`, gone out of view, may be at the body of the vehicle standing at `pose`

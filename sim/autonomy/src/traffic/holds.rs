@@ -30,18 +30,26 @@ impl TrafficRules {
         }
         movers
             .iter()
-            .filter(|t| {
-                !surely_moving(t, cfg)
-                    && (self.arriving(t, now_s, cfg) || self.is_walker(t, cfg) || self.drove_up(t))
-            })
-            .find(|t| {
-                first_within_standing_reach(&self.model, std::slice::from_ref(pose), t, cfg)
-                    .is_some()
-            })
+            .find(|t| self.standing_within_reach(t, pose, now_s, cfg))
             .map(|t| BodyHold::Seen {
                 at: t.position,
                 last_seen_s: t.t_s,
             })
+    }
+
+    /// Whether `t` is a known mover standing within its reach of the vehicle at `pose`, as
+    /// [`Self::standing_at`] holds it for.
+    pub(super) fn standing_within_reach(
+        &self,
+        t: &TrackState,
+        pose: &Isometry2<f64>,
+        now_s: f64,
+        cfg: &TrafficConfig,
+    ) -> bool {
+        !surely_moving(t, cfg)
+            && (self.arriving(t, now_s, cfg) || self.is_walker(t, cfg) || self.drove_up(t))
+            && first_within_standing_reach(&self.model, std::slice::from_ref(pose), t, cfg)
+                .is_some()
     }
 
     /// Whether `t` is a known mover that came where it stands: seen moving as a mover for

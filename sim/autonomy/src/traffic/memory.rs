@@ -5,6 +5,7 @@
 use mapper::TrackState;
 use nalgebra::{Isometry2, Point2, Vector2};
 
+use super::body::box_gap_m;
 use super::rules::{AtBody, BodyHold, LostMover, MoverPath, MoverStreak, TrafficRules};
 use super::{
     TrafficConfig, at_body, came_there, may_have_walked_to, may_reach_body,
@@ -65,6 +66,12 @@ const DRIVEN_THROUGH_M: f64 = 0.75;
 /// seconds, when its kept path does not reach back (a candidate then).
 const CARRIED_BACK_S: f64 = 3.0;
 
+/// A held mover whose box steps away from the body by this much more than its speed explains,
+/// metres, is seen away only in part ([`TrafficRules::still_at_body`]): a box's near edge
+/// wanders a cell or two as hits come and go; a train's went 2.2 m in a revolution as its tug
+/// went out of view (variant 238 of `traffic_jet_speed_profiles.toml`).
+const STEPPED_AWAY_M: f64 = 1.0;
+
 /// How long the rules keep where each mover was seen, seconds: longer than a track coasts out
 /// of view before the tracker drops it.
 const PATH_KEPT_S: f64 = 15.0;
@@ -118,22 +125,16 @@ impl TrafficRules {
             .cloned()
             .collect();
         self.note_paths(&others, now_s);
-        // A mover arriving at the body, or one held there before and not seen away.
-        let mut body: Vec<AtBody> = movers
-            .iter()
-            .filter(|t| {
-                let at = || at_body(&self.model, pose, t, now_s, cfg);
-                if self.at_body.iter().any(|r| r.id == t.id) {
-                    // Held: released only once seen away (a prediction carrying it on through
-                    // the airframe is no evidence that it left).
-                    let seen_now = now_s - t.t_s <= 0.25;
-                    return !seen_now || at();
-                }
-                self.arriving(t, now_s, cfg) && at()
-            })
-            .map(|t| AtBody {
-                velocity: self.path_velocity(t),
-                ..AtBody::of(t, LostMover::AtBody)
+        // A mover arriving at the body (or, the vehicle standing, one standing within its
+        // reach: a train seen in flashes as it crawls to the nose makes no streak), or one held
+        // there before and not seen away.
+        let mut body: Vec<AtBody> = (movers.iter())
+            .filter_map(|t| match self.at_body.iter().find(|r| r.id == t.id) {
+                Some(r) => self.still_at_body(r, t, pose, now_s, cfg),
+                None => ((self.arriving(t, now_s, cfg)
+                    || (stopped && self.standing_within_reach(t, pose, now_s, cfg)))
+                    && at_body(&self.model, pose, t, now_s, cfg))
+                .then(|| self.at_body_now(t, pose)),
             })
             .collect();
         // One lost (its track gone) is waited for for good, as a hidden obstacle: the pilot is
@@ -306,6 +307,51 @@ impl TrafficRules {
                     && then.is_some_and(|p| (p - lost.at).norm() <= 0.5 * o.extent_m);
                 drove_through || carried_on
             })
+    }
+
+    /// Mover `t` at the body of the vehicle at `pose`, as held there: its velocity over its
+    /// kept path's last second, its box's distance from the body.
+    fn at_body_now(&self, t: &TrackState, pose: &Isometry2<f64>) -> AtBody {
+        AtBody {
+            velocity: self.path_velocity(t),
+            gap_m: box_gap_m(&self.model, pose, t, &Vector2::zeros()),
+            ..AtBody::of(t, LostMover::AtBody)
+        }
+    }
+
+    /// What holds mover `t`, held at the body as `held`, now (`None`: it is let go): released
+    /// once seen away from the body ([`at_body`]; a prediction carrying it on through the
+    /// airframe is no evidence that it left) - unless its box stepped away further than
+    /// [`STEPPED_AWAY_M`] plus what its speed explains since: its near part went out of view
+    /// (a tug gone into the blind zone under the nose, its carts still seen, their track's centre
+    /// 5 m back in a revolution). Held then as it was until its track has moved beyond its extent
+    /// from there, away from the body.
+    fn still_at_body(
+        &self,
+        held: &AtBody,
+        t: &TrackState,
+        pose: &Isometry2<f64>,
+        now_s: f64,
+        cfg: &TrafficConfig,
+    ) -> Option<AtBody> {
+        let seen_now = now_s - t.t_s <= 0.25;
+        let at = || at_body(&self.model, pose, t, now_s, cfg);
+        if held.part_hidden {
+            let moved_on = (t.position - held.at).norm() > held.extent_m;
+            return (!seen_now || at() || !moved_on).then_some(*held);
+        }
+        if !seen_now {
+            return Some(self.at_body_now(t, pose));
+        }
+        let gap_m = box_gap_m(&self.model, pose, t, &Vector2::zeros());
+        let speed = held.peak_m_s.max(ELSEWHERE_M_S);
+        if gap_m - held.gap_m > STEPPED_AWAY_M + speed * (t.t_s - held.seen_s).max(0.0) {
+            return Some(AtBody {
+                part_hidden: true,
+                ..*held
+            });
+        }
+        at().then(|| self.at_body_now(t, pose))
     }
 
     /// The velocity of mover `t` over its kept path's last second, m/s (its filter's velocity

@@ -134,6 +134,12 @@ pub(super) struct AtBody {
     pub(super) velocity: Vector2<f64>,
     /// Why it is held once lost.
     pub(super) why: LostMover,
+    /// How far its box was from the body when last seen, metres (infinite: not known).
+    pub(super) gap_m: f64,
+    /// Its box stepped away from the body further than its motion explains while held (its
+    /// near part went out of view): held as lost until its track, seen now away from the
+    /// body, has moved beyond its extent from where it was.
+    pub(super) part_hidden: bool,
 }
 
 impl AtBody {
@@ -148,6 +154,8 @@ impl AtBody {
             peak_m_s: t.peak_speed_m_s,
             velocity: t.velocity,
             why,
+            gap_m: f64::INFINITY,
+            part_hidden: false,
         }
     }
 }
