@@ -266,7 +266,7 @@ fn pilot_calls(records: &[RunRecord]) -> String {
     let calls: usize = by_cause.values().map(|c| c.0).sum();
     let needless: usize = by_cause.values().map(|c| c.1).sum();
     let mut s = format!(
-        "\n## Pilot calls\n\n{calls} of {} runs ended with a pilot call, {needless} of them needless (no object within {} m of what held the vehicle in the last {} s, nor - waiting for a mover believed at its body - one that struck it standing against it, or any mover within {} m of its parts).\n",
+        "\n## Pilot calls\n\n{calls} of {} runs ended with a pilot call, {needless} of them needless (no object within {} m of what held the vehicle in the last {} s, nor - waiting for a mover believed at its body - one that struck it standing against it, or - one lost at its body - any mover within {} m of its parts).\n",
         records.len(),
         crate::engine::REAL_WITHIN_M,
         crate::engine::NEEDLESS_WINDOW_S,

@@ -3,8 +3,8 @@
 //! never saw), and - from ground truth, for the judge only - whether anything was really there.
 //! A call is **needless** when no object stood near any point that held the vehicle in the last
 //! [`NEEDLESS_WINDOW_S`] seconds, and - when it waited for a mover it believed at its body -
-//! none that struck the vehicle stands against it, nor does any mover stand within
-//! [`AT_BODY_WITHIN_M`] of its parts.
+//! none that struck the vehicle stands against it, nor - one it lost there - does any mover
+//! stand within [`AT_BODY_WITHIN_M`] of its parts.
 
 use std::collections::VecDeque;
 
@@ -114,10 +114,11 @@ pub struct PilotCallReport {
     pub at_m: Option<[f64; 2]>,
     /// Ground truth, for the judge: the object nearest any point that held the vehicle in the
     /// last [`NEEDLESS_WINDOW_S`] s (for unseen ground: any cell of it), or - waiting for a
-    /// mover believed at the body - to the vehicle's parts of one that struck it, and how far,
-    /// metres.
+    /// mover believed at the body - to the vehicle's parts of one that struck it (or, one lost
+    /// there, of any mover), and how far, metres: of those, the one nearest within what counts
+    /// for it ([`REAL_WITHIN_M`]; a mover at the body, [`AT_BODY_WITHIN_M`]).
     pub nearest_object: Option<(String, f64)>,
-    /// Nothing stood within [`REAL_WITHIN_M`] of any of them: the call was needless.
+    /// Nothing stood within what counts of any of them: the call was needless.
     pub needless: bool,
 }
 
@@ -164,16 +165,28 @@ impl HoldLog {
             last,
             Some((_, Hold::LostObstacle { mover: Some(_), .. }, _))
         );
-        // ... as is a mover standing at its body.
+        // ... as is - waiting for one held at its body and lost there - any mover at its body.
+        let lost_at_body = matches!(
+            last,
+            Some((
+                _,
+                Hold::LostObstacle {
+                    mover: Some(LostMover::AtBody),
+                    ..
+                },
+                _
+            ))
+        );
         let struck = |id: &str| world.contacts().iter().any(|c| c.object == id);
         let at_body = (world.scene().solids.iter().enumerate())
-            .filter(|(i, s)| for_a_mover && (struck(&s.id) || movers.contains(i)))
-            .filter_map(|(i, s)| {
+            .filter(|(i, s)| (for_a_mover && struck(&s.id)) || (lost_at_body && movers.contains(i)))
+            .filter_map(|(i, _)| {
                 let d = world.distances_to(i).into_iter().reduce(f64::min)?;
-                let within = if struck(&s.id) {
-                    REAL_WITHIN_M
-                } else {
+                let mover_at_body = lost_at_body && movers.contains(&i);
+                let within = if mover_at_body {
                     AT_BODY_WITHIN_M
+                } else {
+                    REAL_WITHIN_M
                 };
                 Some((i, d, within))
             });

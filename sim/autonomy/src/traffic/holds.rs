@@ -30,24 +30,23 @@ impl TrafficRules {
         }
         movers
             .iter()
-            .find(|t| self.standing_within_reach(t, pose, now_s, cfg))
+            .filter(|t| self.arriving(t, now_s, cfg) || self.is_walker(t, cfg) || self.drove_up(t))
+            .find(|t| self.standing_within_reach(t, pose, cfg))
             .map(|t| BodyHold::Seen {
                 at: t.position,
                 last_seen_s: t.t_s,
             })
     }
 
-    /// Whether `t` is a known mover standing within its reach of the vehicle at `pose`, as
-    /// [`Self::standing_at`] holds it for.
+    /// Whether `t`, a track, stands (not [`surely_moving`]) within its reach of the vehicle at
+    /// `pose` ([`first_within_standing_reach`]).
     pub(super) fn standing_within_reach(
         &self,
         t: &TrackState,
         pose: &Isometry2<f64>,
-        now_s: f64,
         cfg: &TrafficConfig,
     ) -> bool {
         !surely_moving(t, cfg)
-            && (self.arriving(t, now_s, cfg) || self.is_walker(t, cfg) || self.drove_up(t))
             && first_within_standing_reach(&self.model, std::slice::from_ref(pose), t, cfg)
                 .is_some()
     }
@@ -55,7 +54,7 @@ impl TrafficRules {
     /// Whether `t` is a known mover that came where it stands: seen moving as a mover for
     /// `MOVER_FOR_S` on end at some time and [`came_there`], as one lost standing must have
     /// (`note_lost_standing`).
-    fn drove_up(&self, t: &TrackState) -> bool {
+    pub(super) fn drove_up(&self, t: &TrackState) -> bool {
         self.walked.contains(&t.id) && came_there(t)
     }
 

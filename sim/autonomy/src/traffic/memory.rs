@@ -98,7 +98,9 @@ impl TrafficRules {
         }
     }
 
-    /// The movers at the body now ([`at_body`]) joined to those lost there before; what holds
+    /// The movers at the body now ([`at_body`]: arriving, or - the vehicle standing - driven up
+    /// and standing within reach), those held there before and not seen away
+    /// ([`Self::still_at_body`]), joined to those lost there before; what holds
     /// the vehicle for them (`None`: nothing at the body): stopped for the one seen last, if
     /// seen within `hidden_after_s`, else waiting for one lost there, as for a hidden obstacle.
     pub(super) fn movers_at_body(
@@ -125,28 +127,34 @@ impl TrafficRules {
             .cloned()
             .collect();
         self.note_paths(&others, now_s);
-        // A mover arriving at the body (or, the vehicle standing, one standing within its
-        // reach: a train seen in flashes as it crawls to the nose makes no streak), or one held
-        // there before and not seen away.
+        // A mover arriving at the body (or, the vehicle standing, one that drove up and stands
+        // within its reach: a train seen in flashes as it crawls to the nose makes no streak),
+        // or one held there before and not seen away (`still_at_body`).
         let mut body: Vec<AtBody> = (movers.iter())
             .filter_map(|t| match self.at_body.iter().find(|r| r.id == t.id) {
                 Some(r) => self.still_at_body(r, t, pose, now_s, cfg),
                 None => ((self.arriving(t, now_s, cfg)
-                    || (stopped && self.standing_within_reach(t, pose, now_s, cfg)))
+                    || (stopped && self.drove_up(t) && self.standing_within_reach(t, pose, cfg)))
                     && at_body(&self.model, pose, t, now_s, cfg))
-                .then(|| self.at_body_now(t, pose)),
+                .then(|| self.at_body_now(t, pose, None)),
             })
             .collect();
         // One lost (its track gone) is waited for for good, as a hidden obstacle: the pilot is
         // called. Its cells reading free would prove nothing - within the map's self-hit margin
         // of the body nothing is ever mapped. Unless it is seen elsewhere under a new number
         // (`seen_elsewhere`): it walked or drove on out of the blind zone; or it left with
-        // others (`left_with_others`: not claimed - the other track is not the lost one).
+        // others (`left_with_others`: not claimed - the other track is not the lost one). Not
+        // one seen away only in part (`still_at_body`).
         let lost: Vec<AtBody> = (self.at_body.iter())
             .filter(|r| !movers.iter().any(|t| t.id == r.id))
             .copied()
             .collect();
         for r in lost {
+            // Seen away only in part: what else is seen tells nothing of the part hidden.
+            if r.stepped_at.is_some() {
+                body.push(r);
+                continue;
+            }
             let seen = self.seen_elsewhere(&r, movers, pose, now_s, cfg);
             if let Some(id) = seen {
                 self.claimed.push(id);
@@ -310,22 +318,29 @@ impl TrafficRules {
     }
 
     /// Mover `t` at the body of the vehicle at `pose`, as held there: its velocity over its
-    /// kept path's last second, its box's distance from the body.
-    fn at_body_now(&self, t: &TrackState, pose: &Isometry2<f64>) -> AtBody {
+    /// kept path's last second, the nearest its box came to the body while held (`held`, if
+    /// it was).
+    fn at_body_now(&self, t: &TrackState, pose: &Isometry2<f64>, held: Option<&AtBody>) -> AtBody {
+        let velocity = self.path_velocity(t);
+        let gap_m = box_gap_m(&self.model, pose, t, &Vector2::zeros());
+        let nearest_gap = match held {
+            Some(h) if h.stepped_at.is_none() && h.nearest_gap.0 < gap_m => h.nearest_gap,
+            _ => (gap_m, t.t_s, velocity.norm()),
+        };
         AtBody {
-            velocity: self.path_velocity(t),
-            gap_m: box_gap_m(&self.model, pose, t, &Vector2::zeros()),
+            velocity,
+            nearest_gap,
             ..AtBody::of(t, LostMover::AtBody)
         }
     }
 
     /// What holds mover `t`, held at the body as `held`, now (`None`: it is let go): released
     /// once seen away from the body ([`at_body`]; a prediction carrying it on through the
-    /// airframe is no evidence that it left) - unless its box stepped away further than
-    /// [`STEPPED_AWAY_M`] plus what its speed explains since: its near part went out of view
-    /// (a tug gone into the blind zone under the nose, its carts still seen, their track's centre
-    /// 5 m back in a revolution). Held then as it was until its track has moved beyond its extent
-    /// from there, away from the body.
+    /// airframe is no evidence that it left) - unless its box stepped away from the nearest it
+    /// came further than [`STEPPED_AWAY_M`] plus what its speed explains since: its near part
+    /// went out of view (a tug gone into the blind zone under the nose, its carts still seen,
+    /// their track's box 2.2 m back in a revolution). Held then as it was until its track has
+    /// moved beyond its extent from where it stepped to, or is seen at the body again.
     fn still_at_body(
         &self,
         held: &AtBody,
@@ -335,23 +350,24 @@ impl TrafficRules {
         cfg: &TrafficConfig,
     ) -> Option<AtBody> {
         let seen_now = now_s - t.t_s <= 0.25;
-        let at = || at_body(&self.model, pose, t, now_s, cfg);
-        if held.part_hidden {
-            let moved_on = (t.position - held.at).norm() > held.extent_m;
-            return (!seen_now || at() || !moved_on).then_some(*held);
+        if (seen_now && at_body(&self.model, pose, t, now_s, cfg))
+            || (!seen_now && held.stepped_at.is_none())
+        {
+            return Some(self.at_body_now(t, pose, Some(held)));
         }
-        if !seen_now {
-            return Some(self.at_body_now(t, pose));
+        if let Some(stepped_at) = held.stepped_at {
+            let moved_on = seen_now && (t.position - stepped_at).norm() > held.extent_m;
+            return (!moved_on).then_some(*held);
         }
+        // Its speed as it was nearest: a step read as motion makes the track's own fast.
+        let (nearest_m, nearest_s, speed_then) = held.nearest_gap;
         let gap_m = box_gap_m(&self.model, pose, t, &Vector2::zeros());
-        let speed = held.peak_m_s.max(ELSEWHERE_M_S);
-        if gap_m - held.gap_m > STEPPED_AWAY_M + speed * (t.t_s - held.seen_s).max(0.0) {
-            return Some(AtBody {
-                part_hidden: true,
-                ..*held
-            });
-        }
-        at().then(|| self.at_body_now(t, pose))
+        let speed = speed_then.max(ELSEWHERE_M_S);
+        let stepped = gap_m - nearest_m > STEPPED_AWAY_M + speed * (t.t_s - nearest_s).max(0.0);
+        stepped.then_some(AtBody {
+            stepped_at: Some(t.position),
+            ..*held
+        })
     }
 
     /// The velocity of mover `t` over its kept path's last second, m/s (its filter's velocity

@@ -83,8 +83,8 @@ fn cart_lost_at_the_nose(extent_m: f64, vy: f64) -> rules::AtBody {
         peak_m_s: vy.abs(),
         velocity: Vector2::new(0.0, vy),
         why: LostMover::AtBody,
-        gap_m: f64::INFINITY,
-        part_hidden: false,
+        nearest_gap: (f64::INFINITY, 1.0, 0.0),
+        stepped_at: None,
     }
 }
 
@@ -265,8 +265,8 @@ fn a_part_of_a_car_seen_again_only_as_a_candidate_is_let_go_by_its_kept_path() {
 /// `traffic_jet_speed_profiles.toml`): held at the body, the train's one track steps back 5 m in
 /// a revolution as the tug goes into the blind zone under the nose and only its carts stay in
 /// view. Not seen away: held as it was (a pilot called once not seen there for
-/// `hidden_after_s`) until the track has moved beyond its extent from there. The same place
-/// reached at its speed is seen away; a step of a cell or two is a box's wander.
+/// `hidden_after_s`) until the track has moved beyond its extent from where it stepped to, or
+/// is seen at the body again. Stepping away as far at its speed (1.5 m/s at least) is seen away.
 #[test]
 fn a_train_whose_tug_goes_out_of_view_at_the_nose_is_not_seen_away() {
     let config = AutonomyConfig::default();
@@ -295,37 +295,43 @@ fn a_train_whose_tug_goes_out_of_view_at_the_nose_is_not_seen_away() {
             last_seen_s,
         })
     };
+    let stepped = |r: &mut TrafficRules| {
+        assert_eq!(plan(r, train(1.0, 1.0)), seen_at(2.5, 1.0));
+        assert_eq!(plan(r, train(1.1, 2.0)), seen_at(3.5, 1.1));
+        // Its box 5 m off in a revolution, beyond the body's reach: held as it was.
+        assert_eq!(plan(r, train(1.2, 7.0)), seen_at(3.5, 1.1));
+        assert_eq!(r.at_body[0].stepped_at, Some(Point2::new(4.5, 8.5)));
+    };
     let mut r = rules_with_mover(&train(1.0, 1.0), cfg);
-    assert_eq!(plan(&mut r, train(1.0, 1.0)), seen_at(2.5, 1.0));
-    // A cell's wander: held, as seen now.
-    assert_eq!(plan(&mut r, train(1.1, 2.0)), seen_at(3.5, 1.1));
-    assert!(!r.at_body[0].part_hidden);
-    // Its box 5 m off in a revolution, beyond the body's reach: held as it was.
-    assert_eq!(plan(&mut r, train(1.2, 7.0)), seen_at(3.5, 1.1));
-    assert!(r.at_body[0].part_hidden);
+    stepped(&mut r);
     let lost = plan(&mut r, train(1.2 + hidden_after_s, 7.0));
     assert!(
         matches!(lost, Some(BodyHold::Lost { why: LostMover::AtBody, last_seen_s, .. }) if last_seen_s == 1.1),
         "{lost:?}"
     );
-    // Its extent on from where it was held (3.5): not yet beyond; then beyond.
-    assert!(plan(&mut r, train(2.0 + hidden_after_s, 8.0)).is_some());
-    assert_eq!(plan(&mut r, train(2.5 + hidden_after_s, 8.5)), None);
-    // The same place reached at its speed, a plan each half second: seen away.
+    // Its extent on from where it stepped to (8.5): not yet beyond; then beyond.
+    assert!(plan(&mut r, train(2.0 + hidden_after_s, 13.0)).is_some());
+    assert_eq!(plan(&mut r, train(2.5 + hidden_after_s, 13.5)), None);
+    // Seen at the body again: held as seen now, and let go once seen away at its speed.
     let mut r = rules_with_mover(&train(1.0, 1.0), cfg);
-    let holds: Vec<bool> = (0..=12)
-        .map(|k| plan(&mut r, train(1.0 + 0.5 * k as f64, 1.0 + 0.5 * k as f64)).is_some())
-        .collect();
-    assert_eq!(holds.iter().filter(|h| **h).count(), 8, "{holds:?}");
-    assert!(holds[..8].iter().all(|h| *h) && r.at_body.is_empty());
+    stepped(&mut r);
+    assert_eq!(plan(&mut r, train(1.3, 2.0)), seen_at(3.5, 1.3));
+    assert_eq!(r.at_body[0].stepped_at, None);
+    // The same place reached at its speed: 2 m every 2 s, seen away.
+    let mut r = rules_with_mover(&train(1.0, 1.0), cfg);
+    assert_eq!(plan(&mut r, train(1.0, 1.0)), seen_at(2.5, 1.0));
+    assert_eq!(plan(&mut r, train(3.0, 3.0)), seen_at(4.5, 3.0));
+    assert_eq!(plan(&mut r, train(5.0, 5.0)), None);
+    assert!(r.at_body.is_empty());
 }
 
 /// A train crawling to the standing jet's nose seen in flashes makes no streak of a second: a
-/// mover that drove up once (`drove_up`) is held at the body of a standing vehicle as one
-/// arriving is, and waited for once lost there; not while the vehicle moves (it stands for
-/// movers arriving only), nor one that never came there (a parked car's sliding part).
+/// mover that drove up once (`drove_up`) and stands within its reach of a standing vehicle is
+/// held at its body as one arriving is, and waited for once lost there; not while the vehicle
+/// moves (it stands for movers arriving only), nor one that never came there (a parked car's
+/// sliding part).
 #[test]
-fn a_mover_that_drove_up_to_the_standing_body_is_held_there() {
+fn a_mover_that_drove_up_and_stands_at_the_standing_body_is_held_there() {
     let config = AutonomyConfig::default();
     let (cfg, hidden_after_s) = (&config.traffic, config.hidden_after_s);
     let pose = Isometry2::identity();
@@ -337,8 +343,22 @@ fn a_mover_that_drove_up_to_the_standing_body_is_held_there() {
     let held = |van: &TrackState, stopped: bool| {
         let mut r = rules();
         r.walked.push(8);
-        let now = r.movers_at_body(std::slice::from_ref(van), &pose, 12.0, stopped, cfg, 1.0);
-        let later = r.movers_at_body(&[], &pose, 13.0 + hidden_after_s, stopped, cfg, 1.0);
+        let now = r.movers_at_body(
+            std::slice::from_ref(van),
+            &pose,
+            12.0,
+            stopped,
+            cfg,
+            hidden_after_s,
+        );
+        let later = r.movers_at_body(
+            &[],
+            &pose,
+            12.5 + hidden_after_s,
+            stopped,
+            cfg,
+            hidden_after_s,
+        );
         (now.is_some(), later)
     };
     let (now, later) = held(&van, true);
@@ -355,7 +375,7 @@ fn a_mover_that_drove_up_to_the_standing_body_is_held_there() {
     );
     assert_eq!(held(&van, false), (false, None));
     let slid = TrackState {
-        travel_m: 14.0,
+        travel_m: 10.0,
         ..van.clone()
     };
     assert_eq!(held(&slid, true), (false, None));

@@ -134,12 +134,13 @@ pub(super) struct AtBody {
     pub(super) velocity: Vector2<f64>,
     /// Why it is held once lost.
     pub(super) why: LostMover,
-    /// How far its box was from the body when last seen, metres (infinite: not known).
-    pub(super) gap_m: f64,
-    /// Its box stepped away from the body further than its motion explains while held (its
-    /// near part went out of view): held as lost until its track, seen now away from the
-    /// body, has moved beyond its extent from where it was.
-    pub(super) part_hidden: bool,
+    /// The nearest its box came to the body while held, metres (infinite: not known), when,
+    /// seconds, and its speed then, m/s.
+    pub(super) nearest_gap: (f64, f64, f64),
+    /// Where its track was when its box stepped away from the body further than its speed
+    /// explains (its near part gone out of view), if it did: seen away only in part, held as it
+    /// was until its track has moved beyond its extent from there.
+    pub(super) stepped_at: Option<Point2<f64>>,
 }
 
 impl AtBody {
@@ -154,8 +155,8 @@ impl AtBody {
             peak_m_s: t.peak_speed_m_s,
             velocity: t.velocity,
             why,
-            gap_m: f64::INFINITY,
-            part_hidden: false,
+            nearest_gap: (f64::INFINITY, t.t_s, 0.0),
+            stepped_at: None,
         }
     }
 }

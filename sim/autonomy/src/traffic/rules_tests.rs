@@ -115,8 +115,8 @@ fn lost_at_the_fuselage(extent_m: f64) -> AtBody {
         peak_m_s: 1.2,
         velocity: Vector2::zeros(),
         why: LostMover::AtBody,
-        gap_m: f64::INFINITY,
-        part_hidden: false,
+        nearest_gap: (f64::INFINITY, 1.0, 0.0),
+        stepped_at: None,
     }
 }
 
