@@ -4,7 +4,7 @@
 use mapper::TrackState;
 use nalgebra::{Isometry2, Point2, Vector2};
 
-use super::rules_tests::{rules, rules_with_mover, track};
+use super::rules_tests::{self, inputs, rules, rules_with_mover, track};
 use super::*;
 use crate::planner::AutonomyConfig;
 
@@ -379,4 +379,38 @@ fn a_mover_that_drove_up_and_stands_at_the_standing_body_is_held_there() {
         ..van.clone()
     };
     assert_eq!(held(&slid, true), (false, None));
+}
+
+/// A van stops at the nose, the jet moves into it (variant 590 of
+/// `traffic_jet_speed_profiles.toml`): too late to stop short of a standing van's reach, the
+/// vehicle stops as short as it can - its stopping distance, a place on the route kept while
+/// the plans go on moving the stop, not a distance ahead taken afresh, which moved on with the
+/// vehicle (it never braked). Let go once nothing moves the stop.
+#[test]
+fn too_late_for_a_standing_vans_reach_the_stop_stays_where_it_was_put() {
+    let config = AutonomyConfig::default();
+    let van = [track(5, 0.0, (44.0, -5.0), (0.0, 0.0), 0b11)];
+    let mut r = rules();
+    let poses = rules_tests::straight();
+    let fast = inputs(&poses, &van, &[], 0.0, 12.0, &config);
+    assert_eq!(r.stand_clear(&fast, 40.0), 33.0);
+    // 1.2 m on at the same speed: the same stopping distance, the same place.
+    let on: Vec<Isometry2<f64>> = poses
+        .iter()
+        .map(|p| Isometry2::new(p.translation.vector + Vector2::new(1.2, 0.0), 0.0))
+        .collect();
+    let later = MoverInputs {
+        s_m: 1.2,
+        ..inputs(&on, &van, &[], 0.1, 12.0, &config)
+    };
+    let at = r.stand_clear(&later, 40.0);
+    assert!((at - 31.8).abs() < 1e-9, "{at}");
+    assert_eq!(rules().stand_clear(&later, 40.0), 33.0, "taken afresh");
+    // The van gone: the stop is the plan's own, the place let go.
+    let gone = MoverInputs {
+        s_m: 1.2,
+        ..inputs(&on, &[], &[], 0.2, 12.0, &config)
+    };
+    assert_eq!(r.stand_clear(&gone, 40.0), 40.0);
+    assert_eq!(r.stand_line, None);
 }

@@ -246,6 +246,9 @@ pub struct TrafficRules {
     pub(super) candidates: Vec<TrackState>,
     /// The plans' first collisions with the map, to find one closing on the vehicle.
     pub(super) closing: Closing,
+    /// Where, on the route, the vehicle stands clear of movers (`stand_clear`), kept while
+    /// the plans go on moving their stop for them: a place, not a distance ahead.
+    pub(super) stand_line: Option<f64>,
 }
 
 impl TrafficRules {
@@ -271,6 +274,7 @@ impl TrafficRules {
             paths: Vec::new(),
             candidates: Vec::new(),
             closing: Closing::default(),
+            stand_line: None,
         }
     }
 
@@ -290,6 +294,7 @@ impl TrafficRules {
         self.candidates.clear();
         self.closing.clear();
         self.hold = None;
+        self.stand_line = None;
     }
 
     /// The decision about movers for the plan `i`: the caution cap, the conflict, the stop
@@ -316,10 +321,11 @@ impl TrafficRules {
         if let Some(at) = stop_at_m {
             stop_at_m = Some(self.short_of_caution_line(at, i));
         }
-        if let Some(at) = stop_at_m {
-            // Stopping - for a mover or the map - never where another mover is predicted to
-            // pass, when the vehicle can stop short of its path.
-            stop_at_m = Some(self.stand_clear(i, at));
+        // Stopping - for a mover or the map - never where another mover is predicted to pass,
+        // when the vehicle can stop short of its path.
+        stop_at_m = stop_at_m.map(|at| self.stand_clear(i, at));
+        if stop_at_m.is_none() {
+            self.stand_line = None;
         }
         stop_at_m = self.short_of_walkers(i, stop_at_m);
         self.candidates = i.candidates.to_vec();

@@ -274,23 +274,22 @@ fn a_stop_beside_a_van_standing_is_moved_short_of_its_reach() {
     let config = AutonomyConfig::default();
     let poses = straight();
     let van = [track(5, 0.0, (44.0, -5.0), (0.0, 0.0), 0b11)];
-    let r = rules();
     // The front circle first comes within 6.5 m of the van at 39.85 m: the vehicle stops with
     // its origin at 30 m (as `stand_clear` itself finds, `a_mover_standing_is_kept_at_its_reach`).
     assert_eq!(
-        r.stand_clear(&inputs(&poses, &van, &[], 0.0, 0.0, &config), 40.0),
+        rules().stand_clear(&inputs(&poses, &van, &[], 0.0, 0.0, &config), 40.0),
         30.0
     );
     // At 12 m/s it stops in 6 + 24 + 3 m, beyond 30 m: too late, it stops in 33 m, not 40;
     // a stop within a pose step of that (standing within the reach) stays.
     let fast = inputs(&poses, &van, &[], 0.0, 12.0, &config);
     assert_eq!(fast.stopping_m, 33.0);
-    assert_eq!(r.stand_clear(&fast, 40.0), 33.0);
-    assert_eq!(r.stand_clear(&fast, 33.4), 33.4);
+    assert_eq!(rules().stand_clear(&fast, 40.0), 33.0);
+    assert_eq!(rules().stand_clear(&fast, 33.4), 33.4);
     let mut off = AutonomyConfig::default();
     off.traffic.enabled = false;
     assert_eq!(
-        r.stand_clear(&inputs(&poses, &van, &[], 0.0, 0.0, &off), 40.0),
+        rules().stand_clear(&inputs(&poses, &van, &[], 0.0, 0.0, &off), 40.0),
         40.0
     );
 }
