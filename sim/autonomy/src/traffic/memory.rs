@@ -186,7 +186,10 @@ impl TrafficRules {
             let lost = self.lost_standing_at(pose, now_s, &body, cfg);
             body.extend(lost);
         }
-        // Movers predicted out of view now, confirmed, beyond what revealing a static object
+        // Movers predicted out of view now, confirmed - or that drove up (`drove_up`: a van
+        // seen in fragments is never confirmed by the stricter rule, and one that went out of
+        // view behind the wing at a third of its speed struck the fuselage unseen, variant 426
+        // of `traffic_jet_speed_profiles.toml`) - beyond what revealing a static object
         // explains, and seen predicted on a few revolutions on end: checked again if their
         // track drops (seen too briefly for a streak, maybe: a van seen in fragments for under
         // a second each). Others are not: a one-cell track jumping at 7 m/s at the edge of
@@ -196,7 +199,7 @@ impl TrafficRules {
             .iter()
             .filter(|t| {
                 now_s - t.t_s > 0.25
-                    && t.confirmed
+                    && (t.confirmed || self.drove_up(t))
                     && moved_beyond_its_extent(t, cfg)
                     && self.predictions.iter().any(|p| p.track.id == t.id)
                     && self

@@ -4,6 +4,7 @@
 use mapper::TrackState;
 use nalgebra::{Isometry2, Point2, Vector2};
 
+use super::rules::MoverStreak;
 use super::rules_tests::{self, inputs, rules, rules_with_mover, track};
 use super::*;
 use crate::planner::AutonomyConfig;
@@ -413,4 +414,48 @@ fn too_late_for_a_standing_vans_reach_the_stop_stays_where_it_was_put() {
     };
     assert_eq!(r.stand_clear(&gone, 40.0), 40.0);
     assert_eq!(r.stand_line, None);
+}
+
+/// A van seen in fragments strikes the standing fuselage unseen (variant 426 of
+/// `traffic_jet_speed_profiles.toml`): never confirmed by the tracker's stricter rule, but seen
+/// moving as a mover for a second on end and come from beyond twice its extent and 3 m
+/// (`drove_up`), it coasts out of view towards the standing jet and is waited for once its
+/// track drops; one not confirmed that never drove up is let go, as before.
+#[test]
+fn a_van_that_drove_up_unconfirmed_and_coasted_towards_the_standing_jet_is_waited_for() {
+    let config = AutonomyConfig::default();
+    let (cfg, hidden_after_s) = (&config.traffic, config.hidden_after_s);
+    let pose = Isometry2::identity();
+    let dropped = |walked: bool| {
+        let van = TrackState {
+            confirmed: false,
+            ..track(21, 10.0, (4.0, -13.0), (0.0, 4.0), 0b01)
+        };
+        // Seen predicted for half a second on end (a streak, not a mover's second).
+        let mut r = rules();
+        r.streaks.push(MoverStreak {
+            id: 21,
+            last_s: 10.0,
+            since_s: 9.5,
+            mover_s: None,
+        });
+        r.predictions = predict(std::slice::from_ref(&van), 10.0, cfg);
+        if walked {
+            r.walked.push(21);
+        }
+        r.movers_at_body(&[van], &pose, 10.5, true, cfg, hidden_after_s);
+        r.movers_at_body(&[], &pose, 12.5, true, cfg, hidden_after_s)
+    };
+    let held = dropped(true);
+    assert!(
+        matches!(
+            held,
+            Some(BodyHold::Lost {
+                why: LostMover::Coasting,
+                ..
+            })
+        ),
+        "{held:?}"
+    );
+    assert_eq!(dropped(false), None);
 }
