@@ -181,6 +181,9 @@ fn run_variant(
         return Ok(None);
     }
     let rec = record(campaign, v, &scenario, &report);
+    if let Some(f) = &rec.needless_file {
+        mapper::write_atomically(&dir.join(f), v.text.as_bytes())?;
+    }
     if let Some(f) = &rec.failure_file {
         mapper::write_atomically(&dir.join(f), v.text.as_bytes())?;
         if record_failures {

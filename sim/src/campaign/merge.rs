@@ -127,9 +127,9 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
         serde_json::to_string_pretty(&merged_meta)?.as_bytes(),
     )?;
     for (r, from) in by_index.values() {
-        if let Some(f) = &r.failure_file {
+        for f in r.failure_file.iter().chain(&r.needless_file) {
             let text = std::fs::read(from.join(f)).map_err(|source| Error::Io {
-                what: "reading a shard's failure file",
+                what: "reading a shard's scenario file (a failure's, or a needless call's)",
                 path: from.join(f),
                 source,
             })?;

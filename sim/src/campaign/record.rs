@@ -129,6 +129,10 @@ pub struct RunRecord {
     /// Ground truth at that call: the object nearest what held the vehicle, and how far, metres.
     #[serde(default)]
     pub pilot_call_object: Option<(String, f64)>,
+    /// The scenario file of a run whose pilot call was needless, relative to the campaign
+    /// directory (`needless/<index>.toml`): to run it alone and read why the stack held.
+    #[serde(default)]
+    pub needless_file: Option<String>,
 }
 
 impl RunRecord {
@@ -294,6 +298,7 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
         r.contacts.len()
     };
     let failed = counted_contacts > 0 || !r.expectations_met;
+    let needless_call = r.pilot_call.as_ref().is_some_and(|c| c.needless);
     let min_of = |xs: &mut dyn Iterator<Item = f64>| xs.reduce(f64::min);
     let clearance = finite(obstacle_clearance);
     let score = clearance.unwrap_or(10.0).min(10.0)
@@ -339,8 +344,9 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
                 c.hold.as_ref().map_or("none", |h| h.name())
             )
         }),
-        needless_pilot_call: r.pilot_call.as_ref().is_some_and(|c| c.needless),
+        needless_pilot_call: needless_call,
         pilot_call_object: r.pilot_call.as_ref().and_then(|c| c.nearest_object.clone()),
+        needless_file: needless_call.then(|| format!("needless/{}.toml", v.index)),
     }
 }
 
@@ -386,6 +392,7 @@ pub(super) fn invalid(campaign: &Campaign, v: &Variant, why: &str) -> RunRecord 
         pilot_call: None,
         needless_pilot_call: false,
         pilot_call_object: None,
+        needless_file: None,
     }
 }
 

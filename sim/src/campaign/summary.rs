@@ -279,5 +279,36 @@ fn pilot_calls(records: &[RunRecord]) -> String {
             let _ = writeln!(s, "| {cause} | {n} | {k} | {} |", there.join(", "));
         }
     }
+    s + &needless_calls(records)
+}
+
+/// The runs whose pilot call was needless: what held the vehicle, the object nearest it, and
+/// the scenario file to run alone (the first [`MAX_ROWS`]).
+fn needless_calls(records: &[RunRecord]) -> String {
+    let needless: Vec<&RunRecord> = records.iter().filter(|r| r.needless_pilot_call).collect();
+    if needless.is_empty() {
+        return String::new();
+    }
+    let mut s = "\nThe needless calls, to read one by one:\n\n| index | call / what held it | nearest object (ground truth) | scenario |\n|---|---|---|---|\n".to_string();
+    for r in needless.iter().take(MAX_ROWS) {
+        let nearest = r
+            .pilot_call_object
+            .as_ref()
+            .map_or("-".to_string(), |(id, d)| format!("{id} {d:.2} m"));
+        let _ = writeln!(
+            s,
+            "| {} | {} | {nearest} | `{}` |",
+            r.index,
+            r.pilot_call.as_deref().unwrap_or("-"),
+            r.needless_file.as_deref().unwrap_or("-")
+        );
+    }
+    if needless.len() > MAX_ROWS {
+        let _ = writeln!(
+            s,
+            "\n... and {} more in `results.jsonl` (`needless_pilot_call: true`).",
+            needless.len() - MAX_ROWS
+        );
+    }
     s
 }

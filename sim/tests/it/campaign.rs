@@ -49,6 +49,17 @@ fn the_smoke_campaign_runs_every_variant_under_every_setting() {
             r.end
         );
         assert!(r.pilot_call_object.is_some() || !called || r.needless_pilot_call);
+        // A needless call's variant is written to be run alone, and listed.
+        assert_eq!(
+            r.needless_file.is_some(),
+            r.needless_pilot_call,
+            "{}",
+            r.index
+        );
+        if let Some(f) = &r.needless_file {
+            assert!(dir.path().join(f).exists(), "{f}");
+            assert!(summary.contains(&format!("`{f}`")), "{summary}");
+        }
     }
     let calls = records.iter().filter(|r| r.pilot_call.is_some()).count();
     assert!(calls > 0, "the smoke campaign's variant 10 calls a pilot");
