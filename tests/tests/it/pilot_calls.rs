@@ -2,7 +2,8 @@
 //! the vehicle as the stack believed it and where, and - from ground truth - whether an object
 //! stood there. A phantom that holds the car is a needless call; the cone a low LiDAR stops the
 //! jet for, the cone under the nose of a jet without a walk-around, and a person who walked on
-//! into the standing jet out of view, or a train that stopped at its nose out of view, are not.
+//! into the standing jet out of view, or a train that stopped at its nose out of view, are not;
+//! a van standing in the path for good is a blocked way.
 
 use std::path::PathBuf;
 
@@ -109,5 +110,17 @@ fn a_train_standing_at_the_nose_out_of_view_makes_a_call_that_was_needed() {
         d > sim::engine::REAL_WITHIN_M && d <= sim::engine::AT_BODY_WITHIN_M,
         "{call:?}"
     );
+    assert!(!call.needless, "{call:?}");
+}
+
+/// A careful van standing in the path for good (variant 38 of `traffic_jet.toml`): the jet
+/// stands short of its reach, stood for as an obstacle - a minute of it is a blocked way and a
+/// pilot is called, with the van there - not yielding to no conflict, silent to the time limit.
+#[test]
+fn a_van_standing_in_the_path_is_a_blocked_way_not_a_silent_yield() {
+    let r = run(&file("found/careful_van_standing_in_the_path_blocks_the_jet.toml"));
+    let call = r.pilot_call.expect("a pilot call, not the time limit");
+    assert_eq!(call.call, "blocked");
+    assert!(matches!(call.hold, Some(Hold::Obstacle { .. })), "{call:?}");
     assert!(!call.needless, "{call:?}");
 }

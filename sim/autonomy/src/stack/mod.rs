@@ -263,10 +263,21 @@ impl Driver {
                 obstacle,
                 last_seen_s,
             },
-            _ if chosen.collision_at_m != p.chosen().collision_at_m => DriverStatus::Yielding {
-                track_id: decision.held_for.unwrap_or(u32::MAX),
-                mover_at: conflict.map_or(here, |c| c.mover_at),
-            },
+            // Standing short of a map obstacle only for a standing mover's reach or a line
+            // (no conflict, no line held for one): what holds it is the obstacle, and a minute
+            // of it is a blocked way (variant 38 of `traffic_jet.toml` stood so, yielding to
+            // nothing, to its time limit).
+            _ if chosen.collision_at_m != p.chosen().collision_at_m
+                && (conflict.is_some()
+                    || decision.held_for.is_some()
+                    || v0 >= 0.05
+                    || p.chosen().collision_at_m.is_none()) =>
+            {
+                DriverStatus::Yielding {
+                    track_id: decision.held_for.unwrap_or(u32::MAX),
+                    mover_at: conflict.map_or(here, |c| c.mover_at),
+                }
+            }
             _ => self.stopped_status(&p, map, estimate.t_s, &config),
         };
         self.stopped_since_s = match self.status {
