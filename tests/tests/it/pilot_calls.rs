@@ -118,7 +118,9 @@ fn a_train_standing_at_the_nose_out_of_view_makes_a_call_that_was_needed() {
 /// pilot is called, with the van there - not yielding to no conflict, silent to the time limit.
 #[test]
 fn a_van_standing_in_the_path_is_a_blocked_way_not_a_silent_yield() {
-    let r = run(&file("found/careful_van_standing_in_the_path_blocks_the_jet.toml"));
+    let r = run(&file(
+        "found/careful_van_standing_in_the_path_blocks_the_jet.toml",
+    ));
     let call = r.pilot_call.expect("a pilot call, not the time limit");
     assert_eq!(call.call, "blocked");
     assert!(matches!(call.hold, Some(Hold::Obstacle { .. })), "{call:?}");

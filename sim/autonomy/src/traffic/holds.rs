@@ -212,6 +212,6 @@ impl TrafficRules {
             .stand_line
             .map_or(i.s_m + clear_m, |l| l.min(i.s_m + clear_m));
         self.stand_line = Some(line);
-        (line - i.s_m).clamp(0.0, at_m)
+        (line - i.s_m).max(0.0).min(at_m)
     }
 }
