@@ -214,6 +214,41 @@ pub fn stand_clear(
     stopping_m: f64,
     cfg: &TrafficConfig,
 ) -> Option<f64> {
+    let stop = StandStop {
+        stop_at_m,
+        stand_back_m,
+        stopping_m,
+    };
+    stand_clear_why(path, model, predictions, standing, stop, cfg).map(|(at_m, _)| at_m)
+}
+
+/// Where the vehicle is about to stop, for [`stand_clear_why`].
+#[derive(Clone, Copy, Debug)]
+pub struct StandStop {
+    /// The stop, ahead along the path.
+    pub stop_at_m: f64,
+    /// How far before its stop the vehicle stands.
+    pub stand_back_m: f64,
+    /// Its stopping distance.
+    pub stopping_m: f64,
+}
+
+/// [`stand_clear`], and whether the place is the stopping distance, taken because it is too
+/// late to stop short of a standing mover's reach (`true`) - a place that moves on with the
+/// vehicle if taken afresh each plan - rather than the start of a mover's zone.
+pub fn stand_clear_why(
+    path: &TimedPath<'_>,
+    model: &CollisionModel,
+    predictions: &[Prediction],
+    standing: &[TrackState],
+    stop: StandStop,
+    cfg: &TrafficConfig,
+) -> Option<(f64, bool)> {
+    let StandStop {
+        stop_at_m,
+        stand_back_m,
+        stopping_m,
+    } = stop;
     let last = path.poses.len().checked_sub(1)?;
     let zones: Vec<Zone> = predictions
         .iter()
@@ -244,6 +279,7 @@ pub fn stand_clear(
     };
     let mut at_m = stop_at_m;
     let mut moved = false;
+    let mut too_late = false;
     // Each earlier line may stand in a third mover's path: at most one step per zone.
     for _ in 0..zones.len() {
         let stand = stand_at(at_m);
@@ -261,15 +297,17 @@ pub fn stand_clear(
             // The earliest; of two as early, the one of a mover that came there.
             .reduce(|a, b| if (b.0, !b.1) < (a.0, !a.1) { b } else { a });
         match earliest {
-            Some((zone_m, _)) if zone_m > stopping_m && zone_m < at_m => at_m = zone_m,
+            Some((zone_m, _)) if zone_m > stopping_m && zone_m < at_m => {
+                (at_m, too_late) = (zone_m, false)
+            }
             Some((_, true)) if stopping_m < at_m - path.step_m && !in_a_sweep(stopping_m) => {
-                at_m = stopping_m
+                (at_m, too_late) = (stopping_m, true)
             }
             _ => break,
         }
         moved = true;
     }
-    moved.then_some(at_m)
+    moved.then_some((at_m, too_late))
 }
 
 /// The first pose (up to `up_to`) that any position the mover is predicted to reach within the

@@ -8,7 +8,8 @@ use nalgebra::Isometry2;
 use super::memory::LOST_STANDING_EXTENT_M;
 use super::rules::{BodyHold, MoverInputs, TrafficRules};
 use super::{
-    Conflict, TimedPath, TrafficConfig, came_there, first_within_standing_reach, surely_moving,
+    Conflict, StandStop, TimedPath, TrafficConfig, came_there, first_within_standing_reach,
+    stand_clear_why, surely_moving,
 };
 
 impl TrafficRules {
@@ -170,12 +171,15 @@ impl TrafficRules {
 
     /// Where to stop instead of `at_m` ahead so as not to stand in a predicted mover's path,
     /// nor beside one of `movers` not predicted now - standing, or too slow to predict
-    /// ([`super::stand_clear`]); `at_m` when it is clear or too late. The place is kept on the
-    /// route (`stand_line`) while the plans go on moving the stop, never moved further on: too
-    /// late to stop short of a standing mover's reach, the stop is the stopping distance, and
-    /// taken afresh each plan it would move ahead with the vehicle, which would never brake
-    /// (it drove on at 2.2 m/s for two seconds, its stop 5.7 m ahead, until the van beside its
-    /// path drove on into the nose: variant 590 of `traffic_jet_speed_profiles.toml`).
+    /// ([`super::stand_clear`]); `at_m` when it is clear or too late. Too late to stop short of
+    /// a standing mover's reach, the stop is the stopping distance, and taken afresh each plan
+    /// it would move ahead with the vehicle, which would never brake (it drove on at 2.2 m/s
+    /// for two seconds, its stop 5.7 m ahead, until the van beside its path drove on into the
+    /// nose: variant 590 of `traffic_jet_speed_profiles.toml`): that place is kept on the
+    /// route (`stand_line`), never moved further on, while the plans go on moving the stop,
+    /// and bounds the stops they move for other causes (the start of a mover's zone, which
+    /// moves on as the mover does, is not kept). A line more than a metre behind the vehicle
+    /// (it went on, or a lap started over) holds nothing.
     pub(super) fn stand_clear(&mut self, i: &MoverInputs<'_>, at_m: f64) -> f64 {
         let (movers, v0, now_s, cfg) = (i.movers, i.speed_m_s, i.now_s, i.traffic);
         let standing: Vec<TrackState> = movers
@@ -194,24 +198,25 @@ impl TrafficRules {
             now_s,
             yielding: false,
         };
-        let moved = super::stand_clear(
-            &path,
-            &self.model,
-            &self.predictions,
-            &standing,
-            at_m,
-            i.stop_buffer_m,
-            i.stopping_m,
-            cfg,
-        );
-        let Some(clear_m) = moved else {
+        let stop = StandStop {
+            stop_at_m: at_m,
+            stand_back_m: i.stop_buffer_m,
+            stopping_m: i.stopping_m,
+        };
+        let moved = stand_clear_why(&path, &self.model, &self.predictions, &standing, stop, cfg);
+        let Some((clear_m, too_late)) = moved else {
             self.stand_line = None;
             return at_m;
         };
+        if self.stand_line.is_some_and(|l| l - i.s_m < -1.0) {
+            self.stand_line = None;
+        }
         let line = self
             .stand_line
             .map_or(i.s_m + clear_m, |l| l.min(i.s_m + clear_m));
-        self.stand_line = Some(line);
+        if too_late {
+            self.stand_line = Some(line);
+        }
         (line - i.s_m).max(0.0).min(at_m)
     }
 }

@@ -459,3 +459,31 @@ fn a_van_that_drove_up_unconfirmed_and_coasted_towards_the_standing_jet_is_waite
     );
     assert_eq!(dropped(false), None);
 }
+
+/// Only the stopping distance taken because it is too late for a standing van's reach is kept
+/// on the route: a stop short of the start of a van's reach moves with the van (kept, a van
+/// that stood and rolled on 3 m would hold the vehicle at the first place), and a kept line
+/// more than a metre behind the vehicle holds nothing.
+#[test]
+fn only_a_stop_too_late_for_a_vans_reach_is_kept_on_the_route() {
+    let config = AutonomyConfig::default();
+    let poses = rules_tests::straight();
+    let van_at = |x: f64| [track(5, 0.0, (x, -5.0), (0.0, 0.0), 0b11)];
+    let mut r = rules();
+    let (first, on) = (van_at(44.0), van_at(47.0));
+    assert_eq!(
+        r.stand_clear(&inputs(&poses, &first, &[], 0.0, 0.0, &config), 40.0),
+        30.0
+    );
+    assert_eq!(r.stand_line, None);
+    let moved_on = inputs(&poses, &on, &[], 0.1, 0.0, &config);
+    assert_eq!(r.stand_clear(&moved_on, 40.0), 33.0);
+    // Too late (12 m/s): kept; behind the vehicle by more than a metre, taken afresh.
+    let fast = inputs(&poses, &first, &[], 0.2, 12.0, &config);
+    assert_eq!(r.stand_clear(&fast, 40.0), 33.0);
+    assert_eq!(r.stand_line, Some(33.0));
+    r.stand_line = Some(-1.5);
+    assert_eq!(r.stand_clear(&fast, 40.0), 33.0);
+    r.stand_line = Some(-0.5);
+    assert_eq!(r.stand_clear(&fast, 40.0), 0.0);
+}

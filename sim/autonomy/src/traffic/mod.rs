@@ -79,8 +79,8 @@ use serde::{Deserialize, Serialize};
 
 pub use body::{at_body, may_have_walked_to, may_reach_body};
 pub use conflict::{
-    first_conflict, first_conflict_straightforward, first_within_standing_reach, passes_standing,
-    stand_clear,
+    StandStop, first_conflict, first_conflict_straightforward, first_within_standing_reach,
+    passes_standing, stand_clear, stand_clear_why,
 };
 pub use predict::{came_there, moved_beyond_its_extent, predict, predict_keeping, surely_moving};
 pub use rules::{BodyHold, LostMover, MoverDecision, MoverInputs, TrafficRules};

@@ -153,6 +153,19 @@ fn a_mover_standing_is_kept_at_its_reach() {
     // Too late to stop short of the reach: as short as it can, not deeper; unless it stops
     // nearer anyway.
     assert_eq!(clear(31.0), Some(31.0));
+    // Which of the two it is: the stopping distance is taken because it is too late.
+    let why = |stopping_m: f64| {
+        let stop = StandStop {
+            stop_at_m: 40.0,
+            stand_back_m: 3.0,
+            stopping_m,
+        };
+        stand_clear_why(&path, &model(), &[], &person, stop, &cfg)
+    };
+    assert_eq!(
+        (why(5.0), why(31.0)),
+        (Some((30.0, false)), Some((31.0, true)))
+    );
     // Within a pose step (0.5 m) of the stop: left where it is.
     assert_eq!(clear(39.6), None);
     assert_eq!(clear(40.0), None);
