@@ -72,6 +72,10 @@ pub struct Driver {
     plan: Option<Plan>,
     speed_command_m_s: f64,
     status: DriverStatus,
+    /// The last plan stood the vehicle short for movers: yielding, or short of a map obstacle
+    /// only for a standing mover's reach (whose status is the obstacle's). The conflict check
+    /// then wants the resume margin after a mover.
+    stood_for_movers: bool,
     /// When the last revolution arrived, seconds (the watchdog's clock).
     last_revolution_s: Option<f64>,
     /// The farthest any circle of the collision model reaches from the vehicle's origin, metres
@@ -120,6 +124,7 @@ impl Driver {
             plan: None,
             speed_command_m_s: 0.0,
             status: DriverStatus::Driving,
+            stood_for_movers: false,
             last_revolution_s: None,
             stopped_since_s: None,
             traffic,
@@ -173,6 +178,7 @@ impl Driver {
     /// start over.
     pub fn restart(&mut self) {
         self.status = DriverStatus::Driving;
+        self.stood_for_movers = false;
         self.stopped_since_s = None;
         self.traffic.restart();
         self.route_s_m = None;
@@ -241,7 +247,7 @@ impl Driver {
             step_m: config.step_m,
             stop_buffer_m: config.stop_buffer_m,
             hidden_after_s: self.config.hidden_after_s,
-            yielding: matches!(self.status, DriverStatus::Yielding { .. }),
+            yielding: self.stood_for_movers,
             traffic: &config.traffic,
         });
         let conflict = decision.conflict;
@@ -255,6 +261,12 @@ impl Driver {
             v = 0.0;
         }
         self.speed_command_m_s = v;
+        let stood_short = v <= 0.0
+            && chosen.collision_at_m != p.chosen().collision_at_m
+            && walk_around.is_none()
+            && body.is_none()
+            && decision.walker.is_none();
+        self.stood_for_movers = stood_short;
         self.status = match conflict {
             _ if let Some(waiting) = walk_around => waiting,
             _ if let Some(held) = body => held,
@@ -267,7 +279,7 @@ impl Driver {
             // (no conflict, no line held for one): what holds it is the obstacle, and a minute
             // of it is a blocked way (variant 38 of `traffic_jet.toml` stood so, yielding to
             // nothing, to its time limit).
-            _ if chosen.collision_at_m != p.chosen().collision_at_m
+            _ if stood_short
                 && (conflict.is_some()
                     || decision.held_for.is_some()
                     || v0 >= 0.05
