@@ -167,4 +167,64 @@ mod tests {
         assert_eq!(ranges(&[3]), "3");
         assert_eq!(ranges(&[3, 7, 8, 9, 12]), "3, 7-9, 12");
     }
+
+    /// A run's record as a campaign writes it: a pilot called for a hidden obstacle, needless
+    /// (nothing there by ground truth) or needed.
+    fn record(index: u64, needless: bool) -> RunRecord {
+        let mut r: RunRecord = serde_json::from_value(serde_json::json!({
+            "index": index, "sample": index, "setting": 0, "seed": 3, "sampled": {},
+            "parameters": {}, "u": [], "end": "waiting_for_hidden_obstacle",
+            "expectations_met": true, "failed": false, "failures": [], "contacts": 0,
+            "contacts_with": [], "min_ttc_s": null, "min_pet_s": null, "obstacles": [],
+            "min_clearance_m": [0.5], "obstacle_clearance_m": 0.5, "static_clearance_m": 1.0,
+            "stops": 1, "deviations": 0, "false_stops": 0, "needless_deviations": 0,
+            "lap_times_s": [], "sim_time_s": 73.1, "wall_time_s": 5.8, "score": 0.5,
+            "failure_file": null,
+            "pilot_call": "hidden_obstacle/mover_lost_at_body",
+            "pilot_call_object": ["fuel_truck_2", 12.16],
+        }))
+        .expect("a record");
+        r.needless_pilot_call = needless;
+        r.needless_file = needless.then(|| format!("needless/{index}.toml"));
+        r
+    }
+
+    /// Two shards, one with a needless pilot call: the merged directory holds its scenario
+    /// file as written and the summary lists it, and only it, among the needless calls.
+    #[test]
+    fn a_merge_keeps_each_needless_calls_scenario_and_lists_it() {
+        let root = std::env::temp_dir().join(format!("taxi-sim-merge-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        let shard = |i: u64, needless: bool| {
+            let dir = root.join(format!("shard{i}"));
+            std::fs::create_dir_all(dir.join("needless")).unwrap();
+            let meta = format!(r#"{{"digest": "d1", "total": 2, "shard": "{i}/2"}}"#);
+            std::fs::write(dir.join("campaign.json"), meta).unwrap();
+            let line = serde_json::to_string(&record(i, needless)).unwrap() + "\n";
+            std::fs::write(dir.join("results.jsonl"), line).unwrap();
+            if needless {
+                std::fs::write(dir.join(format!("needless/{i}.toml")), "# variant 1\n").unwrap();
+            }
+            dir
+        };
+        let (a, b) = (shard(0, false), shard(1, true));
+        let out = root.join("merged");
+        let merged = merge(&[a, b], &out).expect("merged");
+        assert_eq!(merged.records.len(), 2);
+        let kept = std::fs::read_to_string(out.join("needless/1.toml")).expect("copied");
+        assert_eq!(kept, "# variant 1\n");
+        assert!(!out.join("needless/0.toml").exists());
+        let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+        let rows: Vec<&str> = summary
+            .lines()
+            .filter(|l| l.contains("needless/"))
+            .collect();
+        assert_eq!(
+            rows,
+            [
+                "| 1 | hidden_obstacle/mover_lost_at_body | fuel_truck_2 12.16 m | `needless/1.toml` |"
+            ]
+        );
+        let _ = std::fs::remove_dir_all(&root);
+    }
 }
