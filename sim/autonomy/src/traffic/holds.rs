@@ -3,7 +3,7 @@
 //! the known mover standing within reach of a standing vehicle.
 
 use mapper::TrackState;
-use nalgebra::Isometry2;
+use nalgebra::{Isometry2, Point2};
 
 use super::memory::LOST_STANDING_EXTENT_M;
 use super::rules::{BodyHold, MoverInputs, TrafficRules};
@@ -12,11 +12,19 @@ use super::{
     stand_clear_why, surely_moving,
 };
 
+/// The vehicle stands where it stood while it stays within this of it, metres.
+const STOOD_M: f64 = 0.5;
+/// A mover that moved more than this while the vehicle stood came to it, metres: more than a
+/// standing car's box wanders as hits come and go (0.4 m as the jet stood beside one).
+const CAME_M: f64 = 1.0;
+
 impl TrafficRules {
     /// A known mover of `movers` - arriving lately (seen predicted for a second within the last
     /// six, beyond its own extent: not a static object's sliding parts), a person standing
     /// (`is_walker`), or one that drove up longer ago (`drove_up`: a van that stood at the nose
-    /// longer than six seconds, variant 6 of `traffic_jet_speed_profiles.toml`) - standing now
+    /// longer than six seconds, variant 6 of `traffic_jet_speed_profiles.toml`) to the vehicle
+    /// standing (`came_to_the_standing_vehicle`: not a car that made room and stood before the
+    /// vehicle came beside it, `follow_me_car_made_room_beside_the_jet_holds_it.toml`) - standing now
     /// (not [`surely_moving`]) within its reach of the vehicle at `pose`
     /// ([`first_within_standing_reach`]), as what stops the vehicle; `None` with traffic off.
     pub(super) fn standing_at(
@@ -31,7 +39,11 @@ impl TrafficRules {
         }
         movers
             .iter()
-            .filter(|t| self.arriving(t, now_s, cfg) || self.is_walker(t, cfg) || self.drove_up(t))
+            .filter(|t| {
+                self.arriving(t, now_s, cfg)
+                    || self.is_walker(t, cfg)
+                    || (self.drove_up(t) && self.came_to_the_standing_vehicle(t))
+            })
             .find(|t| self.standing_within_reach(t, pose, cfg))
             .map(|t| BodyHold::Seen {
                 at: t.position,
@@ -57,6 +69,36 @@ impl TrafficRules {
     /// (`note_lost_standing`).
     pub(super) fn drove_up(&self, t: &TrackState) -> bool {
         self.walked.contains(&t.id) && came_there(t)
+    }
+
+    /// Notes where the vehicle stands (standing: slower than 0.05 m/s) and where each mover of
+    /// `i` was first seen since it stood there; forgets both once it moves or stands more than
+    /// [`STOOD_M`] from there.
+    pub(super) fn note_stood(&mut self, i: &MoverInputs<'_>) {
+        let here = Point2::from(i.pose.translation.vector);
+        let seen_now = || i.movers.iter().map(|t| (t.id, t.position)).collect();
+        match &mut self.stood {
+            _ if i.speed_m_s >= 0.05 => self.stood = None,
+            Some((at, seen)) if (*at - here).norm() <= STOOD_M => {
+                seen.retain(|(id, _)| i.movers.iter().any(|t| t.id == *id));
+                for t in i.movers {
+                    if !seen.iter().any(|(id, _)| *id == t.id) {
+                        seen.push((t.id, t.position));
+                    }
+                }
+            }
+            _ => self.stood = Some((here, seen_now())),
+        }
+    }
+
+    /// Whether mover `t` moved more than [`CAME_M`] from where it was first seen while the
+    /// vehicle stands where it stands ([`Self::note_stood`]): it came to the standing vehicle;
+    /// one that stood there before the vehicle came beside it did not.
+    pub(super) fn came_to_the_standing_vehicle(&self, t: &TrackState) -> bool {
+        self.stood.as_ref().is_some_and(|(_, seen)| {
+            (seen.iter().find(|(id, _)| *id == t.id))
+                .is_some_and(|(_, p)| (t.position - p).norm() > CAME_M)
+        })
     }
 
     /// Whether `t` is a person standing: a small known mover (up to

@@ -487,3 +487,65 @@ fn only_a_stop_too_late_for_a_vans_reach_is_kept_on_the_route() {
     r.stand_line = Some(-0.5);
     assert_eq!(r.stand_clear(&fast, 40.0), 0.0);
 }
+
+/// A van drives up to the standing jet's nose and stands there (variant 6 of
+/// `traffic_jet_speed_profiles.toml`): seen moving as a mover once, it holds the standing
+/// vehicle longer than the six seconds of arriving, whatever its size; one that travelled no
+/// more than twice its extent and 3 m (a parked car's sliding visible part) does not, nor a car
+/// that stood where it stands before the vehicle came to stand beside it (a follow-me car that
+/// made room: `follow_me_car_made_room_beside_the_jet_holds_it.toml`).
+#[test]
+fn a_van_that_drove_up_to_the_standing_jet_holds_it_past_six_seconds() {
+    let config = AutonomyConfig::default();
+    let poses = rules_tests::straight();
+    let van_at = |y: f64| TrackState {
+        extent_m: 5.6,
+        travel_m: 27.0,
+        ..track(8, 12.0, (4.0, y), (0.0, 0.0), 0b11)
+    };
+    let van = van_at(-5.0);
+    let mut r = rules();
+    r.streaks.push(MoverStreak {
+        id: 8,
+        last_s: 4.0,
+        since_s: 3.0,
+        mover_s: Some(4.0),
+    });
+    r.walked.push(8);
+    let held = |r: &mut TrafficRules, first_seen_y: f64, van: &TrackState| {
+        r.note_stood(&inputs(
+            &poses,
+            &[van_at(first_seen_y)],
+            &[],
+            4.0,
+            0.0,
+            &config,
+        ));
+        r.note_stood(&inputs(
+            &poses,
+            std::slice::from_ref(van),
+            &[],
+            12.0,
+            0.0,
+            &config,
+        ));
+        let pose = Isometry2::identity();
+        r.standing_at(std::slice::from_ref(van), &pose, 12.0, &config.traffic)
+    };
+    assert!(matches!(
+        held(&mut r, -20.0, &van),
+        Some(BodyHold::Seen { .. })
+    ));
+    // It stood 0.9 m from there when the vehicle came to stand: it did not drive up to it.
+    r.stood = None;
+    assert_eq!(held(&mut r, -5.9, &van), None);
+    r.stood = None;
+    let slid = TrackState {
+        travel_m: 14.0,
+        ..van.clone()
+    };
+    assert_eq!(held(&mut r, -20.0, &slid), None);
+    r.stood = None;
+    r.walked.clear();
+    assert_eq!(held(&mut r, -20.0, &van), None);
+}

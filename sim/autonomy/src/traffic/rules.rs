@@ -249,7 +249,13 @@ pub struct TrafficRules {
     /// Where, on the route, the vehicle stands clear of movers (`stand_clear`), kept while
     /// the plans go on moving their stop for them: a place, not a distance ahead.
     pub(super) stand_line: Option<f64>,
+    /// Where the vehicle stands (`None` while it moves), and where each mover was first seen
+    /// since it stood there (see `note_stood`): one that moved since drove up to it.
+    pub(super) stood: Option<(Point2<f64>, Vec<Sighting>)>,
 }
+
+/// A track, and where it was seen.
+pub(super) type Sighting = (u32, Point2<f64>);
 
 impl TrafficRules {
     /// The rules for a vehicle of collision model `model` that accelerates at
@@ -275,6 +281,7 @@ impl TrafficRules {
             candidates: Vec::new(),
             closing: Closing::default(),
             stand_line: None,
+            stood: None,
         }
     }
 
@@ -295,6 +302,7 @@ impl TrafficRules {
         self.closing.clear();
         self.hold = None;
         self.stand_line = None;
+        self.stood = None;
     }
 
     /// The decision about movers for the plan `i`: the caution cap, the conflict, the stop
@@ -332,6 +340,7 @@ impl TrafficRules {
         let body = self.movers_at_body(i.movers, &i.pose, now_s, v0 < 0.05, cfg, i.hidden_after_s);
         // Standing beside a known mover standing within its reach: it may walk or drive on
         // into the airframe (or it touches it already): the vehicle does not move off.
+        self.note_stood(i);
         let body = body.or_else(|| {
             (v0 < 0.05)
                 .then(|| self.standing_at(i.movers, &i.pose, now_s, cfg))

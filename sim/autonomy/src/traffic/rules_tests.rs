@@ -351,33 +351,6 @@ fn a_mover_that_arrived_and_stands_beside_the_standing_jet_holds_it() {
     assert_eq!(r.standing_at(&off, &pose, 5.0, &config.traffic), None);
 }
 
-/// A van drives up to the nose and stands there (variant 6 of `traffic_jet_speed_profiles.toml`):
-/// seen moving as a mover once, it holds the standing vehicle longer than the six seconds of
-/// arriving, whatever its size; one that travelled no more than twice its extent and 3 m (a
-/// parked car's sliding visible part) does not.
-#[test]
-fn a_van_that_drove_up_and_stands_at_the_nose_holds_it_past_six_seconds() {
-    let config = AutonomyConfig::default();
-    let pose = Isometry2::identity();
-    let van = TrackState {
-        extent_m: 5.6,
-        travel_m: 27.0,
-        ..track(8, 12.0, (4.0, -5.0), (0.0, 0.0), 0b11)
-    };
-    let mut r = rules();
-    r.streaks.push(mover_streak(8, 4.0));
-    r.walked.push(8);
-    let held = r.standing_at(std::slice::from_ref(&van), &pose, 12.0, &config.traffic);
-    assert_eq!(held.map(|b| matches!(b, BodyHold::Seen { .. })), Some(true));
-    let slid = TrackState {
-        travel_m: 14.0,
-        ..van.clone()
-    };
-    assert_eq!(r.standing_at(&[slid], &pose, 12.0, &config.traffic), None);
-    r.walked.clear();
-    assert_eq!(r.standing_at(&[van], &pose, 12.0, &config.traffic), None);
-}
-
 /// A van stopped by the road goes on (`van_stopped_by_the_road_goes_on`), where a row of parked
 /// cars a stale map does not hold seems to slide: only a track seen as a mover lately (within
 /// six seconds) that has moved beyond its own extent is arriving.
