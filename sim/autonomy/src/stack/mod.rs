@@ -72,9 +72,10 @@ pub struct Driver {
     plan: Option<Plan>,
     speed_command_m_s: f64,
     status: DriverStatus,
-    /// The last plan stood the vehicle short for movers: yielding, or short of a map obstacle
-    /// only for a standing mover's reach (whose status is the obstacle's). The conflict check
-    /// then wants the resume margin after a mover.
+    /// The last plan stood the vehicle short of where its own plan would stop it (yielding, or
+    /// short of a map obstacle for a standing mover's reach, a caution line or an obstacle
+    /// closing on it - the status then the obstacle's): the conflict check then wants the
+    /// resume margin after a mover (a superset of the yielding status: it errs safe).
     stood_for_movers: bool,
     /// When the last revolution arrived, seconds (the watchdog's clock).
     last_revolution_s: Option<f64>,

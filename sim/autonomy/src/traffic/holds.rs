@@ -3,10 +3,11 @@
 //! the known mover standing within reach of a standing vehicle.
 
 use mapper::TrackState;
-use nalgebra::{Isometry2, Point2};
+use nalgebra::{Isometry2, Point2, Vector2};
 
+use super::body::box_gap_m;
 use super::memory::LOST_STANDING_EXTENT_M;
-use super::rules::{BodyHold, MoverInputs, TrafficRules};
+use super::rules::{BodyHold, MoverInputs, MoverPath, TrafficRules};
 use super::{
     Conflict, StandStop, TimedPath, TrafficConfig, came_there, first_within_standing_reach,
     stand_clear_why, surely_moving,
@@ -14,9 +15,13 @@ use super::{
 
 /// The vehicle stands where it stood while it stays within this of it, metres.
 const STOOD_M: f64 = 0.5;
-/// A mover that moved more than this while the vehicle stood came to it, metres: more than a
-/// standing car's box wanders as hits come and go (0.4 m as the jet stood beside one).
+/// A mover whose box came nearer the standing vehicle's body by more than this came to it,
+/// metres: more than a standing car's box wanders as hits come and go.
 const CAME_M: f64 = 1.0;
+/// Where a mover was this long before the vehicle came to stand is where it was then, seconds:
+/// a van that stopped as the vehicle braked for it came to it; a follow-me car that made room
+/// stood 6.2 s before the jet came to stand beside it (traffic_jet's variant 175).
+const STOOD_GRACE_S: f64 = 3.0;
 
 impl TrafficRules {
     /// A known mover of `movers` - arriving lately (seen predicted for a second within the last
@@ -24,7 +29,9 @@ impl TrafficRules {
     /// (`is_walker`), or one that drove up longer ago (`drove_up`: a van that stood at the nose
     /// longer than six seconds, variant 6 of `traffic_jet_speed_profiles.toml`) to the vehicle
     /// standing (`came_to_the_standing_vehicle`: not a car that made room and stood before the
-    /// vehicle came beside it, `follow_me_car_made_room_beside_the_jet_holds_it.toml`) - standing now
+    /// vehicle came beside it, `follow_me_car_made_room_beside_the_jet_holds_it.toml`; one
+    /// that drove up and stands at the body itself is held there whenever it came,
+    /// `movers_at_body`) - standing now
     /// (not [`surely_moving`]) within its reach of the vehicle at `pose`
     /// ([`first_within_standing_reach`]), as what stops the vehicle; `None` with traffic off.
     pub(super) fn standing_at(
@@ -42,7 +49,7 @@ impl TrafficRules {
             .filter(|t| {
                 self.arriving(t, now_s, cfg)
                     || self.is_walker(t, cfg)
-                    || (self.drove_up(t) && self.came_to_the_standing_vehicle(t))
+                    || (self.drove_up(t) && self.came_to_the_standing_vehicle(t, pose))
             })
             .find(|t| self.standing_within_reach(t, pose, cfg))
             .map(|t| BodyHold::Seen {
@@ -71,34 +78,56 @@ impl TrafficRules {
         self.walked.contains(&t.id) && came_there(t)
     }
 
-    /// Notes where the vehicle stands (standing: slower than 0.05 m/s) and where each mover of
-    /// `i` was first seen since it stood there; forgets both once it moves or stands more than
-    /// [`STOOD_M`] from there.
+    /// Notes where the vehicle came to stand (slower than 0.05 m/s) and where each mover was
+    /// then - [`STOOD_GRACE_S`] before, by its kept path: a van that stopped as the vehicle
+    /// braked for it came to it - or, one first seen since, where first seen; forgets both once
+    /// the vehicle is more than [`STOOD_M`] from there.
     pub(super) fn note_stood(&mut self, i: &MoverInputs<'_>) {
         let here = Point2::from(i.pose.translation.vector);
-        let seen_now = || i.movers.iter().map(|t| (t.id, t.position)).collect();
-        match &mut self.stood {
-            _ if i.speed_m_s >= 0.05 => self.stood = None,
-            Some((at, seen)) if (*at - here).norm() <= STOOD_M => {
-                seen.retain(|(id, _)| i.movers.iter().any(|t| t.id == *id));
-                for t in i.movers {
-                    if !seen.iter().any(|(id, _)| *id == t.id) {
-                        seen.push((t.id, t.position));
-                    }
+        if (self.stood.as_ref()).is_some_and(|(at, _)| (at - here).norm() > STOOD_M) {
+            self.stood = None;
+        }
+        if self.stood.is_none() && i.speed_m_s < 0.05 {
+            let then_s = i.now_s - STOOD_GRACE_S;
+            let then = |p: &MoverPath| {
+                let (first, last) = (p.seen.first()?, p.seen.last()?);
+                Some(
+                    p.at(then_s)
+                        .unwrap_or(if then_s < first.0 { first.1 } else { last.1 }),
+                )
+            };
+            let seen = (self.paths.iter())
+                .filter_map(|p| Some((p.id, then(p)?)))
+                .collect();
+            self.stood = Some((here, seen));
+        }
+        if let Some((_, seen)) = &mut self.stood {
+            for t in i.movers {
+                if !seen.iter().any(|(id, _)| *id == t.id) {
+                    seen.push((t.id, t.position));
                 }
             }
-            _ => self.stood = Some((here, seen_now())),
         }
     }
 
-    /// Whether mover `t` moved more than [`CAME_M`] from where it was first seen while the
-    /// vehicle stands where it stands ([`Self::note_stood`]): it came to the standing vehicle;
-    /// one that stood there before the vehicle came beside it did not.
-    pub(super) fn came_to_the_standing_vehicle(&self, t: &TrackState) -> bool {
-        self.stood.as_ref().is_some_and(|(_, seen)| {
-            (seen.iter().find(|(id, _)| *id == t.id))
-                .is_some_and(|(_, p)| (t.position - p).norm() > CAME_M)
-        })
+    /// Whether mover `t` came to the vehicle standing at `pose` ([`Self::note_stood`]): the box
+    /// of its hits is nearer the body by more than [`CAME_M`] than it was where the mover was
+    /// when the vehicle came to stand. One that stood where it stands before (a car that made
+    /// room), or crept along the body or away from it, did not.
+    pub(super) fn came_to_the_standing_vehicle(
+        &self,
+        t: &TrackState,
+        pose: &Isometry2<f64>,
+    ) -> bool {
+        let Some((_, seen)) = &self.stood else {
+            return false;
+        };
+        seen.iter()
+            .find(|(id, _)| *id == t.id)
+            .is_some_and(|(_, p)| {
+                let gap = |shift: Vector2<f64>| box_gap_m(&self.model, pose, t, &shift);
+                gap(p - t.position) - gap(Vector2::zeros()) > CAME_M
+            })
     }
 
     /// Whether `t` is a person standing: a small known mover (up to

@@ -549,3 +549,46 @@ fn a_van_that_drove_up_to_the_standing_jet_holds_it_past_six_seconds() {
     r.walked.clear();
     assert_eq!(held(&mut r, -20.0, &van), None);
 }
+
+/// Plan by plan through `decide`: a van that drives up to the standing jet and stands within
+/// its reach holds it past the six seconds of arriving, though the jet reads 0.06 m/s once as
+/// it stands; the same van standing there before the jet came to stand does not (a car that
+/// made room: `follow_me_car_made_room_beside_the_jet_holds_it.toml`).
+#[test]
+fn plan_by_plan_a_van_that_drove_up_to_the_standing_jet_holds_it() {
+    let config = AutonomyConfig::default();
+    let poses = rules_tests::straight();
+    let held_at_12_s = |drives_up: bool| {
+        let mut r = rules();
+        r.walked.push(8);
+        let mut body = None;
+        for k in 0..=120 {
+            let t_s = 0.1 * f64::from(k);
+            let moving = drives_up && t_s < 4.0;
+            let y = if drives_up {
+                (-25.5 + 5.0 * t_s).min(-5.5)
+            } else {
+                -5.5
+            };
+            let van = [TrackState {
+                extent_m: 3.0,
+                travel_m: 27.0,
+                ..track(
+                    8,
+                    t_s,
+                    (4.0, y),
+                    (0.0, if moving { 5.0 } else { 0.0 }),
+                    0b11,
+                )
+            }];
+            let speed = if k == 60 { 0.06 } else { 0.0 };
+            body = r
+                .decide(&inputs(&poses, &van, &[], t_s, speed, &config))
+                .body;
+        }
+        body
+    };
+    let held = held_at_12_s(true);
+    assert!(matches!(held, Some(BodyHold::Seen { .. })), "{held:?}");
+    assert_eq!(held_at_12_s(false), None);
+}

@@ -246,11 +246,13 @@ pub struct TrafficRules {
     pub(super) candidates: Vec<TrackState>,
     /// The plans' first collisions with the map, to find one closing on the vehicle.
     pub(super) closing: Closing,
-    /// Where, on the route, the vehicle stands clear of movers (`stand_clear`), kept while
-    /// the plans go on moving their stop for them: a place, not a distance ahead.
+    /// Where, on the route, the vehicle stops as short as it can when it is too late to stop
+    /// short of a standing mover's reach (`stand_clear`), kept while the plans go on moving
+    /// their stop for movers: a place, not a distance ahead.
     pub(super) stand_line: Option<f64>,
-    /// Where the vehicle stands (`None` while it moves), and where each mover was first seen
-    /// since it stood there (see `note_stood`): one that moved since drove up to it.
+    /// Where the vehicle came to stand (`None` once it is away from there), and where each
+    /// mover was then or first seen since (see `note_stood`): one whose box came nearer the
+    /// body since came to it.
     pub(super) stood: Option<(Point2<f64>, Vec<Sighting>)>,
 }
 
