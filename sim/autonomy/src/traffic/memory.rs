@@ -127,6 +127,17 @@ impl TrafficRules {
             .cloned()
             .collect();
         self.note_paths(&others, now_s);
+        // One lost standing that lay within another mover seen now was a part of it (a fuel
+        // truck's corner tracked apart, a follow-me car's front): forgotten for good, as a
+        // dropped track is (`part_of_another`). Kept, it held the jet 25 m off as its walk-to
+        // reach grew (variants 284, 814 and 848 of `traffic_jet.toml`: needless pilot calls).
+        for l in &self.lost_standing {
+            if part_of_another(l, &others, &self.paths, now_s) && !self.parts.contains(&l.id) {
+                self.parts.push(l.id);
+            }
+        }
+        let parts = &self.parts;
+        self.lost_standing.retain(|l| !parts.contains(&l.id));
         // A mover arriving at the body (or, the vehicle standing, one that drove up and stands
         // within its reach: a train seen in flashes as it crawls to the nose makes no streak),
         // or one held there before and not seen away (`still_at_body`).
@@ -411,6 +422,7 @@ impl TrafficRules {
         let lost = &self.lost_standing;
         self.walked
             .retain(|id| movers.iter().any(|t| t.id == *id) || lost.iter().any(|l| l.id == *id));
+        self.parts.retain(|id| movers.iter().any(|t| t.id == *id));
         self.lost_standing.retain(|l| {
             now_s - l.t_s < LOST_STANDING_FOR_S
                 && !movers.iter().any(|t| t.id == l.id && now_s - t.t_s <= 0.25)

@@ -592,3 +592,60 @@ fn plan_by_plan_a_van_that_drove_up_to_the_standing_jet_holds_it() {
     assert!(matches!(held, Some(BodyHold::Seen { .. })), "{held:?}");
     assert_eq!(held_at_12_s(false), None);
 }
+
+/// A fuel truck's corner tracked apart stands and drops while the truck crosses on (variants
+/// 284 and 814 of `traffic_jet.toml`): it lay within the truck, seen now, so it was part of it -
+/// not a person lost standing whose walk-to reach grows until it holds the jet 25 m off. Once
+/// taken for a part it stays one, the truck's kept path long gone. A person lost standing
+/// beyond the truck's extent is still kept.
+#[test]
+fn a_trucks_corner_lost_standing_is_part_of_the_truck_not_a_person() {
+    let config = AutonomyConfig::default();
+    let (cfg, hidden_after_s) = (&config.traffic, config.hidden_after_s);
+    let pose = Isometry2::identity();
+    let truck = |t_s: f64| TrackState {
+        extent_m: 9.0,
+        ..track(
+            32,
+            t_s,
+            (14.0, -12.0 - 1.4 * (t_s - 10.0)),
+            (0.0, -1.4),
+            0b01,
+        )
+    };
+    let kept = |corner_y: f64| {
+        let corner = TrackState {
+            extent_m: 0.4,
+            ..track(31, 10.0, (12.5, corner_y), (0.0, 0.0), 0b01)
+        };
+        let mut r = rules();
+        r.streaks.push(rules_tests::mover_streak(31, 9.0));
+        r.movers_at_body(
+            &[corner.clone(), truck(10.0)],
+            &pose,
+            10.0,
+            false,
+            cfg,
+            hidden_after_s,
+        );
+        // The corner drops from view; the truck crosses on, then the jet stands, 40 s later.
+        let mut held = Vec::new();
+        for k in 1..=80 {
+            let now = 10.0 + 0.5 * k as f64;
+            r.movers_at_body(
+                &[corner.clone(), truck(now)],
+                &pose,
+                now,
+                true,
+                cfg,
+                hidden_after_s,
+            );
+            held.push(r.lost_standing.iter().any(|l| l.id == 31));
+        }
+        held
+    };
+    // 1.5 m from the truck's centre when it dropped: never kept.
+    assert!(kept(-10.5).iter().all(|k| !k));
+    // 11 m from it, beyond the truck's 9 m: kept throughout.
+    assert!(kept(-1.0).iter().all(|k| *k));
+}

@@ -232,6 +232,9 @@ pub struct TrafficRules {
     pub(super) lost_standing: Vec<TrackState>,
     /// The tracks seen moving as movers for `MOVER_FOR_S` on end at some time.
     pub(super) walked: Vec<u32>,
+    /// The tracks lost standing within another mover (see `part_of_another`): parts of it,
+    /// never kept as lost standing while the tracker keeps them.
+    pub(super) parts: Vec<u32>,
     /// The tracks taken for movers lost at the body seen again (see `seen_elsewhere`): each
     /// lets go of one only.
     pub(super) claimed: Vec<u32>,
@@ -277,6 +280,7 @@ impl TrafficRules {
             streaks: Vec::new(),
             lost_standing: Vec::new(),
             walked: Vec::new(),
+            parts: Vec::new(),
             claimed: Vec::new(),
             walker_stop: None,
             paths: Vec::new(),
@@ -298,6 +302,7 @@ impl TrafficRules {
         self.streaks.clear();
         self.lost_standing.clear();
         self.walked.clear();
+        self.parts.clear();
         self.claimed.clear();
         self.paths.clear();
         self.candidates.clear();

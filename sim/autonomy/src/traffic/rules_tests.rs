@@ -95,7 +95,7 @@ pub(super) fn inputs<'a>(
 }
 
 /// A streak that made track `id` a mover at `mover_s`.
-fn mover_streak(id: u32, mover_s: f64) -> MoverStreak {
+pub(super) fn mover_streak(id: u32, mover_s: f64) -> MoverStreak {
     MoverStreak {
         id,
         last_s: mover_s,
