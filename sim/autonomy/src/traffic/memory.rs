@@ -66,6 +66,11 @@ const DRIVEN_THROUGH_M: f64 = 0.75;
 /// seconds, when its kept path does not reach back (a candidate then).
 const CARRIED_BACK_S: f64 = 3.0;
 
+/// ... or, lost at this extent or more, metres (a fuel truck, a train: what the tracker follows
+/// as two tracks of its parts; a van is 5.6 m, a cart 2), that was the same object tracked
+/// twice and has gone on whole.
+const TRACKED_TWICE_M: f64 = 8.0;
+
 /// A held mover whose box steps away from the body by this much more than its speed explains,
 /// metres, is seen away only in part ([`TrafficRules::still_at_body`]): a box's near edge
 /// wanders a cell or two as hits come and go; a train's went 2.2 m in a revolution as its tug
@@ -312,11 +317,13 @@ impl TrafficRules {
         others
             .iter()
             .filter(|o| o.id != lost.id && now_s - o.t_s <= 0.25 && o.levels & lost.levels != 0)
-            .filter(|o| moved_beyond_its_extent(o, cfg) && o.velocity.norm() >= LEFT_WITH_M_S)
-            .filter(|o| o.velocity.angle(&lost.velocity) <= LEFT_WITH_RAD)
+            .filter(|o| o.velocity.norm() >= LEFT_WITH_M_S)
             .any(|o| {
+                let its_way = moved_beyond_its_extent(o, cfg)
+                    && o.velocity.angle(&lost.velocity) <= LEFT_WITH_RAD;
                 let path = self.paths.iter().find(|p| p.id == o.id);
-                let drove_through = (o.position - lost.at).dot(&way) > DRIVEN_THROUGH_M
+                let drove_through = its_way
+                    && (o.position - lost.at).dot(&way) > DRIVEN_THROUGH_M
                     && path.is_some_and(|p| {
                         (p.seen.iter()).any(|(s, at)| *s > lost.seen_s && near(at))
                     });
@@ -324,10 +331,30 @@ impl TrafficRules {
                     ((o.t_s - lost.seen_s).abs() <= CARRIED_BACK_S)
                         .then(|| o.position + o.velocity * (lost.seen_s - o.t_s))
                 });
-                let carried_on = o.extent_m >= lost.extent_m
+                let carried_on = its_way
+                    && o.extent_m >= lost.extent_m
                     && o.born_s <= lost.seen_s
                     && then.is_some_and(|p| (p - lost.at).norm() <= 0.5 * o.extent_m);
-                drove_through || carried_on
+                // One long object tracked twice: of about its extent (`e`, the larger, no more than
+                // twice the other), tracked since before, that place within `e` where it was
+                // kept within `CARRIED_BACK_S` of then (a candidate till then, maybe); since
+                // moved beyond `e` from there (no static object's hits do), now beyond that
+                // place the way `lost` went by more than `e` - all of it gone from there,
+                // whatever part `lost` was (a jump as its hits were taken over turns its way).
+                let e = o.extent_m.max(lost.extent_m);
+                let kept_near = path.and_then(|p| {
+                    (p.seen.iter())
+                        .find(|(s, at)| {
+                            (s - lost.seen_s).abs() <= CARRIED_BACK_S && (at - lost.at).norm() <= e
+                        })
+                        .map(|&(_, at)| at)
+                });
+                let gone_as_one = lost.extent_m >= TRACKED_TWICE_M
+                    && o.extent_m.min(lost.extent_m) >= 0.5 * e
+                    && o.born_s <= lost.seen_s
+                    && kept_near.is_some_and(|p| (o.position - p).norm() > e)
+                    && (o.position - lost.at).dot(&way) > e + DRIVEN_THROUGH_M;
+                drove_through || carried_on || gone_as_one
             })
     }
 

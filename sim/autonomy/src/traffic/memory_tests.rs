@@ -212,6 +212,54 @@ fn a_cart_lost_at_the_nose_is_let_go_once_its_train_carries_it_on() {
     assert!(still_held(lost, &unkept));
 }
 
+/// A fuel truck crossing before the standing jet's nose, tracked twice (variants 439 and 930 of
+/// `traffic_jet.toml`): its rear's track, 9.6 m across, jumps as the other takes its hits and
+/// is lost at the nose going 45 degrees off the truck's way; the other, of about its extent and
+/// tracked since before, first kept 2.5 s later 7.4 m from it (a candidate till then), drives
+/// on. Once that one is beyond the place by more than the extent, the way the rear went, and
+/// has moved as far from where it was kept, all of the truck has gone: let go. Not before; not
+/// for a track under half the extent, one first seen after the rear was lost, or one kept only
+/// 4 s later; nor if the rear was standing, or a van's (5.6 m: two vans are not one).
+#[test]
+fn a_trucks_rear_lost_at_the_nose_is_let_go_once_the_truck_has_gone_on() {
+    let rear = |vx: f64, vy: f64| rules::AtBody {
+        extent_m: 9.6,
+        velocity: Vector2::new(vx, vy),
+        ..cart_lost_at_the_nose(9.6, vy)
+    };
+    // Track 22 of `extent_m`, first seen at `born_s`, kept from `from_s` to `to_s` at (3, y)
+    // going 1.6 m/s down from y = `y0` at 3.5 s.
+    let track_from = |y0: f64, extent_m: f64, born_s: f64, from_s: f64, to_s: f64| {
+        let steps = ((to_s - from_s) / 0.5).round() as usize;
+        (0..=steps)
+            .map(|k| {
+                let t_s = from_s + 0.5 * k as f64;
+                let y = y0 - 1.6 * (t_s - 3.5);
+                let t = TrackState {
+                    extent_m,
+                    born_s,
+                    ..track(22, t_s, (3.0, y), (0.0, -1.6), 0b01)
+                };
+                (t_s, vec![t])
+            })
+            .collect::<Vec<_>>()
+    };
+    let truck = |extent_m, born_s, from_s, to_s| track_from(-5.5, extent_m, born_s, from_s, to_s);
+    let going = rear(1.4, -1.8);
+    assert!(!still_held(going, &truck(9.5, -5.0, 3.5, 10.0)));
+    assert!(still_held(going, &truck(9.5, -5.0, 3.5, 9.0)));
+    assert!(still_held(going, &truck(4.5, -5.0, 3.5, 20.0)));
+    assert!(still_held(going, &truck(9.5, 2.0, 3.5, 20.0)));
+    assert!(still_held(going, &truck(9.5, -5.0, 5.0, 20.0)));
+    assert!(still_held(rear(0.0, 0.0), &truck(9.5, -5.0, 3.5, 20.0)));
+    let van = rules::AtBody {
+        extent_m: 5.6,
+        ..going
+    };
+    // The other 4.4 m from it then: within a van's extent too.
+    assert!(still_held(van, &track_from(-2.5, 5.6, -5.0, 3.5, 20.0)));
+}
+
 /// The front of a follow-me car, lost coasting towards the standing jet, while the car backs
 /// aside so slowly that the tracker holds it only as a candidate again (variant 92 of
 /// `traffic_jet.toml`): the car was a mover lately, so its path is kept and tells that the
