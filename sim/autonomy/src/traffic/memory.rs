@@ -66,9 +66,9 @@ const DRIVEN_THROUGH_M: f64 = 0.75;
 /// seconds, when its kept path does not reach back (a candidate then).
 const CARRIED_BACK_S: f64 = 3.0;
 
-/// ... or, lost at this extent or more, metres (a fuel truck, a train: what the tracker follows
-/// as two tracks of its parts; a van is 5.6 m, a cart 2), that was the same object tracked
-/// twice and has gone on whole.
+/// ... or, it and the other this extent or more, metres (a fuel truck, a train: what the
+/// tracker follows as two tracks of its parts; a van is 5.6 m, a cart 2), that was the same
+/// object tracked twice and has gone on whole ([`TrafficRules::gone_as_one`]).
 const TRACKED_TWICE_M: f64 = 8.0;
 
 /// A held mover whose box steps away from the body by this much more than its speed explains,
@@ -132,12 +132,12 @@ impl TrafficRules {
             .cloned()
             .collect();
         self.note_paths(&others, now_s);
-        // One lost standing that lay within another mover seen now was a part of it (a fuel
-        // truck's corner tracked apart, a follow-me car's front): forgotten for good, as a
-        // dropped track is (`part_of_another`). Kept, it held the jet 25 m off as its walk-to
-        // reach grew (variants 284, 814 and 848 of `traffic_jet.toml`: needless pilot calls).
+        // One lost standing that was a part of another mover carried on (`carried_part`: a
+        // fuel truck's corner tracked apart, a follow-me car's front) is forgotten while it
+        // stays out of view. Kept, it held the jet 25 m off as its walk-to reach grew
+        // (variants 284, 814 and 848 of `traffic_jet.toml`: needless pilot calls).
         for l in &self.lost_standing {
-            if part_of_another(l, &others, &self.paths, now_s) && !self.parts.contains(&l.id) {
+            if carried_part(l, &others, &self.paths, now_s) && !self.parts.contains(&l.id) {
                 self.parts.push(l.id);
             }
         }
@@ -301,7 +301,10 @@ impl TrafficRules {
     /// - or carried it on: as large or larger, tracked since before `lost` was last seen, its
     ///   centre then within half its extent of that place (on its kept path, or within
     ///   [`CARRIED_BACK_S`] as its motion says: a candidate then) - the carts of a train the
-    ///   tracker takes for one object, one of them lost as its hits join the train's track.
+    ///   tracker takes for one object, one of them lost as its hits join the train's track;
+    /// - or, going at [`LEFT_WITH_M_S`] or more whatever its extent's travel and its way, was
+    ///   one long object with `lost`, tracked twice, that has gone on whole
+    ///   ([`Self::gone_as_one`]).
     fn left_with_others(
         &self,
         lost: &AtBody,
@@ -335,27 +338,46 @@ impl TrafficRules {
                     && o.extent_m >= lost.extent_m
                     && o.born_s <= lost.seen_s
                     && then.is_some_and(|p| (p - lost.at).norm() <= 0.5 * o.extent_m);
-                // One long object tracked twice: of about its extent (`e`, the larger, no more than
-                // twice the other), tracked since before, that place within `e` where it was
-                // kept within `CARRIED_BACK_S` of then (a candidate till then, maybe); since
-                // moved beyond `e` from there (no static object's hits do), now beyond that
-                // place the way `lost` went by more than `e` - all of it gone from there,
-                // whatever part `lost` was (a jump as its hits were taken over turns its way).
-                let e = o.extent_m.max(lost.extent_m);
-                let kept_near = path.and_then(|p| {
-                    (p.seen.iter())
-                        .find(|(s, at)| {
-                            (s - lost.seen_s).abs() <= CARRIED_BACK_S && (at - lost.at).norm() <= e
-                        })
-                        .map(|&(_, at)| at)
-                });
-                let gone_as_one = lost.extent_m >= TRACKED_TWICE_M
-                    && o.extent_m.min(lost.extent_m) >= 0.5 * e
-                    && o.born_s <= lost.seen_s
-                    && kept_near.is_some_and(|p| (o.position - p).norm() > e)
-                    && (o.position - lost.at).dot(&way) > e + DRIVEN_THROUGH_M;
+                let gone_as_one = path.is_some_and(|p| self.gone_as_one(lost, o, p));
                 drove_through || carried_on || gone_as_one
             })
+    }
+
+    /// Whether `lost` (a mover lost at the body going, see [`Self::left_with_others`]) and `o`,
+    /// kept on `path`, were one long object tracked twice that has gone on whole: both
+    /// [`TRACKED_TWICE_M`] across or more (a fuel truck, a train; not a van, 5.6 m), `o` tracked
+    /// since before `lost` was last seen; its sighting nearest then, within [`CARRIED_BACK_S`]
+    /// (a candidate till then, maybe), within `e` (the larger extent) of that place; since moved
+    /// beyond `e` from there (no static object's hits do), along a line that passes within a
+    /// quarter of `e` of that place (not a vehicle in the next lane), the way `lost` went, and
+    /// now beyond that place by more than `e` - all of it gone from there, whatever part `lost`
+    /// was. Its own line, not `lost`'s way: a jump as the other took its hits turns that 40
+    /// degrees (variants 439 and 930 of `traffic_jet.toml`, a fuel truck's rear lost at the nose).
+    fn gone_as_one(&self, lost: &AtBody, o: &TrackState, path: &MoverPath) -> bool {
+        let e = o.extent_m.max(lost.extent_m);
+        if o.extent_m.min(lost.extent_m) < TRACKED_TWICE_M || o.born_s > lost.seen_s {
+            return false;
+        }
+        let nearest_then = (path.seen.iter())
+            .filter(|(s, _)| (s - lost.seen_s).abs() <= CARRIED_BACK_S)
+            .min_by(|a, b| {
+                (a.0 - lost.seen_s)
+                    .abs()
+                    .total_cmp(&(b.0 - lost.seen_s).abs())
+            });
+        let Some(&(_, from)) = nearest_then else {
+            return false;
+        };
+        let moved = o.position - from;
+        if (from - lost.at).norm() > e || moved.norm() <= e {
+            return false;
+        }
+        let line = moved.normalize();
+        let off = lost.at - from;
+        let aside = (off - line * off.dot(&line)).norm();
+        aside <= 0.25 * e
+            && lost.velocity.dot(&line) > 0.0
+            && (o.position - lost.at).dot(&line) > e + DRIVEN_THROUGH_M
     }
 
     /// Mover `t` at the body of the vehicle at `pose`, as held there: its velocity over its
@@ -449,7 +471,9 @@ impl TrafficRules {
         let lost = &self.lost_standing;
         self.walked
             .retain(|id| movers.iter().any(|t| t.id == *id) || lost.iter().any(|l| l.id == *id));
-        self.parts.retain(|id| movers.iter().any(|t| t.id == *id));
+        // A part seen again is a track like any other: judged afresh if lost again.
+        self.parts
+            .retain(|id| movers.iter().any(|t| t.id == *id && now_s - t.t_s > 0.25));
         self.lost_standing.retain(|l| {
             now_s - l.t_s < LOST_STANDING_FOR_S
                 && !movers.iter().any(|t| t.id == l.id && now_s - t.t_s <= 0.25)
@@ -547,5 +571,33 @@ fn part_of_another(t: &TrackState, movers: &[TrackState], paths: &[MoverPath], n
             && o.levels & t.levels != 0
             && o.extent_m >= t.extent_m
             && (then - t.position).norm() <= o.extent_m
+    })
+}
+
+/// Whether `t`, a mover lost standing, was a part of another of `movers` (the movers, and the
+/// candidates that were movers lately) that carried it on: one seen now, no smaller than it,
+/// hit in a level it was, tracked since before `t` was last seen, whose centre was then within
+/// half its extent of `t` and that was going at [`LEFT_WITH_M_S`] or more then - on its kept
+/// path (its speed over the second before), or within [`CARRIED_BACK_S`] as its motion says.
+/// A fuel truck's corner tracked apart as the truck crosses, a follow-me car's front as the car
+/// drives off. Not a person beside a truck standing; not decided once where the other was then
+/// is no longer known.
+fn carried_part(t: &TrackState, movers: &[TrackState], paths: &[MoverPath], now_s: f64) -> bool {
+    movers.iter().any(|o| {
+        let path = paths.iter().find(|p| p.id == o.id);
+        let kept = path.and_then(|p| Some((p.at(t.t_s)?, p.at(t.t_s - 1.0)?)));
+        let then = match kept {
+            Some((at, before)) => Some((at, (at - before).norm())),
+            None => ((o.t_s - t.t_s).abs() <= CARRIED_BACK_S)
+                .then(|| (o.position + o.velocity * (t.t_s - o.t_s), o.velocity.norm())),
+        };
+        o.id != t.id
+            && now_s - o.t_s <= 0.25
+            && o.levels & t.levels != 0
+            && o.extent_m >= t.extent_m
+            && o.born_s <= t.t_s
+            && then.is_some_and(|(at, speed)| {
+                (at - t.position).norm() <= 0.5 * o.extent_m && speed >= LEFT_WITH_M_S
+            })
     })
 }
