@@ -137,7 +137,7 @@ impl TrafficRules {
         // stays out of view. Kept, it held the jet 25 m off as its walk-to reach grew
         // (variants 284, 814 and 848 of `traffic_jet.toml`: needless pilot calls).
         for l in &self.lost_standing {
-            if carried_part(l, &others, &self.paths, now_s) && !self.parts.contains(&l.id) {
+            if !self.parts.contains(&l.id) && carried_part(l, &others, &self.paths, now_s) {
                 self.parts.push(l.id);
             }
         }
@@ -330,10 +330,8 @@ impl TrafficRules {
                     && path.is_some_and(|p| {
                         (p.seen.iter()).any(|(s, at)| *s > lost.seen_s && near(at))
                     });
-                let then = (path.and_then(|p| p.at(lost.seen_s))).or_else(|| {
-                    ((o.t_s - lost.seen_s).abs() <= CARRIED_BACK_S)
-                        .then(|| o.position + o.velocity * (lost.seen_s - o.t_s))
-                });
+                let then =
+                    (path.and_then(|p| p.at(lost.seen_s))).or_else(|| read_back(o, lost.seen_s));
                 let carried_on = its_way
                     && o.extent_m >= lost.extent_m
                     && o.born_s <= lost.seen_s
@@ -588,8 +586,7 @@ fn carried_part(t: &TrackState, movers: &[TrackState], paths: &[MoverPath], now_
         let kept = path.and_then(|p| Some((p.at(t.t_s)?, p.at(t.t_s - 1.0)?)));
         let then = match kept {
             Some((at, before)) => Some((at, (at - before).norm())),
-            None => ((o.t_s - t.t_s).abs() <= CARRIED_BACK_S)
-                .then(|| (o.position + o.velocity * (t.t_s - o.t_s), o.velocity.norm())),
+            None => read_back(o, t.t_s).map(|at| (at, o.velocity.norm())),
         };
         o.id != t.id
             && now_s - o.t_s <= 0.25
@@ -600,4 +597,10 @@ fn carried_part(t: &TrackState, movers: &[TrackState], paths: &[MoverPath], now_
                 (at - t.position).norm() <= 0.5 * o.extent_m && speed >= LEFT_WITH_M_S
             })
     })
+}
+
+/// Where track `o` was at `t_s` as its motion says, if `t_s` is within [`CARRIED_BACK_S`] of when
+/// it was last seen (further back, its constant velocity tells nothing).
+fn read_back(o: &TrackState, t_s: f64) -> Option<Point2<f64>> {
+    ((o.t_s - t_s).abs() <= CARRIED_BACK_S).then(|| o.position + o.velocity * (t_s - o.t_s))
 }
