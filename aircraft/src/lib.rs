@@ -33,4 +33,4 @@ pub use shapes::{Part, Shape};
 pub use spec::{
     DEFAULT_OVERHEAD_CLEARANCE_M, ExtraLidar, LidarMount, MotionLimits, Steering, VehicleSpec,
 };
-pub use vehicle::{SHIPPED_VEHICLES, Vehicle};
+pub use vehicle::{FIT_MEMO_SIZE, SHIPPED_VEHICLES, Vehicle};

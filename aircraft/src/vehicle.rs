@@ -165,15 +165,37 @@ impl Vehicle {
 
     /// Fits the circle model with the spec's heights of interest and fit options.
     pub fn fit(&self) -> Result<FittedModel> {
-        fit_parts(
-            &self.parts,
-            &self.spec.heights_of_interest_m,
-            &self.spec.fit,
-        )
+        self.fit_with(&self.spec.heights_of_interest_m, &self.spec.fit)
     }
 
-    /// Fits the circle model with other heights or options.
+    /// Fits the circle model with other heights or options. A run asks for the same fits more
+    /// than once (its collision model, then the self-hit filter's banded model for the online map
+    /// and again for the localizer's), and every run of a campaign for the same ones: the last
+    /// [`FIT_MEMO_SIZE`] fits are kept, process-wide, keyed by the parts, heights and options
+    /// exactly (their debug text: floats print in the shortest form that reads back to the same
+    /// bits). [`fit_parts`] is a pure function, so a kept fit is the fit.
     pub fn fit_with(&self, heights_m: &[f64], options: &FitOptions) -> Result<FittedModel> {
-        fit_parts(&self.parts, heights_m, options)
+        let key = format!("{:?}|{heights_m:?}|{options:?}", self.parts);
+        let memo = || {
+            FIT_MEMO
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+        };
+        if let Some((_, fit)) = memo().iter().find(|(k, _)| *k == key) {
+            return Ok(fit.clone());
+        }
+        let fit = fit_parts(&self.parts, heights_m, options)?;
+        let mut kept = memo();
+        if kept.len() >= FIT_MEMO_SIZE {
+            kept.remove(0);
+        }
+        kept.push((key, fit.clone()));
+        Ok(fit)
     }
 }
+
+/// How many fits [`Vehicle::fit_with`] keeps (a campaign's vehicles: two fits each).
+pub const FIT_MEMO_SIZE: usize = 16;
+
+/// The fits kept, oldest first, each under its key.
+static FIT_MEMO: std::sync::Mutex<Vec<(String, FittedModel)>> = std::sync::Mutex::new(Vec::new());

@@ -213,7 +213,8 @@ fn jet_fit_has_tens_of_varied_circles_and_is_deterministic() {
     for k in 0..2 {
         assert!(fit.model.circles().iter().any(|c| c.level == k));
     }
-    assert_eq!(jet.fit().expect("again"), fit);
+    let direct = aircraft::fit_parts(&jet.parts, &jet.spec.heights_of_interest_m, &jet.spec.fit);
+    assert_eq!(direct.expect("fit without the memo"), fit);
     // More circles, tighter: the overshoot falls.
     let loose = evaluate(&fit, 200);
     let tight_fit = jet
@@ -229,6 +230,46 @@ fn jet_fit_has_tens_of_varied_circles_and_is_deterministic() {
     for (a, b) in loose.iter().zip(&tight) {
         assert!(b.area_ratio < a.area_ratio, "level {}", a.level);
     }
+}
+
+/// The fits a vehicle keeps answer as fitting anew, whatever the order they are asked in: other
+/// heights, other options and another vehicle's parts each get their own fit, and more fits than
+/// are kept (the oldest then fitted again) too.
+#[test]
+fn kept_fits_answer_as_fitting_anew() {
+    let jet = Vehicle::shipped("praetor600").expect("jet");
+    let car = Vehicle::shipped("iara_car_fake_wing").expect("car");
+    let banded = FitOptions {
+        banded_maps: true,
+        ..jet.spec.fit.clone()
+    };
+    let budget = |n| FitOptions {
+        max_circles: Some(n),
+        ..FitOptions::default()
+    };
+    let mut asks: Vec<(&Vehicle, Vec<f64>, FitOptions)> = vec![
+        (&jet, vec![0.0, 1.1], jet.spec.fit.clone()),
+        (&jet, vec![0.0, 1.1], banded.clone()),
+        (&jet, vec![0.0, 1.3], jet.spec.fit.clone()),
+        (&car, vec![0.0, 1.1], jet.spec.fit.clone()),
+    ];
+    asks.extend((0..aircraft::FIT_MEMO_SIZE).map(|i| (&car, vec![0.0], budget(8 + i))));
+    let firsts: Vec<_> = asks.iter().take(4).cloned().collect();
+    asks.extend(firsts.iter().cloned().rev());
+    let mut distinct = Vec::new();
+    for (v, heights, options) in &asks {
+        let kept = v.fit_with(heights, options).expect("fit");
+        let anew = aircraft::fit_parts(&v.parts, heights, options).expect("fit anew");
+        assert_eq!(kept, anew, "{heights:?} {options:?}");
+        if !distinct.contains(&kept.model) {
+            distinct.push(kept.model);
+        }
+    }
+    assert!(
+        distinct.len() >= 12,
+        "the asks give different fits: {}",
+        distinct.len()
+    );
 }
 
 #[test]
