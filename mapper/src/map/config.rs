@@ -58,6 +58,17 @@ pub struct MapConfig {
     /// open, the cells of an object hit only at the sensor's height and above are crossed by no
     /// other beam. Lower it for a sensor that misses dark objects nearer.
     pub no_echo_clears_within_m: f64,
+    /// The sensor's intensity calibration: its returns' intensity falls off with range as
+    /// `exp(-falloff r)`, per metre, so a return's remission is its intensity times `exp(falloff
+    /// r)` (at most 1; [`MapConfig::remission_of`]). The remission layer holds remissions, and the
+    /// localizer compares remissions with it: a cell surveyed at 40 m then reads the same seen
+    /// from 10 m (a real stack's calibrated reflectivity). The shipped HDL-32E model's falloff
+    /// is 0.004 (`[lidar] atmosphere_attenuation_rate`): set that for a map surveyed along other
+    /// lines than the run drives (an airport's survey: `tests/found/xtsm_*_survey_*`). Default
+    /// 0, intensities as they come: a map driven along the run's own route reads each cell from
+    /// about the ranges the run does (docs/results.md, "Airports", for what the default's change
+    /// would move).
+    pub intensity_falloff_per_m: f64,
 }
 
 /// Which columns of a scan walk free space, and where.
@@ -110,6 +121,7 @@ impl Default for MapConfig {
             free_space_stop: FreeSpaceStop::ScanHits,
             free_space_walks: FreeSpaceWalks::CoarseToFine,
             no_echo_clears_within_m: 30.0,
+            intensity_falloff_per_m: 0.0,
         }
     }
 }
@@ -179,11 +191,75 @@ impl MapConfig {
                 format!("{}: must be >= 0", self.no_echo_clears_within_m),
             ));
         }
+        let f = self.intensity_falloff_per_m;
+        if !(f.is_finite() && (0.0..=0.1).contains(&f)) {
+            return Err(MapError::invalid(
+                "intensity_falloff_per_m",
+                format!("{f}: must be in [0, 0.1] (per metre)"),
+            ));
+        }
         Ok(())
+    }
+
+    /// The remission of a return of `intensity` at `range_m` from the sensor: the intensity with
+    /// the sensor's falloff over that range taken out (`intensity_falloff_per_m`), at most 1.
+    pub fn remission_of(&self, intensity: f32, range_m: f32) -> f32 {
+        if self.intensity_falloff_per_m == 0.0 {
+            return intensity;
+        }
+        (intensity * (self.intensity_falloff_per_m as f32 * range_m).exp()).min(1.0)
     }
 
     /// Side of a block in metres.
     pub fn block_m(&self) -> f64 {
         self.block_cells as f64 * self.resolution_m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A return's remission is its intensity with the falloff over its range taken out: the same
+    /// cell reads the same from 5 m and from 60 m, as it was before the sensor's falloff, and at
+    /// most 1; with no falloff the intensity as it came; a falloff out of range is refused.
+    #[test]
+    fn a_returns_remission_does_not_depend_on_its_range() {
+        let config = MapConfig {
+            intensity_falloff_per_m: 0.004,
+            ..MapConfig::default()
+        };
+        let falloff = config.intensity_falloff_per_m;
+        for remission in [0.05f32, 0.3, 0.8, 1.0] {
+            for range in [0.5f32, 5.0, 20.0, 60.0, 100.0] {
+                let intensity = remission * (-(falloff as f32) * range).exp();
+                let back = config.remission_of(intensity, range);
+                assert!(
+                    (back - remission).abs() <= 1e-6 && back <= 1.0,
+                    "{remission} at {range} m: read {intensity}, taken back to {back}"
+                );
+                // Without the calibration the far reading is off by the falloff.
+                if range >= 60.0 {
+                    assert!(remission - intensity > 0.2 * remission);
+                }
+            }
+        }
+        assert_eq!(config.remission_of(0.99, 80.0), 1.0, "capped at 1");
+        let raw = MapConfig::default();
+        assert_eq!(
+            raw.intensity_falloff_per_m, 0.0,
+            "the default takes them as they come"
+        );
+        assert_eq!(raw.remission_of(0.37, 80.0), 0.37);
+        raw.validate().expect("0 is a falloff");
+        for bad in [-0.001, f64::NAN, 0.5] {
+            let e = MapConfig {
+                intensity_falloff_per_m: bad,
+                ..config
+            }
+            .validate()
+            .expect_err("refused");
+            assert!(e.to_string().contains("intensity_falloff_per_m"), "{e}");
+        }
     }
 }

@@ -180,7 +180,7 @@ impl MultiHeightMap {
                 let rem = self.live_remission.data_mut();
                 for (c, r) in ctx.classified.iter().zip(scan.returns()) {
                     if let (Some(r), false, true) = (r, c.obstacle, c.cell != DROPPED) {
-                        rem[c.cell as usize].add(r.intensity);
+                        rem[c.cell as usize].add(config.remission_of(r.intensity, r.range_m));
                     }
                 }
             },

@@ -62,7 +62,13 @@ pub fn figures_for(
     pf.initialise(&start)?;
     let self_filter = crate::offline_map::self_filter_model(vehicle)?;
     let margin = run.mapping.map.self_hit_margin_m;
-    let obs = Observation::from_revolution(&revolution, &config, Some(&self_filter), margin);
+    let obs = Observation::from_revolution(
+        &revolution,
+        &config,
+        Some(&self_filter),
+        margin,
+        &run.mapping.map,
+    );
     figures(
         &mut pf,
         &revolution,
@@ -131,10 +137,17 @@ fn figures(
             &config,
             Some(self_filter),
             margin,
+            pf.map().config(),
         ));
     });
     let update = median_seconds(samples, 5, || {
-        let o = Observation::from_revolution(revolution, &config, Some(self_filter), margin);
+        let o = Observation::from_revolution(
+            revolution,
+            &config,
+            Some(self_filter),
+            margin,
+            pf.map().config(),
+        );
         let mut stats = UpdateStats::default();
         pf.measurement_update(&o, &mut stats);
     });

@@ -455,8 +455,13 @@ impl ParticleFilter {
         self_filter: Option<&CollisionModel>,
         self_margin_m: f64,
     ) -> Result<UpdateStats, mapper::MapError> {
-        let mut obs =
-            Observation::from_revolution(revolution, &self.config, self_filter, self_margin_m);
+        let mut obs = Observation::from_revolution(
+            revolution,
+            &self.config,
+            self_filter,
+            self_margin_m,
+            self.map.config(),
+        );
         // Taken where the vehicle was then: its returns moved into the vehicle's frame now.
         let Some(now_from_then) = self.now_from_then(revolution.t_s) else {
             return Ok(UpdateStats::default());

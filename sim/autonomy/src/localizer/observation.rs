@@ -1,7 +1,7 @@
 //! A revolution reduced to what the filter weighs: ground and obstacle returns in the vehicle
 //! frame, classified by height, decimated.
 
-use mapper::CollisionModel;
+use mapper::{CollisionModel, MapConfig};
 use nalgebra::{Isometry2, Point2};
 
 use super::LocalizerConfig;
@@ -20,12 +20,15 @@ pub struct Observation {
 impl Observation {
     /// The returns of `revolution` in the vehicle frame (each column's points taken back through
     /// the pose the column was placed at), the vehicle's own body left out (`self_filter`, with
-    /// `self_margin_m`), spread evenly over the revolution down to the configured counts.
+    /// `self_margin_m`), spread evenly over the revolution down to the configured counts; the
+    /// ground returns' intensities as remissions, by the calibration of the map they are compared
+    /// with (`map`: [`MapConfig::remission_of`]).
     pub fn from_revolution(
         revolution: &LidarRevolution,
         config: &LocalizerConfig,
         self_filter: Option<&CollisionModel>,
         self_margin_m: f64,
+        map: &MapConfig,
     ) -> Self {
         let scan = &revolution.scan;
         let beams = scan.beams().max(1);
@@ -58,7 +61,10 @@ impl Observation {
         let ground = decimate(ground, config.remission_points)
             .into_iter()
             .filter_map(in_vehicle)
-            .map(|(v, r)| [v.x, v.y, f64::from(r.intensity)])
+            .map(|(v, r)| {
+                let remission = map.remission_of(r.intensity, r.range_m);
+                [v.x, v.y, f64::from(remission)]
+            })
             .collect();
         // Four times as many obstacle returns as wanted, then the vehicle's own body left out.
         let obstacles = decimate(obstacles, 4 * config.field_points)

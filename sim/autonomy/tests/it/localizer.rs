@@ -251,6 +251,7 @@ fn the_tables_weigh_like_the_straightforward_way() {
             &config,
             None,
             0.0,
+            pf.map().config(),
         );
         assert!(obs.ground.len() == 400 && obs.obstacles.len() == 200);
         let particles: Vec<Particle> = pf.particles().to_vec();
@@ -288,4 +289,39 @@ fn the_tables_weigh_like_the_straightforward_way() {
         );
         assert!(w[1..].iter().all(|o| *o < w[0]), "{measurement:?}: {w:?}");
     }
+}
+
+/// The ground returns the filter weighs are remissions by the calibration of the map it weighs
+/// them against: with the map's falloff each intensity is taken back over its range (a ground
+/// point `d` m away from the car's sensor, 2.15 m up, was read across `hypot(d, 2.15)`), with
+/// none it is the intensity as read.
+#[test]
+fn ground_intensities_are_weighed_as_the_maps_remissions() {
+    let scene = scene(false);
+    let truth = Isometry2::new(Vector2::new(20.0, 0.0), 0.3);
+    let rev = revolution(&scene, &truth, true, 0.0);
+    let config = LocalizerConfig::default();
+    let observe = |falloff: f64| {
+        let map = MapConfig {
+            intensity_falloff_per_m: falloff,
+            ..MapConfig::default()
+        };
+        Observation::from_revolution(&rev, &config, None, 0.0, &map)
+    };
+    let (raw, calibrated) = (observe(0.0), observe(0.004));
+    assert_eq!(raw.ground.len(), calibrated.ground.len());
+    assert!(raw.ground.len() > 300);
+    let mut far = 0;
+    for (r, c) in raw.ground.iter().zip(&calibrated.ground) {
+        assert_eq!((r[0], r[1]), (c[0], c[1]), "the same points");
+        let range = r[0].hypot(r[1]).hypot(2.15);
+        let want = r[2] * (0.004 * range).exp();
+        assert!(
+            (c[2] - want).abs() <= 2e-6,
+            "{r:?}: {} against {want}",
+            c[2]
+        );
+        far += usize::from(range > 20.0 && c[2] > r[2] * 1.08);
+    }
+    assert!(far > 20, "far returns read brighter once calibrated: {far}");
 }
