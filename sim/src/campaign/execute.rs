@@ -20,7 +20,7 @@ use crate::engine::{
     run_external, run_with,
 };
 use crate::error::{Error, Result};
-use crate::scenario::Scenario;
+use crate::scenario::{RunConfig, Scenario};
 
 /// How a campaign is run.
 pub struct RunOptions<'a> {
@@ -159,7 +159,8 @@ fn run_variant(
         // kept out of the statistics, and the campaign goes on.
         Err(e) => return Ok(Some(invalid(campaign, v, &e.to_string()))),
     };
-    let config = campaign.config(v.setting)?;
+    // The variant's own `[config]`, as a run of its file reads it (a `--set config.*` in it).
+    let config = RunConfig::for_scenario(&scenario, None)?;
     let map_dir = maps.get(&v.text, &scenario, &config)?;
     let setup = RunSetup {
         config,

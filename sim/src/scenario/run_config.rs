@@ -77,7 +77,9 @@ pub struct MappingConfig {
     /// defaults with a 1.5 m self-hit margin and returns [`OBSTACLE_HEIGHT_M`] (0.1 m) above the
     /// flat ground obstacles whatever the consecutive-beam test says. The offline map is built with the same settings;
     /// its fingerprint holds them. `max_distance_m` is set by the run from the vehicle and planner
-    /// (`run::distance_cap_m`).
+    /// (`run::distance_cap_m`). A `[mapping.map]` that names some fields keeps these defaults
+    /// for the others (`map_over_the_defaults`), not the mapper's own.
+    #[serde(deserialize_with = "map_over_the_defaults")]
     pub map: MapConfig,
     /// Distance maps are kept over a square of this half side around the estimate, metres.
     /// Default `None`: `run::distance_map_half_size_m` of the vehicle and planner.
@@ -137,6 +139,21 @@ impl Default for MappingConfig {
             max_return_error_m: 1.0,
         }
     }
+}
+
+/// A `[mapping.map]` table read over [`MappingConfig::default`]'s map: the fields it names
+/// replace the defaults', the others keep them (serde's own `default` would take the mapper's
+/// defaults for them - a 0.8 m self-hit margin, obstacles only from 1 m up - and a table naming
+/// one field would silently change three others).
+fn map_over_the_defaults<'de, D: serde::Deserializer<'de>>(d: D) -> Result<MapConfig, D::Error> {
+    use serde::de::Error as _;
+    let given = toml::Table::deserialize(d)?;
+    let mut table =
+        toml::Table::try_from(MappingConfig::default().map).map_err(D::Error::custom)?;
+    for (key, value) in given {
+        crate::toml_file::set_path(&mut table, &key, value);
+    }
+    MapConfig::deserialize(toml::Value::Table(table)).map_err(D::Error::custom)
 }
 
 /// Where the stack's pose estimate comes from.
@@ -438,6 +455,30 @@ fn non_finite(v: &toml::Value, path: String) -> Option<(String, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A `[mapping.map]` naming some fields keeps the run's defaults for the others (a 1.5 m
+    /// self-hit margin, obstacles from 0.1 m up), nested tables too; an unknown field is still
+    /// refused by name.
+    #[test]
+    fn a_partial_map_table_keeps_the_runs_defaults_for_the_rest() {
+        let c = RunConfig::from_toml(
+            "[mapping.map]\nintensity_falloff_per_m = 0.004\n[mapping.map.obstacle_test]\nsigma = 0.5\n",
+            "test",
+        )
+        .expect("config");
+        let mut want = RunConfig::default();
+        want.mapping.map.intensity_falloff_per_m = 0.004;
+        want.mapping.map.obstacle_test.sigma = 0.5;
+        assert_eq!(c, want);
+        assert_eq!(c.mapping.map.self_hit_margin_m, 1.5);
+        assert_eq!(
+            c.mapping.map.obstacle_test.unsafe_height_above_ground_m,
+            Some(OBSTACLE_HEIGHT_M)
+        );
+        let e = RunConfig::from_toml("[mapping.map]\nself_hit_margin = 2.0\n", "test")
+            .expect_err("an unknown field");
+        assert!(e.to_string().contains("self_hit_margin"), "{e}");
+    }
 
     #[test]
     fn a_configuration_survives_toml_both_ways() {

@@ -495,3 +495,46 @@ fn a_field_set_over_the_file_changes_every_variant_and_only_that() {
         "{e}"
     );
 }
+
+/// `campaign run --set config.*`: the variants run with the configuration their files hold, so a
+/// variant's file run alone (`failures/`, `needless/`) is the campaign's run - the set field
+/// over the base's `[config]`, the file's settings over both.
+#[test]
+fn a_configuration_field_set_over_the_file_is_the_one_each_variant_runs_with() {
+    let plain = Campaign::from_file(&smoke_path()).unwrap();
+    let mut set = Campaign::from_file(&smoke_path()).unwrap();
+    set.set_field(
+        "config.mapping.map.intensity_falloff_per_m",
+        toml::Value::Float(0.004),
+    )
+    .unwrap();
+    for i in 0..4 {
+        let (a, b) = (variant(&plain, i, &[]), variant(&set, i, &[]));
+        let (ca, cb) = (
+            plain.variant_config(&a).unwrap(),
+            set.variant_config(&b).unwrap(),
+        );
+        assert_eq!(cb.mapping.map.intensity_falloff_per_m, 0.004);
+        assert_eq!(ca.mapping.map.intensity_falloff_per_m, 0.0);
+        // Without a set field, the file's configuration is the setting's over the base's.
+        assert_eq!(ca, plain.config(a.setting).unwrap(), "variant {i}");
+        // The written file, read as `taxi-sim run` reads it, runs with the same.
+        let file = sim::scenario::Scenario::from_str(&b.text, &set.variant_path(i)).unwrap();
+        let alone = sim::scenario::RunConfig::for_scenario(&file, None).unwrap();
+        assert_eq!(alone, cb, "variant {i}");
+        assert_eq!(
+            ca,
+            sim::scenario::RunConfig {
+                mapping: sim::scenario::MappingConfig {
+                    map: mapper::MapConfig {
+                        intensity_falloff_per_m: 0.0,
+                        ..cb.mapping.map
+                    },
+                    ..cb.mapping.clone()
+                },
+                ..cb.clone()
+            },
+            "only the set field differs"
+        );
+    }
+}
