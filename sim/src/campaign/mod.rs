@@ -466,14 +466,6 @@ impl Campaign {
     pub fn config(&self, setting: usize) -> crate::Result<RunConfig> {
         config_of(&self.base_doc, &self.settings[setting]).map_err(crate::Error::Invalid)
     }
-
-    /// The run configuration variant `v` runs with: its own file's `[config]` (the base's, a
-    /// `--set config.*` and its setting over it), exactly what `taxi-sim run` on the variant's
-    /// file (`failures/`, `needless/`) reads, so the file reproduces the run.
-    pub fn variant_config(&self, v: &Variant) -> crate::Result<RunConfig> {
-        let scenario = Scenario::from_str(&v.text, &self.variant_path(v.index))?;
-        RunConfig::for_scenario(&scenario, None)
-    }
 }
 
 fn compile_pool(layout: &mut Layout, p: &PoolSpec) -> Result<(Node, usize, Vec<Node>), String> {
