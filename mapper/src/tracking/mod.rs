@@ -12,7 +12,10 @@
 //! largest extent it was seen with (and at least [`TrackerConfig::min_travel_m`]), steadily
 //! (its path no longer than [`TrackerConfig::max_path_ratio`] times that travel, plus a metre),
 //! and only objects smaller than [`TrackerConfig::max_object_m`] may move (the visible stretch
-//! of a long wall slides along with the vehicle). A track lost from view clears nothing: what it
+//! of a long wall slides along with the vehicle). The extent is the one seen, and a static
+//! object the offline map does not hold may show only a sliver of itself, which slides along
+//! it as the sensor moves (a parked aircraft's side at grazing incidence): a track seen mostly
+//! on or beside cells hit well before it was first seen, by no mover, travels nothing. A track lost from view clears nothing: what it
 //! painted keeps its state. A track clears only on a revolution that continued its motion (seen
 //! the revolution before, its step where its velocity said, within half its extent), and only
 //! cells it hit since its last jump: a step its motion does not explain may be another object's
@@ -58,6 +61,10 @@ pub const PEAK_HEADING_RAD: f64 = std::f64::consts::FRAC_PI_4;
 struct CellRecord {
     owner: u32,
     last_hit_s: f64,
+    /// When a revolution first hit it (since the tracker started, or pruned it), seconds.
+    first_hit_s: f64,
+    /// Whether a track offered for prediction (or confirmed moving) has hit it.
+    by_mover: bool,
 }
 
 /// The tracker: tracks, and the owner and last hit of every cell hit since it started (pruned
@@ -117,6 +124,8 @@ impl Tracker {
                 .or_insert(CellRecord {
                     owner: u32::MAX,
                     last_hit_s: t_s,
+                    first_hit_s: t_s,
+                    by_mover: false,
                 });
         }
         if !self.config.enabled {

@@ -441,3 +441,95 @@ fn a_disabled_tracker_clears_nothing_but_still_records_hits() {
     }
     assert_eq!(t.last_hit_s((0, 0)), Some(0.0));
 }
+
+/// The first revolution (from 0) at which `t` offers a mover, of `n` revolutions of a single
+/// cell sliding along row 0 at 4 m/s (two cells a revolution) from column 0, from `t0_s`.
+fn first_mover_of_a_sliding_cell(t: &mut Tracker, t0_s: f64, n: i64) -> Option<i64> {
+    (0..n).find(|&k| {
+        t.update(t0_s + k as f64 * 0.1, &[(2 * k, 0)]);
+        !t.movers().is_empty()
+    })
+}
+
+/// A single cell sliding along the side of a static object the offline map does not hold (a
+/// parked aircraft's fuselage at grazing incidence) is its visible part, not a mover, when
+/// that side was seen before, though the cell's own extent is tiny; the same slide over
+/// ground nothing was ever seen on is a mover, and what the wall's cells hold is kept.
+#[test]
+fn a_cell_sliding_along_a_side_seen_before_is_no_mover() {
+    let mut open = Tracker::new(TrackerConfig::default(), 0.2);
+    let k = first_mover_of_a_sliding_cell(&mut open, 4.0, 20).expect("over open ground");
+    assert!(k <= 8, "a mover at revolution {k}");
+
+    let mut t = Tracker::new(TrackerConfig::default(), 0.2);
+    let wall = block(0, 0, 40, 1); // 8 m, one cell deep, along the slide
+    for k in 0..10 {
+        t.update(k as f64 * 0.1, &wall);
+    }
+    // Out of view for 3 s (its track dropped), then only a cell of it shows, sliding.
+    for k in 10..40 {
+        assert!(t.update(k as f64 * 0.1, &[]).is_empty());
+    }
+    let mut cleared = Vec::new();
+    for k in 0..20 {
+        cleared.extend(t.update(4.0 + k as f64 * 0.1, &[(2 * k, 0)]));
+        assert!(t.movers().is_empty(), "revolution {k}: {:?}", t.movers());
+        assert!(t.candidate_movers().is_empty(), "revolution {k}");
+    }
+    assert!(cleared.is_empty(), "cleared {cleared:?}");
+}
+
+/// A cart following its tug's path a few seconds behind, over cells the tug hit, is a mover
+/// as soon as it would be on open ground: what a mover painted and left is no static
+/// object's side.
+#[test]
+fn a_cart_on_its_tugs_path_is_a_mover() {
+    let mut t = Tracker::new(TrackerConfig::default(), 0.2);
+    let mut cart_mover = None;
+    for k in 0..80 {
+        let x = k; // 2 m/s at 10 Hz
+        let mut hits = block(x, 0, 10, 6); // the tug, 2 m
+        if k >= 30 {
+            hits.extend(block(x - 30, 0, 10, 6)); // the cart, 3 s behind on its cells
+        }
+        t.update(k as f64 * 0.1, &hits);
+        let cart = t
+            .movers()
+            .into_iter()
+            .find(|m| m.position.x < (x as f64 - 10.0) * 0.2);
+        if k >= 30 && cart.is_some() {
+            cart_mover.get_or_insert(k - 30);
+        }
+    }
+    let k = cart_mover.expect("the cart is a mover");
+    assert!(k <= 10, "the cart a mover {k} revolutions after it appears");
+}
+
+/// The revolution (from 0) at which `t` first offers a candidate mover or a mover, of `n`
+/// revolutions of an 8 m truck driving at 2 m/s along x from column `x0`, from `t0_s`.
+fn first_travelling_truck(t: &mut Tracker, t0_s: f64, x0: i64, n: i64) -> Option<i64> {
+    (0..n).find(|&j| {
+        t.update(t0_s + j as f64 * 0.1, &block(x0 + j, 0, 40, 10));
+        !(t.candidate_movers().is_empty() && t.movers().is_empty())
+    })
+}
+
+/// A truck that drove, stood out of view for longer than its track is kept, and drives on
+/// from the cells it stood on is a candidate mover as soon as on open ground: its body, hit
+/// while it was seen travelling, is no static object's side.
+#[test]
+fn a_truck_seen_again_on_its_own_cells_travels_at_once() {
+    let mut open = Tracker::new(TrackerConfig::default(), 0.2);
+    let fresh = first_travelling_truck(&mut open, 10.0, 30, 40).expect("on open ground");
+
+    let mut t = Tracker::new(TrackerConfig::default(), 0.2);
+    for k in 0..30 {
+        t.update(k as f64 * 0.1, &block(k, 0, 40, 10));
+    }
+    assert!(!t.movers().is_empty(), "predicted as it drives");
+    for k in 30..100 {
+        t.update(k as f64 * 0.1, &[]);
+    }
+    let again = first_travelling_truck(&mut t, 10.0, 30, 40).expect("seen again");
+    assert_eq!(again, fresh, "fresh {fresh}");
+}

@@ -150,6 +150,15 @@ impl Tracker {
             track.motion.correct(cluster.center, cfg.position_sigma_m);
             track.path_m += step.norm();
         }
+        // Seen on what was hit well before it was, by no mover: the part of a static object
+        // the offline map does not hold that shows, sliding along it as the sensor moves, is
+        // no travel (a parked A320's side, seen at grazing incidence from 50 m, slid 14 m in
+        // 2 s as the airliner rolled 2 m, and was predicted into its wing).
+        if !track.moving && on_known_cells(&self.cells, cluster, track.born_s) {
+            track.first = cluster.center;
+            track.origin = cluster.center;
+            track.path_m = 0.0;
+        }
         if track.smooth {
             track.steady += 1;
             let velocity = track.motion.velocity();
@@ -175,14 +184,27 @@ impl Tracker {
         // What it hits on a step its motion does not explain (it took over another object's
         // hits) it owns, so no other track clears it, but never clears itself.
         let paints = track.smooth || track.seen <= 1;
+        // Offered for prediction (or confirmed): its cells are no static object's. Not a
+        // candidate mover's: a parked car's visible part, sliding, is one (a stale map's cars
+        // then passed for movers again, `parking_lot_on_a_stale_map_movers_predicted`).
+        let offered = track.moving || track.predictable;
         for &c in &cluster.cells {
             if let Some(rec) = self.cells.get_mut(&c) {
                 if rec.owner != track.id && paints {
                     track.painted.push(c);
                 }
                 rec.owner = track.id;
+                rec.by_mover |= offered;
             }
         }
+        self.confirm_if_moving(ti);
+    }
+
+    /// Confirms track `ti` moving once its centre has travelled more than its extent allows a
+    /// static object's (see the module's documentation), steadily.
+    fn confirm_if_moving(&mut self, ti: usize) {
+        let cfg = &self.config;
+        let track = &mut self.tracks[ti];
         let travel = (track.last - track.first).norm();
         if !track.moving
             && track.max_extent_m <= cfg.max_object_m
@@ -192,4 +214,33 @@ impl Tracker {
             track.moving = true;
         }
     }
+}
+
+/// A cell hit this long before a track was first seen, by no mover, is a static object's to
+/// it, seconds: a mover's own cells under a track it had a moment before are not.
+const KNOWN_BEFORE_S: f64 = 1.0;
+
+/// ... within this many cells of a cluster's cell (the part of a curved side that comes into
+/// view as the sensor moves lies beside the part seen before).
+const KNOWN_WITHIN_CELLS: i64 = 2;
+
+/// Whether most of `cluster`'s cells are known static to a track born at `born_s`: first hit
+/// [`KNOWN_BEFORE_S`] or more before it, and never by a track offered for prediction (a tug's path,
+/// which its train's carts follow, is not; nor a truck's body under the new track it gets when
+/// its hits jump).
+fn on_known_cells(
+    cells: &foldhash::HashMap<WorldCell, super::CellRecord>,
+    cluster: &Cluster,
+    born_s: f64,
+) -> bool {
+    let static_cell = |c: &WorldCell| {
+        cells
+            .get(c)
+            .is_some_and(|r| !r.by_mover && r.first_hit_s <= born_s - KNOWN_BEFORE_S)
+    };
+    let n = KNOWN_WITHIN_CELLS;
+    let known = (cluster.cells.iter())
+        .filter(|&&(x, y)| (x - n..=x + n).any(|x| (y - n..=y + n).any(|y| static_cell(&(x, y)))))
+        .count();
+    2 * known > cluster.cells.len()
 }
