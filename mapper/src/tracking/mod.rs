@@ -61,9 +61,11 @@ pub const PEAK_HEADING_RAD: f64 = std::f64::consts::FRAC_PI_4;
 struct CellRecord {
     owner: u32,
     last_hit_s: f64,
-    /// When a revolution first hit it (since the tracker started, or pruned it), seconds.
+    /// When a revolution first hit it since its record was made (the tracker started, or a
+    /// prune or a mover's clearing dropped it), seconds.
     first_hit_s: f64,
-    /// Whether a track offered for prediction (or confirmed moving) has hit it.
+    /// Whether a track offered for prediction as of the revolution before (or confirmed
+    /// moving) has hit it.
     by_mover: bool,
 }
 

@@ -224,10 +224,10 @@ const KNOWN_BEFORE_S: f64 = 1.0;
 /// view as the sensor moves lies beside the part seen before).
 const KNOWN_WITHIN_CELLS: i64 = 2;
 
-/// Whether most of `cluster`'s cells are known static to a track born at `born_s`: first hit
-/// [`KNOWN_BEFORE_S`] or more before it, and never by a track offered for prediction (a tug's path,
-/// which its train's carts follow, is not; nor a truck's body under the new track it gets when
-/// its hits jump).
+/// Whether more than half of `cluster`'s cells lie on or within [`KNOWN_WITHIN_CELLS`] of a
+/// cell known static to a track born at `born_s`: first hit [`KNOWN_BEFORE_S`] or more before
+/// it, and never by a track offered for prediction (a tug's path, which its train's carts
+/// follow, is not; nor a truck's body under the new track it gets when its hits jump).
 fn on_known_cells(
     cells: &foldhash::HashMap<WorldCell, super::CellRecord>,
     cluster: &Cluster,
