@@ -18,6 +18,27 @@ const GRACE: Duration = Duration::from_secs(5);
 /// Lines of the stack's log quoted when it exits on its own.
 const TAIL_LINES: usize = 5;
 
+/// Gives the stack's process SIGINT's and SIGQUIT's default actions, whatever the simulator's
+/// own are: a simulator started in the background by a non-interactive shell has them ignored,
+/// an ignored disposition survives `exec`, and a shell started with SIGINT ignored can neither
+/// trap nor reset it - the stack would then be killed after the grace, not stopped as Ctrl-C
+/// stops it.
+#[allow(unsafe_code)] // the workspace's fourth unsafe code: std has no way to reset a signal
+fn interruptible(command: &mut Command) {
+    // SAFETY: runs in the forked child before exec; `signal` is async-signal-safe (POSIX) and
+    // touches no memory of the parent's.
+    unsafe {
+        command.pre_exec(|| {
+            for sig in [libc::SIGINT, libc::SIGQUIT] {
+                if libc::signal(sig, libc::SIG_DFL) == libc::SIG_ERR {
+                    return Err(std::io::Error::last_os_error());
+                }
+            }
+            Ok(())
+        });
+    }
+}
+
 /// A stack process the simulator started and will stop.
 pub struct StackProcess {
     command: String,
@@ -45,14 +66,17 @@ impl StackProcess {
             }
             None => (Stdio::from(std::io::stderr()), Stdio::inherit()),
         };
-        let child = Command::new("sh")
+        let mut shell = Command::new("sh");
+        shell
             .arg("-c")
             .arg(command)
             .env("ROS_DOMAIN_ID", domain_id.to_string())
             .stdin(Stdio::null())
             .stdout(out)
             .stderr(err)
-            .process_group(0)
+            .process_group(0);
+        interruptible(&mut shell);
+        let child = shell
             .spawn()
             .map_err(|e| Error::Stack(format!("starting the stack `{command}`: {e}")))?;
         Ok(StackProcess {
