@@ -10,17 +10,19 @@ use super::predict::{Footprint, reach};
 
 /// Whether a known mover lost while standing, `t`, may have walked from where it was last seen
 /// to the body of the vehicle `model` at `pose` by `now_s`: within its footprint and
-/// `walk_m_s` times the time since, of a circle of a level it occupies.
+/// `walk_m_s` times the time since, no more than `walk_max_m`, of a circle of a level it
+/// occupies.
 pub fn may_have_walked_to(
     model: &CollisionModel,
     pose: &Isometry2<f64>,
     t: &TrackState,
     now_s: f64,
-    walk_m_s: f64,
+    (walk_m_s, walk_max_m): (f64, f64),
     cfg: &TrafficConfig,
 ) -> bool {
     let f = Footprint::of(t, cfg);
-    let reach = f.half_length_m.max(f.half_width_m) + walk_m_s * (now_s - t.t_s).max(0.0);
+    let walked_m = (walk_m_s * (now_s - t.t_s).max(0.0)).min(walk_max_m);
+    let reach = f.half_length_m.max(f.half_width_m) + walked_m;
     touches(model, pose, t.levels, &t.position, &t.position, reach)
 }
 

@@ -702,3 +702,26 @@ fn a_trucks_corner_lost_standing_is_part_of_the_truck_not_a_person() {
     let held = kept(&again, 1.4, 0.0, 40.0);
     assert!(held[..40].iter().all(|k| !k) && held[41..].iter().all(|k| *k));
 }
+
+/// A person lost standing is followed unseen no farther than `LOST_STANDING_WALK_MAX_M`: one
+/// last seen 12 m beside the standing body holds it once they could have walked there, one 25 m
+/// off never does - a walk of 1.5 m/s for the minute a person is kept would reach it in 16 s
+/// (variant 6 of the speed profiles: a person 58 m behind held the jet until a pilot was called).
+#[test]
+fn a_person_lost_standing_far_off_never_holds_the_standing_body() {
+    let config = AutonomyConfig::default();
+    let cfg = &config.traffic;
+    let pose = Isometry2::identity();
+    let held = |aside_m: f64, after_s: f64| {
+        let mut r = rules();
+        r.lost_standing.push(TrackState {
+            extent_m: 0.5,
+            ..track(41, 10.0, (0.0, -aside_m), (0.0, 0.0), 0b01)
+        });
+        !r.lost_standing_at(&pose, 10.0 + after_s, &[], cfg)
+            .is_empty()
+    };
+    assert!(!held(12.0, 0.5));
+    assert!(held(12.0, 10.0) && held(12.0, 59.0));
+    assert!((1..60).all(|s| !held(25.0, f64::from(s))));
+}
