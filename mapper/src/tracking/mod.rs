@@ -16,10 +16,11 @@
 //! object the offline map does not hold may show only a sliver of itself, which slides along
 //! it as the sensor moves (a parked aircraft's side at grazing incidence): a track seen mostly
 //! on or beside cells hit well before it was first seen, by no mover, travels nothing. A track
-//! lost from view clears nothing: what it painted keeps its state. A track clears only on a revolution that continued its motion (seen
-//! the revolution before, its step where its velocity said, within half its extent), and only
-//! cells it hit since its last jump: a step its motion does not explain may be another object's
-//! hits taken over, so what it painted before is no longer its to clear, nor what it took over.
+//! lost from view clears nothing: what it painted keeps its state. A track clears only on a
+//! revolution that continued its motion (seen the revolution before, its step where its
+//! velocity said, within half its extent), and only cells it hit since its last jump: a step its
+//! motion does not explain may be another object's hits taken over, so what it painted before
+//! is no longer its to clear, nor what it took over.
 //!
 //! The files, by job: [`TrackerConfig`] (`config`), the constant-velocity filter on a track's
 //! centre (`motion`), a track and how a revolution's cluster moves it on (`track`), one

@@ -44,11 +44,11 @@ const LOST_STANDING_WALK_M_S: f64 = 1.5;
 /// a parked car a stale map does not hold, whose visible part slides, is larger).
 const LOST_STANDING_FOR_S: f64 = 60.0;
 pub(super) const LOST_STANDING_EXTENT_M: f64 = 2.0;
-/// A mover lost standing walks no farther unseen than this, metres: the sensor's blind ground round the airframe
-/// reaches 9.6 m from it (ahead of the nose, for a 0.7 m object; `taxi-sim model coverage`), so
-/// one who walks up from farther is seen on the way and tracked afresh - a person last seen
-/// standing 58 m behind, 22 m aside, held the jet standing for a van 34 s on until it called a
-/// pilot (`tests/found/person_lost_standing_far_behind_holds_the_jet.toml`).
+/// A mover lost standing walks no farther unseen than this, metres: the sensor's blind ground
+/// round the airframe reaches 9.6 m from it (ahead of the nose, for a 0.7 m object; `taxi-sim
+/// model coverage`), so one who walks up from farther is seen on the way and tracked afresh - a
+/// person last seen standing 58 m behind, 22 m aside, held the jet standing for a van 34 s on
+/// until it called a pilot (`tests/found/person_lost_standing_far_behind_holds_the_jet.toml`).
 const LOST_STANDING_WALK_MAX_M: f64 = 20.0;
 
 /// A mover lost at the body is the same mover as a track the tracker started within this many
