@@ -65,6 +65,8 @@ mod holds;
 mod memory;
 #[cfg(test)]
 mod memory_tests;
+#[cfg(test)]
+mod parts_tests;
 mod predict;
 mod rules;
 #[cfg(test)]
