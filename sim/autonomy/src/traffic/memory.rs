@@ -139,9 +139,10 @@ impl TrafficRules {
             .collect();
         self.note_paths(&others, now_s);
         // One lost standing that was a part of another mover carried on (`carried_part`: a
-        // fuel truck's corner tracked apart, a follow-me car's front), or driven over by one
-        // since (`driven_over`), is forgotten while it stays out of view. Kept, it held the jet 25 m off as its walk-to reach grew
-        // (variants 284, 814 and 848 of `traffic_jet.toml`: needless pilot calls).
+        // fuel truck's corner tracked apart, a follow-me car's front) or driven over by it
+        // (`driven_over`: a follow-me car's corner) is forgotten while it stays out of view.
+        // Kept, it held the jet 25 m off as its walk-to reach grew (variants 284 and 814 of
+        // `traffic_jet.toml`: needless pilot calls; 399).
         for l in &self.lost_standing {
             let taken = carried_part(l, &others, &self.paths, now_s)
                 || driven_over(l, &others, &self.paths);
@@ -199,7 +200,13 @@ impl TrafficRules {
                 .iter()
                 .filter(|t| !movers.iter().any(|m| m.id == t.id))
                 .filter(|t| !body.iter().any(|r| r.id == t.id) && now_s - t.t_s >= COASTED_S)
-                .filter(|t| !part_of_another(t, &others, &self.paths))
+                .filter(|t| {
+                    let reaches = |o: &TrackState| {
+                        let window = (now_s, now_s + DROPPED_AT_BODY_S);
+                        may_reach_body(&self.model, pose, o, window, cfg)
+                    };
+                    !part_of_another(t, &others, &self.paths, now_s, reaches)
+                })
                 .filter(|t| {
                     let window = (now_s, now_s + DROPPED_AT_BODY_S);
                     may_reach_body(&self.model, pose, t, window, cfg)
@@ -559,25 +566,34 @@ impl TrafficRules {
 }
 
 /// Whether `t`, a track dropped, lay when last seen within the extent of another of `movers`
-/// (the movers, and the candidates that were movers lately), seen since (at or after `t` was
-/// last seen), no smaller than it by more than [`PART_SMALLER`] of its extent and hit in a
-/// level it was, where that one was then (where it was seen, else where its motion puts it): a
-/// part of it tracked apart, or the same object tracked twice - a fuel truck's split-off part
-/// that seemed to move the other way, a van's front (variants 27 and 32 of `traffic_jet.toml`,
-/// waited for as lost until the pilot was called), a follow-me car's front heading for the jet
-/// before the car backed aside (variant 41: its constant velocity, backing, put it 10.7 m from
-/// its front; variant 92: the car, slow as it backed, a candidate again). Seen since, not seen
-/// now: a follow-me car that made room, tracked twice, one track dropped as it swung round at
-/// 4 m/s the wrong way, the other seen on for a second as the car stood aside and no longer
-/// after (variant 287: a pilot called for the car 40 m ahead in plain view). Two vans in convoy
-/// closer than their length would be taken for one.
-fn part_of_another(t: &TrackState, movers: &[TrackState], paths: &[MoverPath]) -> bool {
+/// (the movers, and the candidates that were movers lately) where that one was then (on its
+/// kept path, else within [`CARRIED_BACK_S`] as its motion says), no smaller than it by more
+/// than [`PART_SMALLER`] of its extent and hit in a level it was, seen after it: now, or
+/// [`SEEN_AFTER_S`] or more after `t` was last seen where it cannot reach the body (`reaches`
+/// says whether it can; two that went out of view together, a tug and its cart into the blind
+/// zone under the nose, tell nothing of each other). A part of it tracked apart, or the same
+/// object tracked twice - a fuel truck's split-off part that seemed to move the other way, a
+/// van's front (variants 27 and 32 of `traffic_jet.toml`, waited for as lost until the pilot was
+/// called), a follow-me car's front heading for the jet before the car backed aside (variant
+/// 41; variant 92: the car, slow as it backed, a candidate again); a follow-me car making room
+/// 40 m ahead, tracked twice, one track dropped as it swung round at 4 m/s the wrong way, the
+/// other seen on for a second as the car stood aside and no longer after (variant 287). Two vans
+/// in convoy closer than their length would be taken for one.
+fn part_of_another(
+    t: &TrackState,
+    movers: &[TrackState],
+    paths: &[MoverPath],
+    now_s: f64,
+    reaches: impl Fn(&TrackState) -> bool,
+) -> bool {
     movers.iter().any(|o| {
-        let then = (paths.iter().find(|p| p.id == o.id))
-            .and_then(|p| p.at(t.t_s))
-            .unwrap_or_else(|| o.position + o.velocity * (t.t_s - o.t_s));
+        let kept = (paths.iter().find(|p| p.id == o.id)).and_then(|p| p.at(t.t_s));
+        let Some(then) = kept.or_else(|| read_back(o, t.t_s)) else {
+            return false;
+        };
+        let seen_after = now_s - o.t_s <= 0.25 || (o.t_s - t.t_s >= SEEN_AFTER_S && !reaches(o));
         o.id != t.id
-            && o.t_s >= t.t_s
+            && seen_after
             && o.levels & t.levels != 0
             && o.extent_m >= (1.0 - PART_SMALLER) * t.extent_m
             && (then - t.position).norm() <= o.extent_m
@@ -585,11 +601,48 @@ fn part_of_another(t: &TrackState, movers: &[TrackState], paths: &[MoverPath]) -
 }
 
 /// What a part tracked apart may seem larger than the object it is part of, as a fraction of
-/// its extent: one object's two tracks' boxes grow and shrink by a cell or two as hits come
-/// and go (variant 399 of `traffic_jet.toml`: a follow-me car tracked as 5.2 m and 5.0 m, the
+/// its extent: the largest extents two tracks of one object were seen with differ by a cell or
+/// two (variant 399 of `traffic_jet.toml`: a follow-me car tracked as 5.2 m and 5.0 m, the
 /// first dropped 48 m ahead of the jet in plain view, a pilot called for it). A person (0.9 m)
 /// is not part of a cart half their size.
 const PART_SMALLER: f64 = 0.1;
+
+/// A dropped track's other track, seen since but not now, was seen this long after it, seconds
+/// ([`part_of_another`]).
+const SEEN_AFTER_S: f64 = 0.5;
+
+/// Whether `t`, a mover lost standing, was a part of another of `movers` (the movers, and the
+/// candidates that were movers lately), no smaller than it and hit in a level it was, that
+/// drove over it: on that one's kept path, its centre was within its extent of `t` when `t` was
+/// last seen, and within [`CARRIED_BACK_S`] after, going [`LEFT_WITH_M_S`] or more over the
+/// second before, it was seen within [`DRIVEN_THROUGH_M`] of where `t` stood. Two objects do
+/// not stand in one place, and a person standing against a car going on steps no farther in a
+/// few seconds: a follow-me car backing aside at 2 m/s, its corner tracked apart as a person
+/// for 4 s and lost standing 2.8 m from the car's centre (beyond what [`carried_part`] takes,
+/// half its extent), which drove through that spot 1.2 s later (variant 399 of
+/// `traffic_jet.toml`, a pilot called for it 30 s on). Not one the other passes later, which
+/// may have walked off unseen before.
+fn driven_over(t: &TrackState, movers: &[TrackState], paths: &[MoverPath]) -> bool {
+    movers.iter().any(|o| {
+        let Some(path) = paths.iter().find(|p| p.id == o.id) else {
+            return false;
+        };
+        let going = |s: f64, at: &Point2<f64>| {
+            path.at(s - 1.0)
+                .is_some_and(|before| (at - before).norm() >= LEFT_WITH_M_S)
+        };
+        o.id != t.id
+            && o.levels & t.levels != 0
+            && o.extent_m >= t.extent_m
+            && (path.at(t.t_s)).is_some_and(|then| (then - t.position).norm() <= o.extent_m)
+            && (path.seen.iter()).any(|&(s, at)| {
+                s > t.t_s
+                    && s - t.t_s <= CARRIED_BACK_S
+                    && (at - t.position).norm() <= DRIVEN_THROUGH_M
+                    && going(s, &at)
+            })
+    })
+}
 
 /// Whether `t`, a mover lost standing, was a part of another of `movers` (the movers, and the
 /// candidates that were movers lately) that carried it on: one seen now, no smaller than it,
@@ -616,43 +669,6 @@ fn carried_part(t: &TrackState, movers: &[TrackState], paths: &[MoverPath], now_
                 (at - t.position).norm() <= 0.5 * o.extent_m && speed >= LEFT_WITH_M_S
             })
     })
-}
-
-/// Whether another of `movers` (the movers, and the candidates that were movers lately), no
-/// smaller than `t`, a mover lost standing, and hit in a level it was, drove over where `t` was
-/// last seen since: on its kept path after `t` was last seen, its centre came within
-/// [`DRIVEN_THROUGH_M`] of that place between two sightings, going at [`LEFT_WITH_M_S`] or more.
-/// Two objects do not stand in one place: `t` was a part of the other tracked apart that stood
-/// as the whole went on (a follow-me car backing aside at 2 m/s, its corner tracked as a
-/// person for 4 s and lost standing 2.8 m from the car's centre, which drove through that spot
-/// a second later: variant 399 of `traffic_jet.toml`, a pilot called for it 30 s on).
-fn driven_over(t: &TrackState, movers: &[TrackState], paths: &[MoverPath]) -> bool {
-    movers.iter().any(|o| {
-        let Some(path) = paths.iter().find(|p| p.id == o.id) else {
-            return false;
-        };
-        o.id != t.id
-            && o.levels & t.levels != 0
-            && o.extent_m >= t.extent_m
-            && (path.seen.windows(2)).any(|w| {
-                let ((s0, p0), (s1, p1)) = (w[0], w[1]);
-                let speed = (p1 - p0).norm() / (s1 - s0);
-                s0 >= t.t_s
-                    && speed >= LEFT_WITH_M_S
-                    && segment_gap_m(&t.position, &p0, &p1) <= DRIVEN_THROUGH_M
-            })
-    })
-}
-
-/// How far `at` lies from the segment `a`-`b`, metres.
-fn segment_gap_m(at: &Point2<f64>, a: &Point2<f64>, b: &Point2<f64>) -> f64 {
-    let ab = b - a;
-    let u = if ab.norm_squared() > 0.0 {
-        ((at - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (at - (a + ab * u)).norm()
 }
 
 /// Where track `o` was at `t_s` as its motion says, if `t_s` is within [`CARRIED_BACK_S`] of when
