@@ -195,22 +195,18 @@ impl TrafficRules {
         // dropped: if it may reach the body within `DROPPED_AT_BODY_S`, it is waited for as
         // one lost there (a van that drove into the blind zone behind the wing has not gone).
         if stopped {
+            let window = (now_s, now_s + DROPPED_AT_BODY_S);
             let dropped = self
                 .coasting
                 .iter()
                 .filter(|t| !movers.iter().any(|m| m.id == t.id))
                 .filter(|t| !body.iter().any(|r| r.id == t.id) && now_s - t.t_s >= COASTED_S)
                 .filter(|t| {
-                    let reaches = |o: &TrackState| {
-                        let window = (now_s, now_s + DROPPED_AT_BODY_S);
-                        may_reach_body(&self.model, pose, o, window, cfg)
-                    };
+                    let reaches =
+                        |o: &TrackState| may_reach_body(&self.model, pose, o, window, cfg);
                     !part_of_another(t, &others, &self.paths, now_s, reaches)
                 })
-                .filter(|t| {
-                    let window = (now_s, now_s + DROPPED_AT_BODY_S);
-                    may_reach_body(&self.model, pose, t, window, cfg)
-                })
+                .filter(|t| may_reach_body(&self.model, pose, t, window, cfg))
                 .map(|t| AtBody::of(t, LostMover::Coasting))
                 .collect::<Vec<_>>();
             body.extend(dropped);
