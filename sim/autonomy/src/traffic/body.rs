@@ -84,7 +84,7 @@ pub(super) fn box_gap_m(
 }
 
 /// The corners of the box of the hits of `t` when last seen, metres.
-fn hit_box(t: &TrackState) -> (Vector2<f64>, Vector2<f64>) {
+pub(super) fn hit_box(t: &TrackState) -> (Vector2<f64>, Vector2<f64>) {
     let ((x0, y0), (x1, y1)) = t.bbox;
     let r = t.size_m[0] / (x1 - x0 + 1).max(1) as f64;
     let lo = Vector2::new(x0 as f64 * r, y0 as f64 * r);

@@ -5,7 +5,7 @@
 use mapper::TrackState;
 use nalgebra::{Isometry2, Point2, Vector2};
 
-use super::body::box_gap_m;
+use super::body::{box_gap_m, hit_box};
 use super::rules::{AtBody, BodyHold, LostMover, MoverPath, MoverStreak, TrafficRules};
 use super::{
     TrafficConfig, at_body, came_there, may_have_walked_to, may_reach_body,
@@ -87,6 +87,16 @@ const STEPPED_AWAY_M: f64 = 1.0;
 /// of view before the tracker drops it.
 const PATH_KEPT_S: f64 = 15.0;
 
+/// How long the rules keep where the vehicle was, seconds (longer than [`HIDDEN_IN_PLACE_S`]).
+const VEHICLE_KEPT_S: f64 = 3.0;
+
+/// A track whose box now lies within its box this long before, seconds (the streak a mover
+/// needs, [`MOVER_FOR_S`]) ...
+const HIDDEN_IN_PLACE_S: f64 = 1.0;
+/// ... and smaller, while the vehicle travelled this far, metres, shows less of itself where
+/// it stood ([`TrafficRules::hidden_in_place`]).
+const HIDDEN_IN_PLACE_M: f64 = 1.0;
+
 impl TrafficRules {
     /// Notes where each of `movers` was last seen, and forgets what is older than
     /// [`PATH_KEPT_S`] or of tracks not among them.
@@ -96,17 +106,68 @@ impl TrafficRules {
             let i = match self.paths.iter().position(|p| p.id == t.id) {
                 Some(i) => i,
                 None => {
-                    let seen = Vec::new();
-                    self.paths.push(MoverPath { id: t.id, seen });
+                    let (seen, boxes) = (Vec::new(), Vec::new());
+                    self.paths.push(MoverPath {
+                        id: t.id,
+                        seen,
+                        boxes,
+                    });
                     self.paths.len() - 1
                 }
             };
-            let seen = &mut self.paths[i].seen;
-            if seen.last().is_none_or(|&(s, _)| t.t_s > s) {
-                seen.push((t.t_s, t.position));
+            let path = &mut self.paths[i];
+            if path.seen.last().is_none_or(|&(s, _)| t.t_s > s) {
+                path.seen.push((t.t_s, t.position));
+                path.boxes.push((t.t_s, hit_box(t)));
             }
-            seen.retain(|&(s, _)| now_s - s <= PATH_KEPT_S);
+            path.seen.retain(|&(s, _)| now_s - s <= PATH_KEPT_S);
+            path.boxes.retain(|&(s, _)| now_s - s <= PATH_KEPT_S);
         }
+    }
+
+    /// Notes where the vehicle is at the plan of `now_s`, and forgets where it was more than
+    /// [`VEHICLE_KEPT_S`] before.
+    fn note_vehicle(&mut self, pose: &Isometry2<f64>, now_s: f64) {
+        self.vehicle_seen
+            .push((now_s, Point2::from(pose.translation.vector)));
+        self.vehicle_seen
+            .retain(|&(s, _)| now_s - s <= VEHICLE_KEPT_S);
+    }
+
+    /// Whether track `t` only shows less of itself where it stood as the vehicle moves by: the
+    /// box of its hits lies within (a cell more than) the box it was seen with
+    /// [`HIDDEN_IN_PLACE_S`] or more before, and is smaller, while the vehicle travelled
+    /// [`HIDDEN_IN_PLACE_M`] or more since. Its centre slides as the airframe or the sensor's
+    /// blind ground sweeps over it: no motion of its own. A follow-me car that had pulled aside
+    /// and stood, its front hidden as the jet passed at 3 m/s, seemed to move at 1.4 m/s for a
+    /// second, became a mover arriving at the body again and held the jet until it called a
+    /// pilot (`tests/found/traffic_follow_me_car_head_on.toml`). A van driving on under the wing
+    /// of a standing jet shrinks within its box too: there the vehicle did not move.
+    pub(super) fn hidden_in_place(&self, t: &TrackState) -> bool {
+        let Some(path) = self.paths.iter().find(|p| p.id == t.id) else {
+            return false;
+        };
+        let then_s = t.t_s - HIDDEN_IN_PLACE_S;
+        let Some(&(s, (lo0, hi0))) = path.boxes.iter().rev().find(|&&(s, _)| s <= then_s) else {
+            return false;
+        };
+        let at = |s: f64| {
+            (self.vehicle_seen.iter().rev())
+                .find(|&&(v, _)| v <= s)
+                .map(|&(_, p)| p)
+        };
+        let moved = match (at(s), at(t.t_s)) {
+            (Some(a), Some(b)) => (b - a).norm() >= HIDDEN_IN_PLACE_M,
+            _ => false,
+        };
+        let (lo, hi) = hit_box(t);
+        let cell = t.size_m[0] / ((t.bbox.1.0 - t.bbox.0.0 + 1).max(1) as f64);
+        let area = |lo: Vector2<f64>, hi: Vector2<f64>| (hi - lo).product();
+        let tol = Vector2::repeat(cell);
+        moved
+            && lo.iter().zip((lo0 - tol).iter()).all(|(a, b)| a >= b)
+            && hi.iter().zip((hi0 + tol).iter()).all(|(a, b)| a <= b)
+            && area(lo, hi) < area(lo0, hi0)
     }
 
     /// The movers at the body now ([`at_body`]: arriving, or - the vehicle standing - driven up
@@ -128,6 +189,7 @@ impl TrafficRules {
             self.coasting.clear();
             return None;
         }
+        self.note_vehicle(pose, now_s);
         self.note_streaks(now_s);
         self.note_lost_standing(movers, now_s, cfg);
         self.claimed.retain(|id| movers.iter().any(|t| t.id == *id));
@@ -533,6 +595,10 @@ impl TrafficRules {
             .iter()
             .filter(|p| now_s - p.track.t_s <= 0.25)
         {
+            // Less of it seen where it stood, as the vehicle goes by: no motion of its own.
+            if self.hidden_in_place(&p.track) {
+                continue;
+            }
             let id = p.track.id;
             let r = match self.streaks.iter_mut().find(|r| r.id == id) {
                 Some(r) => r,

@@ -181,7 +181,12 @@ pub(super) struct MoverPath {
     pub(super) id: u32,
     /// When and where it was seen.
     pub(super) seen: Vec<(f64, Point2<f64>)>,
+    /// When it was seen, and the corners of the box of its hits then, metres.
+    pub(super) boxes: Vec<(f64, HitBox)>,
 }
+
+/// The lower and upper corners of the box of a track's hits, metres.
+pub(super) type HitBox = (Vector2<f64>, Vector2<f64>);
 
 impl MoverPath {
     /// Where it was at `t_s`: between the sightings around it, linearly (`None` before the
@@ -258,6 +263,8 @@ pub struct TrafficRules {
     /// mover was then or first seen since (see `note_stood`): one whose box came nearer the
     /// body since came to it.
     pub(super) stood: Option<(Point2<f64>, Vec<Sighting>)>,
+    /// Where the vehicle was at each plan of the last few seconds (see `note_vehicle`).
+    pub(super) vehicle_seen: Vec<(f64, Point2<f64>)>,
 }
 
 /// A track, and where it was seen.
@@ -289,6 +296,7 @@ impl TrafficRules {
             closing: Closing::default(),
             stand_line: None,
             stood: None,
+            vehicle_seen: Vec::new(),
         }
     }
 
@@ -311,6 +319,7 @@ impl TrafficRules {
         self.hold = None;
         self.stand_line = None;
         self.stood = None;
+        self.vehicle_seen.clear();
     }
 
     /// The decision about movers for the plan `i`: the caution cap, the conflict, the stop
