@@ -90,8 +90,7 @@ const PATH_KEPT_S: f64 = 15.0;
 /// How long the rules keep where the vehicle was, seconds (longer than [`HIDDEN_IN_PLACE_S`]).
 const VEHICLE_KEPT_S: f64 = 3.0;
 
-/// A track whose box now lies within its box this long before, seconds (the streak a mover
-/// needs, [`MOVER_FOR_S`]) ...
+/// A track whose box now lies within its box this long or longer before, seconds ...
 const HIDDEN_IN_PLACE_S: f64 = 1.0;
 /// ... and smaller, while the vehicle travelled this far, metres, shows less of itself where
 /// it stood ([`TrafficRules::hidden_in_place`]).
@@ -135,15 +134,18 @@ impl TrafficRules {
     }
 
     /// Whether track `t` only shows less of itself where it stood as the vehicle moves by: the
-    /// box of its hits lies within (a cell more than) the box it was seen with
-    /// [`HIDDEN_IN_PLACE_S`] or more before, and is smaller, while the vehicle travelled
-    /// [`HIDDEN_IN_PLACE_M`] or more since. Its centre slides as the airframe or the sensor's
-    /// blind ground sweeps over it: no motion of its own. A follow-me car that had pulled aside
-    /// and stood, its front hidden as the jet passed at 3 m/s, seemed to move at 1.4 m/s for a
-    /// second, became a mover arriving at the body again and held the jet until it called a
-    /// pilot (`tests/found/traffic_follow_me_car_head_on.toml`). A van driving on under the wing
-    /// of a standing jet shrinks within its box too: there the vehicle did not move.
-    pub(super) fn hidden_in_place(&self, t: &TrackState) -> bool {
+    /// box of its hits is smaller than the box it was seen with [`HIDDEN_IN_PLACE_S`] or more
+    /// before and lies within it (a cell more), on each axis one of its edges where it was
+    /// then (within a cell: the object's own end, standing), while the vehicle travelled
+    /// [`HIDDEN_IN_PLACE_M`] or more since (the other edge is where the airframe or the
+    /// sensor's blind ground, moving with it, cuts the object off). Its centre slides: no
+    /// motion of its own. A follow-me car that had pulled aside and stood, its front hidden as
+    /// the jet passed at 3 m/s, seemed to move at 1.4 m/s for a second, became a mover
+    /// arriving at the body again and held the jet until it called a pilot
+    /// (`tests/found/traffic_follow_me_car_head_on.toml`). A mover driving into the shadow
+    /// of a moving airframe is cut off too, but its own far end moves with it; under a
+    /// standing airframe the vehicle does not move.
+    fn hidden_in_place(&self, t: &TrackState) -> bool {
         let Some(path) = self.paths.iter().find(|p| p.id == t.id) else {
             return false;
         };
@@ -163,11 +165,10 @@ impl TrafficRules {
         let (lo, hi) = hit_box(t);
         let cell = t.size_m[0] / ((t.bbox.1.0 - t.bbox.0.0 + 1).max(1) as f64);
         let area = |lo: Vector2<f64>, hi: Vector2<f64>| (hi - lo).product();
-        let tol = Vector2::repeat(cell);
-        moved
-            && lo.iter().zip((lo0 - tol).iter()).all(|(a, b)| a >= b)
-            && hi.iter().zip((hi0 + tol).iter()).all(|(a, b)| a <= b)
-            && area(lo, hi) < area(lo0, hi0)
+        let within = (0..2).all(|k| lo[k] >= lo0[k] - cell && hi[k] <= hi0[k] + cell);
+        let an_end_stood =
+            (0..2).all(|k| (lo[k] - lo0[k]).abs() <= cell || (hi[k] - hi0[k]).abs() <= cell);
+        moved && within && an_end_stood && area(lo, hi) < area(lo0, hi0)
     }
 
     /// The movers at the body now ([`at_body`]: arriving, or - the vehicle standing - driven up
@@ -588,18 +589,23 @@ impl TrafficRules {
 
     /// Each track seen (this revolution or the last, 0.25 s) and predicted now continues its
     /// streak, or starts one; its last streak, once it lasted [`MOVER_FOR_S`], makes it a mover
-    /// as of the streak's last plan. Streaks not continued are kept for [`MOVER_LATELY_S`].
+    /// as of the streak's last plan. Streaks not continued are kept for [`MOVER_LATELY_S`]. A
+    /// track that is not a mover lately and only shows less of itself where it stood
+    /// ([`Self::hidden_in_place`]) continues nothing: a break over 0.25 s starts a new streak.
     pub(super) fn note_streaks(&mut self, now_s: f64) {
         for p in self
             .predictions
             .iter()
             .filter(|p| now_s - p.track.t_s <= 0.25)
         {
-            // Less of it seen where it stood, as the vehicle goes by: no motion of its own.
-            if self.hidden_in_place(&p.track) {
+            // Less of it seen where it stood, as the vehicle goes by: no motion of its own -
+            // unless it is a mover lately (a streak it has is not broken by this).
+            let id = p.track.id;
+            let mover_lately = (self.streaks.iter())
+                .any(|r| r.id == id && r.mover_s.is_some_and(|m| now_s - m <= MOVER_LATELY_S));
+            if !mover_lately && self.hidden_in_place(&p.track) {
                 continue;
             }
-            let id = p.track.id;
             let r = match self.streaks.iter_mut().find(|r| r.id == id) {
                 Some(r) => r,
                 None => {

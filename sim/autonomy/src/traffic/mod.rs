@@ -61,6 +61,8 @@ mod closing;
 #[cfg(test)]
 mod closing_tests;
 mod conflict;
+#[cfg(test)]
+mod hidden_tests;
 mod holds;
 mod memory;
 #[cfg(test)]
