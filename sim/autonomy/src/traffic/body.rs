@@ -7,6 +7,7 @@ use nalgebra::{Isometry2, Point2, Vector2};
 use super::TrafficConfig;
 use super::conflict::touches;
 use super::predict::{Footprint, reach};
+use super::rules::HitBox;
 
 /// Whether a known mover lost while standing, `t`, may have walked from where it was last seen
 /// to the body of the vehicle `model` at `pose` by `now_s`: within its footprint and
@@ -84,12 +85,18 @@ pub(super) fn box_gap_m(
 }
 
 /// The corners of the box of the hits of `t` when last seen, metres.
-pub(super) fn hit_box(t: &TrackState) -> (Vector2<f64>, Vector2<f64>) {
+pub(super) fn hit_box(t: &TrackState) -> HitBox {
     let ((x0, y0), (x1, y1)) = t.bbox;
-    let r = t.size_m[0] / (x1 - x0 + 1).max(1) as f64;
+    let r = cell_m(t);
     let lo = Vector2::new(x0 as f64 * r, y0 as f64 * r);
     let hi = Vector2::new((x1 + 1) as f64 * r, (y1 + 1) as f64 * r);
     (lo, hi)
+}
+
+/// The side of the map cells the box of `t` is counted in, metres.
+pub(super) fn cell_m(t: &TrackState) -> f64 {
+    let ((x0, _), (x1, _)) = t.bbox;
+    t.size_m[0] / (x1 - x0 + 1).max(1) as f64
 }
 
 /// Whether mover `t`, gone out of view, may be at the body of the vehicle standing at `pose`

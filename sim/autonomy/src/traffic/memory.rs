@@ -5,7 +5,7 @@
 use mapper::TrackState;
 use nalgebra::{Isometry2, Point2, Vector2};
 
-use super::body::{box_gap_m, hit_box};
+use super::body::{box_gap_m, cell_m, hit_box};
 use super::rules::{AtBody, BodyHold, LostMover, MoverPath, MoverStreak, TrafficRules};
 use super::{
     TrafficConfig, at_body, came_there, may_have_walked_to, may_reach_body,
@@ -120,7 +120,8 @@ impl TrafficRules {
                 path.boxes.push((t.t_s, hit_box(t)));
             }
             path.seen.retain(|&(s, _)| now_s - s <= PATH_KEPT_S);
-            path.boxes.retain(|&(s, _)| now_s - s <= PATH_KEPT_S);
+            // Only what `hidden_in_place` can use: the vehicle's positions go back no further.
+            path.boxes.retain(|&(s, _)| now_s - s <= VEHICLE_KEPT_S);
         }
     }
 
@@ -163,7 +164,7 @@ impl TrafficRules {
             _ => false,
         };
         let (lo, hi) = hit_box(t);
-        let cell = t.size_m[0] / ((t.bbox.1.0 - t.bbox.0.0 + 1).max(1) as f64);
+        let cell = cell_m(t);
         let area = |lo: Vector2<f64>, hi: Vector2<f64>| (hi - lo).product();
         let within = (0..2).all(|k| lo[k] >= lo0[k] - cell && hi[k] <= hi0[k] + cell);
         let an_end_stood =
@@ -517,10 +518,13 @@ impl TrafficRules {
     /// Whether track `t` is a mover that may arrive at the body: one predicted on a streak
     /// lately that has moved beyond its own extent.
     pub(super) fn arriving(&self, t: &TrackState, now_s: f64, cfg: &TrafficConfig) -> bool {
-        self.streaks
-            .iter()
-            .any(|r| r.id == t.id && r.mover_s.is_some_and(|m| now_s - m <= MOVER_LATELY_S))
-            && moved_beyond_its_extent(t, cfg)
+        self.mover_lately(t.id, now_s) && moved_beyond_its_extent(t, cfg)
+    }
+
+    /// Whether track `id` was a mover (its streak's `mover_s`) within [`MOVER_LATELY_S`].
+    fn mover_lately(&self, id: u32, now_s: f64) -> bool {
+        (self.streaks.iter())
+            .any(|r| r.id == id && r.mover_s.is_some_and(|m| now_s - m <= MOVER_LATELY_S))
     }
 
     /// Keeps the known movers out of view while standing (the tracker's confirmed movers, no
@@ -601,9 +605,7 @@ impl TrafficRules {
             // Less of it seen where it stood, as the vehicle goes by: no motion of its own -
             // unless it is a mover lately (a streak it has is not broken by this).
             let id = p.track.id;
-            let mover_lately = (self.streaks.iter())
-                .any(|r| r.id == id && r.mover_s.is_some_and(|m| now_s - m <= MOVER_LATELY_S));
-            if !mover_lately && self.hidden_in_place(&p.track) {
+            if !self.mover_lately(id, now_s) && self.hidden_in_place(&p.track) {
                 continue;
             }
             let r = match self.streaks.iter_mut().find(|r| r.id == id) {

@@ -181,7 +181,8 @@ pub(super) struct MoverPath {
     pub(super) id: u32,
     /// When and where it was seen.
     pub(super) seen: Vec<(f64, Point2<f64>)>,
-    /// When it was seen, and the corners of the box of its hits then, metres.
+    /// When it was seen, and the corners of the box of its hits then, metres (the last few
+    /// seconds only: what `hidden_in_place` reads).
     pub(super) boxes: Vec<(f64, HitBox)>,
 }
 
