@@ -61,4 +61,4 @@ pub use ros_occupancy::RosOccupancy;
 pub use scan::{Return, Scan, ScanColumn};
 pub use self_hits::SelfHitFilter;
 pub use self_mask::SelfMask;
-pub use tracking::{MovingObject, TrackState, Tracker, TrackerConfig};
+pub use tracking::{MovingObject, SeenFrom, TrackState, Tracker, TrackerConfig};

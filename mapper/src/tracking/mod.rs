@@ -41,11 +41,22 @@ mod tests;
 
 use foldhash::HashMap;
 
-use nalgebra::Point2;
+use nalgebra::{Isometry2, Point2};
 
 use crate::map::WorldCell;
 
 pub use config::TrackerConfig;
+
+/// Where the vehicle was when a revolution was seen, and the height below which an object is
+/// low (the vehicle's lowest level above the ground): what a low object's travel is measured
+/// against ([`Tracker::update_except`]).
+#[derive(Clone, Copy, Debug)]
+pub struct SeenFrom {
+    /// The vehicle's pose in the world, as the revolution's points were placed with.
+    pub vehicle: Isometry2<f64>,
+    /// An object seen in level 0 alone, with beams passing over it below this, is low, metres.
+    pub low_below_m: f32,
+}
 pub use state::{MovingObject, TrackState};
 use track::Track;
 
@@ -79,6 +90,9 @@ pub struct Tracker {
     tracks: Vec<Track>,
     next_id: u32,
     cells: HashMap<WorldCell, CellRecord>,
+    /// Where the vehicle was when the revolution being taken in was seen, and what is low
+    /// (`None`: not told).
+    seen_from: Option<SeenFrom>,
 }
 
 impl Tracker {
@@ -90,6 +104,7 @@ impl Tracker {
             tracks: Vec::new(),
             next_id: 0,
             cells: HashMap::default(),
+            seen_from: None,
         }
     }
 
@@ -104,7 +119,7 @@ impl Tracker {
     /// confirmed moving and seen this revolution, whose centre is now farther from them than its
     /// largest extent plus the clear margin, and not hit by anything since.
     pub fn update_with_levels(&mut self, t_s: f64, hits: &[(WorldCell, u32)]) -> Vec<WorldCell> {
-        self.update_except(t_s, hits, &[], |_| false)
+        self.update_except(t_s, None, hits, &[], |_| false)
     }
 
     /// [`Tracker::update_with_levels`], but the hits on cells `is_static` names (an offline
@@ -112,14 +127,19 @@ impl Tracker {
     /// object never passes for a mover, and a mover passing one (a truck beside a lamp post)
     /// is followed on its own hits. `open_tops` (sorted by cell, as
     /// `MultiHeightMap::last_scan_open_tops` gives them) says how high the object hit in a cell
-    /// may reach unseen ([`TrackState::open_top_m`]).
+    /// may reach unseen ([`TrackState::open_top_m`]). `seen_from`: where the vehicle was; a low track (hit in
+    /// level 0 alone, beams passing over it below `SeenFrom::low_below_m`) whose travel as seen
+    /// from the vehicle is under a quarter of its travel over the ground does not move (what
+    /// shows of a low wall slides along with the sensor: `Track::travel_m`).
     pub fn update_except(
         &mut self,
         t_s: f64,
+        seen_from: Option<SeenFrom>,
         hits: &[(WorldCell, u32)],
         open_tops: &[(WorldCell, f32)],
         is_static: impl Fn(WorldCell) -> bool,
     ) -> Vec<WorldCell> {
+        self.seen_from = seen_from;
         for &(c, _) in hits {
             self.cells
                 .entry(c)

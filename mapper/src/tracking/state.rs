@@ -83,12 +83,13 @@ impl Tracker {
     /// confirmed moving. A track seen again after a step its motion did not explain starts
     /// over.
     pub(super) fn mark_predictable(&mut self) {
+        let low_below_m = self.low_below_m();
         let cfg = &self.config;
         for t in &mut self.tracks {
             if t.bbox.is_none() {
                 continue;
             }
-            let travel = (t.last - t.first).norm();
+            let travel = t.travel_m(low_below_m);
             t.predictable = t.moving
                 || (t.steady >= cfg.predict_after_revolutions
                     && t.max_extent_m <= cfg.max_object_m
@@ -129,7 +130,8 @@ impl Tracker {
 
     /// The tracks seen this revolution, steadily for `predict_after_revolutions`, no larger
     /// than `max_extent_m`, not predictable, whose centre is (`travelled`) or is not yet
-    /// `predict_min_travel_m` from where it was first seen.
+    /// `predict_min_travel_m` from where it was first seen, over the ground (a low object
+    /// keeping pace with the vehicle is one to be cautious of: `Track::travel_m`).
     fn steady_unpredictable(&self, max_extent_m: f64, travelled: bool) -> Vec<TrackState> {
         let cfg = &self.config;
         self.tracks
@@ -139,7 +141,7 @@ impl Tracker {
                     && t.bbox.is_some()
                     && t.steady >= cfg.predict_after_revolutions
                     && t.max_extent_m <= max_extent_m
-                    && ((t.last - t.first).norm() >= cfg.predict_min_travel_m) == travelled
+                    && (t.ground_travel_m() >= cfg.predict_min_travel_m) == travelled
             })
             .map(|t| self.state(t))
             .collect()

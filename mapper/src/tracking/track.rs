@@ -20,6 +20,10 @@ pub(super) struct Track {
     pub(super) first: Point2<f64>,
     /// The centre of its hits when last seen.
     pub(super) last: Point2<f64>,
+    /// `first` and `last` in the frame of the vehicle that saw them then (`None`: the update
+    /// was not told where the vehicle was): see [`Track::travel_m`].
+    pub(super) first_rel: Option<Point2<f64>>,
+    pub(super) last_rel: Option<Point2<f64>>,
     /// When it was last seen, seconds.
     pub(super) last_t_s: f64,
     /// Sum of the centre's steps, metres.
@@ -56,7 +60,62 @@ pub(super) struct Track {
     pub(super) born_s: f64,
 }
 
+/// A low track whose travel as seen from the vehicle is under this share of its travel over the
+/// ground moves along with the sensor ([`Track::travel_m`]).
+const ALONG_WITH_THE_SENSOR: f64 = 0.25;
+
+impl Track {
+    /// How far its centre has travelled since its current motion started, metres: over the
+    /// ground - or, for a low track (`low_below_m`: told where the vehicle was), as the vehicle
+    /// saw it move when that is under [`ALONG_WITH_THE_SENSOR`] of it. A low object shows only
+    /// where the beams come down to it, so what shows of it slides along with the sensor: a
+    /// 0.3 m wall beside the path seemed to move at the jet's speed, cell by cell, and was
+    /// predicted into the main gear's path (`tests/found/low_wall_under_the_wing.toml`). Low
+    /// means hit in level 0 alone with beams seen passing over it below `low_below_m` (its open
+    /// top): a van under the wing is also hit in level 0 alone, the wing stopping the beams
+    /// above it, and one seen moving partly along with a braking jet must still become a mover
+    /// (`tests/found/van_lost_behind_the_wing_strikes_it.toml`). A low mover keeping pace with
+    /// the vehicle is then no mover to the tracker - the map holds it as an obstacle, beams
+    /// clear what it leaves, and its travel over the ground still makes it a candidate
+    /// ([`Tracker::candidate_movers`]) - but one that closes on it or crosses its path moves as
+    /// seen from it too.
+    pub(super) fn travel_m(&self, low_below_m: Option<f32>) -> f64 {
+        let ground = self.ground_travel_m();
+        let low = self.levels == 1
+            && low_below_m.is_some_and(|low| self.open_top_m.is_some_and(|top| top < low));
+        match (self.first_rel, self.last_rel) {
+            (Some(a), Some(b)) if low => {
+                let seen = (b - a).norm();
+                if seen < ALONG_WITH_THE_SENSOR * ground {
+                    seen
+                } else {
+                    ground
+                }
+            }
+            _ => ground,
+        }
+    }
+
+    /// How far its centre has travelled over the ground since its current motion started,
+    /// metres.
+    pub(super) fn ground_travel_m(&self) -> f64 {
+        (self.last - self.first).norm()
+    }
+}
+
 impl Tracker {
+    /// Below what an object is low, if the update was told (`SeenFrom::low_below_m`).
+    pub(super) fn low_below_m(&self) -> Option<f32> {
+        self.seen_from.map(|s| s.low_below_m)
+    }
+
+    /// Where `p` lies in the frame of the vehicle this revolution was seen from (`None`: not
+    /// told).
+    pub(super) fn relative(&self, p: Point2<f64>) -> Option<Point2<f64>> {
+        self.seen_from
+            .map(|v| v.vehicle.inverse_transform_point(&p))
+    }
+
     /// A new track at a cluster nobody follows; its index.
     pub(super) fn new_track(&mut self, t_s: f64, cluster: &Cluster) -> usize {
         let cfg = &self.config;
@@ -65,6 +124,8 @@ impl Tracker {
             origin: cluster.center,
             first: cluster.center,
             last: cluster.center,
+            first_rel: self.relative(cluster.center),
+            last_rel: self.relative(cluster.center),
             last_t_s: t_s,
             path_m: 0.0,
             recent_velocities: std::collections::VecDeque::new(),
@@ -93,6 +154,7 @@ impl Tracker {
 
     /// Track `ti` seen at `cluster` at `t_s`: its motion, what it paints, whether it moves.
     pub(super) fn follow(&mut self, ti: usize, t_s: f64, cluster: &Cluster) {
+        let rel = self.relative(cluster.center);
         let cfg = &self.config;
         let r = self.resolution_m;
         let (lo, hi) = cluster.bbox;
@@ -136,6 +198,7 @@ impl Tracker {
                 track.seen = 0;
             }
             track.first = cluster.center;
+            track.first_rel = rel;
             track.path_m = 0.0;
             track.recent_velocities.clear();
             track.motion = Motion::new(
@@ -156,6 +219,7 @@ impl Tracker {
         // 2 s as the airliner rolled 2 m, and was predicted into its wing).
         if !track.moving && on_known_cells(&self.cells, cluster, track.born_s) {
             track.first = cluster.center;
+            track.first_rel = rel;
             track.origin = cluster.center;
             track.path_m = 0.0;
         }
@@ -173,6 +237,7 @@ impl Tracker {
         }
         track.seen += 1;
         track.last = cluster.center;
+        track.last_rel = rel;
         track.last_t_s = t_s;
         track.bbox = Some(cluster.bbox);
         track.last_bbox = cluster.bbox;
@@ -203,9 +268,10 @@ impl Tracker {
     /// Confirms track `ti` moving once its centre has travelled more than its extent allows a
     /// static object's (see the module's documentation), steadily.
     fn confirm_if_moving(&mut self, ti: usize) {
+        let low_below_m = self.low_below_m();
         let cfg = &self.config;
         let track = &mut self.tracks[ti];
-        let travel = (track.last - track.first).norm();
+        let travel = track.travel_m(low_below_m);
         if !track.moving
             && track.max_extent_m <= cfg.max_object_m
             && travel >= cfg.min_travel_m.max(cfg.extent_factor * track.max_extent_m)

@@ -1,7 +1,7 @@
 //! The stack's online map: the offline multi-height map merged with what the LiDAR sees, kept
 //! around the vehicle's estimated pose, and the distance maps the collision checks read.
 
-use mapper::{CollisionModel, MultiHeightMap, Tracker, TrackerConfig, WorldCell};
+use mapper::{CollisionModel, MultiHeightMap, SeenFrom, Tracker, TrackerConfig, WorldCell};
 use nalgebra::{Matrix3, Point2};
 use serde::{Deserialize, Serialize};
 
@@ -168,9 +168,15 @@ impl OnlineMap {
                 (y - 1..=y + 1).any(|y| (0..levels).any(|l| map.is_prior_obstacle(l, (x, y))))
             })
         };
+        // Where the vehicle was, for low objects' travel as seen from it (`Track::travel_m`):
+        // below level 1 (with one level there is no telling what is low).
+        let seen_from = (levels > 1).then(|| SeenFrom {
+            vehicle: revolution.world_from_vehicle_estimate,
+            low_below_m: map.levels().heights_m()[1] as f32,
+        });
         let clear = self
             .tracker
-            .update_except(revolution.t_s, &hits, &tops, is_static);
+            .update_except(revolution.t_s, seen_from, &hits, &tops, is_static);
         self.map.clear_live(&clear);
         self.revolutions += 1;
         if self.revolutions.is_multiple_of(50) {
