@@ -127,10 +127,10 @@ impl Tracker {
     /// object never passes for a mover, and a mover passing one (a truck beside a lamp post)
     /// is followed on its own hits. `open_tops` (sorted by cell, as
     /// `MultiHeightMap::last_scan_open_tops` gives them) says how high the object hit in a cell
-    /// may reach unseen ([`TrackState::open_top_m`]). `seen_from`: where the vehicle was; a low track (hit in
-    /// level 0 alone, beams passing over it below `SeenFrom::low_below_m`) whose travel as seen
-    /// from the vehicle is under a quarter of its travel over the ground does not move (what
-    /// shows of a low wall slides along with the sensor: `Track::travel_m`).
+    /// may reach unseen ([`TrackState::open_top_m`]). `seen_from`: where the vehicle was; a
+    /// low track (hit in level 0 alone, beams passing over it below `SeenFrom::low_below_m`)
+    /// whose travel as seen from the vehicle is under a quarter of its travel over the ground
+    /// does not move (what shows of a low wall slides along with the sensor: `Track::travel_m`).
     pub fn update_except(
         &mut self,
         t_s: f64,
@@ -204,7 +204,7 @@ impl Tracker {
             .map(|t| MovingObject {
                 id: t.id,
                 position: t.last,
-                travel_m: (t.last - t.first).norm(),
+                travel_m: t.ground_travel_m(),
             })
             .collect()
     }

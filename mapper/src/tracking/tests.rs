@@ -626,10 +626,7 @@ fn a_low_cell_keeping_pace_then_drifting_in_becomes_a_mover() {
     // Turning: the vehicle on a circle of 40 m at 4 m/s, the cell 5 m to its right.
     let turning = |k: i64| {
         let a = 0.01 * k as f64;
-        Isometry2::new(
-            nalgebra::Vector2::new(40.0 * a.sin(), 40.0 - 40.0 * a.cos()),
-            a,
-        )
+        Isometry2::new(Vector2::new(40.0 * a.sin(), 40.0 - 40.0 * a.cos()), a)
     };
     let riding = |k: i64| {
         let p = turning(k) * Point2::new(8.0, -5.0);
