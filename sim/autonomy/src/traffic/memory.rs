@@ -6,6 +6,10 @@ use mapper::TrackState;
 use nalgebra::{Isometry2, Point2, Vector2};
 
 use super::body::{box_gap_m, cell_m, hit_box};
+use super::parts::{
+    CARRIED_BACK_S, DRIVEN_THROUGH_M, LEFT_WITH_M_S, carried_part, driven_over, part_of_another,
+    read_back, stood_in_its_body,
+};
 use super::rules::{AtBody, BodyHold, LostMover, MoverPath, MoverStreak, TrafficRules};
 use super::{
     TrafficConfig, at_body, came_there, may_have_walked_to, may_reach_body,
@@ -58,19 +62,11 @@ const ELSEWHERE_WITHIN_S: f64 = 10.0;
 /// walk).
 const ELSEWHERE_M_S: f64 = 1.5;
 
-/// A mover lost at the body going at this speed or more, m/s (a slow walk; a train of carts at
-/// 1.2 m/s whose centre seemed to slow to 0.6 m/s as the airframe hid it), has left with
-/// another going its way at as much ([`TrafficRules::left_with_others`]) ...
-const LEFT_WITH_M_S: f64 = 0.5;
-/// ... within this of its direction, radians (30 degrees) ...
+/// A mover lost at the body going at [`LEFT_WITH_M_S`] or more has left with another going its
+/// way at as much ([`TrafficRules::left_with_others`]) within this of its direction, radians (30
+/// degrees), that drove through where it was last seen ([`DRIVEN_THROUGH_M`]) and on beyond it
+/// by as much, or that carried it on (read back at most [`CARRIED_BACK_S`]) ...
 const LEFT_WITH_RAD: f64 = 0.52;
-/// ... that drove through where it was last seen (its centre within this of it, metres) and on
-/// beyond it by as much: two objects do not stand in one place (a train's carts, each followed
-/// by the next along one path) ...
-const DRIVEN_THROUGH_M: f64 = 0.75;
-/// ... or that carried it on, where it was then read from its motion for at most this long,
-/// seconds, when its kept path does not reach back (a candidate then).
-const CARRIED_BACK_S: f64 = 3.0;
 
 /// ... or, it and the other this extent or more, metres (a fuel truck, a train: what the
 /// tracker follows as two tracks of its parts; a van is 5.6 m, a cart 2), that was the same
@@ -203,13 +199,16 @@ impl TrafficRules {
             .collect();
         self.note_paths(&others, now_s);
         // One lost standing that was a part of another mover carried on (`carried_part`: a
-        // fuel truck's corner tracked apart, a follow-me car's front) or driven over by it
-        // (`driven_over`: a follow-me car's corner) is forgotten while it stays out of view.
+        // fuel truck's corner tracked apart, a follow-me car's front), driven over by it
+        // (`driven_over`: a follow-me car's corner) or standing where its body was
+        // (`stood_in_its_body`: a fuel truck's side) is forgotten while it stays out of view.
         // Kept, it held the jet 25 m off as its walk-to reach grew (variants 284 and 814 of
         // `traffic_jet.toml`: needless pilot calls; 399).
+        let from = Point2::from(pose.translation.vector);
         for l in &self.lost_standing {
             let taken = carried_part(l, &others, &self.paths, now_s)
-                || driven_over(l, &others, &self.paths);
+                || driven_over(l, &others, &self.paths)
+                || stood_in_its_body(l, &others, &self.paths, &from);
             if !self.parts.contains(&l.id) && taken {
                 self.parts.push(l.id);
             }
@@ -633,116 +632,4 @@ impl TrafficRules {
         }
         self.streaks.retain(|r| now_s - r.last_s <= MOVER_LATELY_S);
     }
-}
-
-/// Whether `t`, a track dropped, lay when last seen within the extent of another of `movers`
-/// (the movers, and the candidates that were movers lately) where that one was then (on its
-/// kept path, else within [`CARRIED_BACK_S`] as its motion says), no smaller than it by more
-/// than [`PART_SMALLER`] of its extent and hit in a level it was, seen after it: now, or
-/// [`SEEN_AFTER_S`] or more after `t` was last seen where it cannot reach the body (`reaches`
-/// says whether it can; two that went out of view together, a tug and its cart into the blind
-/// zone under the nose, tell nothing of each other). A part of it tracked apart, or the same
-/// object tracked twice - a fuel truck's split-off part that seemed to move the other way, a
-/// van's front (variants 27 and 32 of `traffic_jet.toml`, waited for as lost until the pilot was
-/// called), a follow-me car's front heading for the jet before the car backed aside (variant
-/// 41; variant 92: the car, slow as it backed, a candidate again); a follow-me car making room
-/// 40 m ahead, tracked twice, one track dropped as it swung round at 4 m/s the wrong way, the
-/// other seen on for a second as the car stood aside and no longer after (variant 287). Two vans
-/// in convoy closer than their length would be taken for one.
-fn part_of_another(
-    t: &TrackState,
-    movers: &[TrackState],
-    paths: &[MoverPath],
-    now_s: f64,
-    reaches: impl Fn(&TrackState) -> bool,
-) -> bool {
-    movers.iter().any(|o| {
-        let kept = (paths.iter().find(|p| p.id == o.id)).and_then(|p| p.at(t.t_s));
-        let Some(then) = kept.or_else(|| read_back(o, t.t_s)) else {
-            return false;
-        };
-        let seen_after = now_s - o.t_s <= 0.25 || (o.t_s - t.t_s >= SEEN_AFTER_S && !reaches(o));
-        o.id != t.id
-            && seen_after
-            && o.levels & t.levels != 0
-            && o.extent_m >= (1.0 - PART_SMALLER) * t.extent_m
-            && (then - t.position).norm() <= o.extent_m
-    })
-}
-
-/// What a part tracked apart may seem larger than the object it is part of, as a fraction of
-/// its extent: the largest extents two tracks of one object were seen with differ by a cell or
-/// two (variant 399 of `traffic_jet.toml`: a follow-me car tracked as 5.2 m and 5.0 m, the
-/// first dropped 48 m ahead of the jet in plain view, a pilot called for it). A person (0.9 m)
-/// is not part of a cart half their size.
-const PART_SMALLER: f64 = 0.1;
-
-/// A dropped track's other track, seen since but not now, was seen this long after it, seconds
-/// ([`part_of_another`]).
-const SEEN_AFTER_S: f64 = 0.5;
-
-/// Whether `t`, a mover lost standing, was a part of another of `movers` (the movers, and the
-/// candidates that were movers lately), no smaller than it and hit in a level it was, that
-/// drove over it: on that one's kept path, its centre was within its extent of `t` when `t` was
-/// last seen, and within [`CARRIED_BACK_S`] after, going [`LEFT_WITH_M_S`] or more over the
-/// second before, it was seen within [`DRIVEN_THROUGH_M`] of where `t` stood. Two objects do
-/// not stand in one place, and a person standing against a car going on steps no farther in a
-/// few seconds: a follow-me car backing aside at 2 m/s, its corner tracked apart as a person
-/// for 4 s and lost standing 2.8 m from the car's centre (beyond what [`carried_part`] takes,
-/// half its extent), which drove through that spot 1.2 s later (variant 399 of
-/// `traffic_jet.toml`, a pilot called for it 30 s on). Not one the other passes later, which
-/// may have walked off unseen before.
-fn driven_over(t: &TrackState, movers: &[TrackState], paths: &[MoverPath]) -> bool {
-    movers.iter().any(|o| {
-        let Some(path) = paths.iter().find(|p| p.id == o.id) else {
-            return false;
-        };
-        let going = |s: f64, at: &Point2<f64>| {
-            path.at(s - 1.0)
-                .is_some_and(|before| (at - before).norm() >= LEFT_WITH_M_S)
-        };
-        o.id != t.id
-            && o.levels & t.levels != 0
-            && o.extent_m >= t.extent_m
-            && (path.at(t.t_s)).is_some_and(|then| (then - t.position).norm() <= o.extent_m)
-            && (path.seen.iter()).any(|&(s, at)| {
-                s > t.t_s
-                    && s - t.t_s <= CARRIED_BACK_S
-                    && (at - t.position).norm() <= DRIVEN_THROUGH_M
-                    && going(s, &at)
-            })
-    })
-}
-
-/// Whether `t`, a mover lost standing, was a part of another of `movers` (the movers, and the
-/// candidates that were movers lately) that carried it on: one seen now, no smaller than it,
-/// hit in a level it was, tracked since before `t` was last seen, whose centre was then within
-/// half its extent of `t` and that was going at [`LEFT_WITH_M_S`] or more then - on its kept
-/// path (its speed over the second before), or within [`CARRIED_BACK_S`] as its motion says.
-/// A fuel truck's corner tracked apart as the truck crosses, a follow-me car's front as the car
-/// drives off. Not a person beside a truck standing; not decided once where the other was then
-/// is no longer known.
-fn carried_part(t: &TrackState, movers: &[TrackState], paths: &[MoverPath], now_s: f64) -> bool {
-    movers.iter().any(|o| {
-        let path = paths.iter().find(|p| p.id == o.id);
-        let kept = path.and_then(|p| Some((p.at(t.t_s)?, p.at(t.t_s - 1.0)?)));
-        let then = match kept {
-            Some((at, before)) => Some((at, (at - before).norm())),
-            None => read_back(o, t.t_s).map(|at| (at, o.velocity.norm())),
-        };
-        o.id != t.id
-            && now_s - o.t_s <= 0.25
-            && o.levels & t.levels != 0
-            && o.extent_m >= t.extent_m
-            && o.born_s <= t.t_s
-            && then.is_some_and(|(at, speed)| {
-                (at - t.position).norm() <= 0.5 * o.extent_m && speed >= LEFT_WITH_M_S
-            })
-    })
-}
-
-/// Where track `o` was at `t_s` as its motion says, if `t_s` is within [`CARRIED_BACK_S`] of when
-/// it was last seen (further back, its constant velocity tells nothing).
-fn read_back(o: &TrackState, t_s: f64) -> Option<Point2<f64>> {
-    ((o.t_s - t_s).abs() <= CARRIED_BACK_S).then(|| o.position + o.velocity * (t_s - o.t_s))
 }

@@ -53,8 +53,9 @@
 //! The files, by job: `predict` (the movers' footprints over the horizon), `conflict` (the
 //! space-time check of the path, where to stand clear), `body` (movers at or reaching the
 //! vehicle's body) - pure functions of tracks and poses - and the rules that keep memory from
-//! plan to plan ([`TrafficRules`], in `rules`, `speed_cap`, `closing`, `holds` and `memory`): one call a
-//! plan ([`TrafficRules::decide`]) turns the plan's inputs into its decision about movers.
+//! plan to plan ([`TrafficRules`], in `rules`, `speed_cap`, `closing`, `holds`, `memory` and
+//! `parts`): one call a plan ([`TrafficRules::decide`]) turns the plan's inputs into its
+//! decision about movers.
 
 mod body;
 mod closing;
@@ -67,6 +68,7 @@ mod holds;
 mod memory;
 #[cfg(test)]
 mod memory_tests;
+mod parts;
 #[cfg(test)]
 mod parts_tests;
 mod predict;

@@ -107,3 +107,64 @@ fn a_part_lost_standing_is_let_go_once_the_whole_drives_over_it() {
         assert!(k[1..].iter().all(|k| *k), "{why}: {k:?}");
     }
 }
+
+/// A fuel truck coming on towards the standing jet at 2 m/s, seen head-on: the box of its hits
+/// is its front (2.6 m wide, one cell deep), its extent 9.6 m. A piece of its side, tracked
+/// apart, seems to stand where the beams meet the side as the truck slides by and is lost at
+/// 10 s, 7 m behind the front - beyond half the extent from the centre of the hits
+/// (`carried_part`), 1.2 m beside the path of that centre (`driven_over`). It stood in the
+/// truck's body: forgotten from the first plan it was out of view (variants 439 and 930 of
+/// `traffic_jet.toml`: such pieces held the jet until it called a pilot). Kept: one a cell and
+/// more beside the truck's span, one beyond its extent behind its front, one ahead of its
+/// front, one beside the truck standing, one in another level, one behind the truck going away
+/// (the box of its hits may be its rear).
+#[test]
+fn a_piece_lost_standing_where_a_trucks_body_was_is_let_go() {
+    let config = AutonomyConfig::default();
+    let (cfg, hidden_after_s) = (&config.traffic, config.hidden_after_s);
+    let pose = Isometry2::identity();
+    // The truck's front at `t_s`: x from 14.0 to 16.6 m, at y = 11 - v (t - 7), going -y.
+    let truck = |t_s: f64, v: f64, levels: u32| {
+        let y = 11.0 - v * (t_s - 7.0);
+        let row = (y / 0.2).floor() as i64;
+        TrackState {
+            extent_m: 9.6,
+            born_s: 0.0,
+            bbox: ((70, row), (82, row)),
+            size_m: [2.6, 0.2],
+            ..track(32, t_s, (15.3, y), (0.0, -v), levels)
+        }
+    };
+    // Whether the piece (1.8 m, at `at`, seen standing from 7 s, lost at 10 s) is kept as
+    // lost standing at each plan from 10.5 s to 20 s.
+    let kept = |at: (f64, f64), v: f64, levels: u32| {
+        let mut r = rules();
+        r.streaks.push(rules_tests::mover_streak(31, 6.0));
+        (0..=26)
+            .filter_map(|k| {
+                let now = 7.0 + 0.5 * f64::from(k);
+                let piece = TrackState {
+                    extent_m: 1.8,
+                    ..track(31, now.min(10.0), at, (0.0, 0.0), 0b01)
+                };
+                let tracks = [piece, truck(now, v, levels)];
+                r.movers_at_body(&tracks, &pose, now, now > 10.0, cfg, hidden_after_s);
+                (now > 10.0).then(|| r.lost_standing.iter().any(|l| l.id == 31))
+            })
+            .collect::<Vec<_>>()
+    };
+    let side = kept((14.1, 12.0), 2.0, 0b01);
+    assert!(side.iter().all(|k| !k), "{side:?}");
+    for (why, at, v, levels) in [
+        ("beside its span", (13.5, 12.0), 2.0, 0b01),
+        ("beyond its extent", (14.1, 15.0), 2.0, 0b01),
+        ("ahead of its front", (14.1, 0.0), 2.0, 0b01),
+        ("the truck standing", (14.1, 12.0), 0.0, 0b01),
+        ("in another level", (14.1, 12.0), 2.0, 0b10),
+        // Going +y, away: its box at 10 s at y = 17, the piece 7 m behind that.
+        ("behind it going away", (14.1, 10.0), -2.0, 0b01),
+    ] {
+        let k = kept(at, v, levels);
+        assert!(k.iter().all(|k| *k), "{why}: {k:?}");
+    }
+}
