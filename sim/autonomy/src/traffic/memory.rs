@@ -130,6 +130,21 @@ impl TrafficRules {
             .retain(|&(s, _)| now_s - s <= VEHICLE_KEPT_S);
     }
 
+    /// The rearmost and foremost points of the vehicle's centreline at `pose`: where its
+    /// circles reach along its length.
+    fn centreline_ends(&self, pose: &Isometry2<f64>) -> [Point2<f64>; 2] {
+        let circles = self.model.circles();
+        let rear = circles
+            .iter()
+            .map(|c| c.x_m - c.radius_m)
+            .fold(0.0, f64::min);
+        let front = circles
+            .iter()
+            .map(|c| c.x_m + c.radius_m)
+            .fold(0.0, f64::max);
+        [rear, front].map(|x| pose * Point2::new(x, 0.0))
+    }
+
     /// Whether track `t` only shows less of itself where it stood as the vehicle moves by: the
     /// box of its hits is smaller than the box it was seen with [`HIDDEN_IN_PLACE_S`] or more
     /// before and lies within it (a cell more), on each axis one of its edges where it was
@@ -204,11 +219,11 @@ impl TrafficRules {
         // (`stood_in_its_body`: a fuel truck's side) is forgotten while it stays out of view.
         // Kept, it held the jet 25 m off as its walk-to reach grew (variants 284 and 814 of
         // `traffic_jet.toml`: needless pilot calls; 399).
-        let from = Point2::from(pose.translation.vector);
+        let ends = self.centreline_ends(pose);
         for l in &self.lost_standing {
             let taken = carried_part(l, &others, &self.paths, now_s)
                 || driven_over(l, &others, &self.paths)
-                || stood_in_its_body(l, &others, &self.paths, &from);
+                || stood_in_its_body(l, &others, &self.paths, (now_s, ends));
             if !self.parts.contains(&l.id) && taken {
                 self.parts.push(l.id);
             }

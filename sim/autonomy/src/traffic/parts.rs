@@ -139,22 +139,27 @@ pub(super) fn read_back(o: &TrackState, t_s: f64) -> Option<Point2<f64>> {
 
 /// Whether `t`, a mover lost standing, stood where the body of another of `movers` (the movers,
 /// and the candidates that were movers lately) was when `t` was last seen: one no smaller than
-/// it, hit in a level it was, seen since, going [`LEFT_WITH_M_S`] or more then (on its kept
-/// path, over the second before) towards the vehicle at `from` - so the box of its hits is its
-/// front, and the rest of it lies behind - with `t` behind that box's front along its way, no
-/// farther back than its extent, and across its way within the box's span (a cell more). Two
-/// objects do not stand in one place. What shows of a fuel truck coming on is its front; its
-/// side, seen as it passes, is tracked apart in pieces that seem to stand where the beams meet
-/// it as it slides by, and are lost as its rear passes (variants 439 and 930 of
-/// `traffic_jet.toml`: two of them, lost standing 7 and 9 m behind its front, held the jet
-/// until it called a pilot, the truck gone). Not one beside the box's span (a person the truck
-/// passes), ahead of its front, farther back than the truck's extent reaches, or behind one
-/// going away (its box may be its rear: a person may walk behind it).
+/// it, hit in a level it was, seen now, going [`LEFT_WITH_M_S`] or more then (on its kept path,
+/// over the second before) towards every point of the vehicle's centreline, `ends` (its
+/// rearmost and foremost points: the sensors lie between them, so the box of its hits, the
+/// side facing them, is its front and the rest of it lies behind), within [`ALONG_AN_AXIS_RAD`]
+/// of an axis of the map's grid (the box is of grid cells: across a slanted way it is wider
+/// than the object), with `t` behind that box's front along its way, no farther back than its
+/// extent, and across its way within the box's span (a cell more), the box seen within a
+/// revolution of then. Two objects do not stand in one place. What shows of a fuel truck coming
+/// on is its front; its side, seen as it passes, is tracked apart in pieces that seem to stand
+/// where the beams meet it as it slides by, and are lost as its rear passes (variants 439 and
+/// 930 of `traffic_jet.toml`: two of them, lost standing 7 and 9 m behind its front, held the
+/// jet until it called a pilot, the truck gone). Not one beside the box's span (a person the
+/// truck passes), ahead of its front, farther back than the truck's extent reaches, behind one
+/// going away from any part of the vehicle (its box may be its rear: a person may walk behind
+/// it), or one going slantwise. The extent is the largest the other was seen with: two tracks
+/// merged make it larger, and the window longer (docs/known-problems.md).
 pub(super) fn stood_in_its_body(
     t: &TrackState,
     movers: &[TrackState],
     paths: &[MoverPath],
-    from: &Point2<f64>,
+    (now_s, ends): (f64, [Point2<f64>; 2]),
 ) -> bool {
     movers.iter().any(|o| {
         let Some(path) = paths.iter().find(|p| p.id == o.id) else {
@@ -163,17 +168,24 @@ pub(super) fn stood_in_its_body(
         let (Some(at), Some(before)) = (path.at(t.t_s), path.at(t.t_s - 1.0)) else {
             return false;
         };
-        let Some(&(_, (lo, hi))) = path.boxes.iter().rev().find(|&&(s, _)| s <= t.t_s) else {
+        let Some(&(s, (lo, hi))) = path.boxes.iter().rev().find(|&&(s, _)| s <= t.t_s) else {
             return false;
         };
         let way = at - before;
         let speed = way.norm();
+        let slant = way
+            .x
+            .abs()
+            .min(way.y.abs())
+            .atan2(way.x.abs().max(way.y.abs()));
         if o.id == t.id
-            || o.t_s <= t.t_s
+            || now_s - o.t_s > 0.25
+            || t.t_s - s > 0.25
             || o.levels & t.levels == 0
             || o.extent_m < t.extent_m
             || speed < LEFT_WITH_M_S
-            || way.dot(&(from - at)) <= 0.0
+            || slant > ALONG_AN_AXIS_RAD
+            || ends.iter().any(|e| way.dot(&(e - at)) <= 0.0)
         {
             return false;
         }
@@ -191,3 +203,8 @@ pub(super) fn stood_in_its_body(
         a <= front && a >= front - o.extent_m && c >= left - cell && c <= right + cell
     })
 }
+
+/// How far off an axis of the map's grid a mover's way may be for [`stood_in_its_body`],
+/// radians (6 degrees: a 9.6 m truck's box, front and side seen, is then up to 1 m wider across
+/// its way than the truck; the centre of a truck crossing along an axis wanders 3 degrees).
+const ALONG_AN_AXIS_RAD: f64 = 0.105;

@@ -116,28 +116,37 @@ fn a_part_lost_standing_is_let_go_once_the_whole_drives_over_it() {
 /// truck's body: forgotten from the first plan it was out of view (variants 439 and 930 of
 /// `traffic_jet.toml`: such pieces held the jet until it called a pilot). Kept: one a cell and
 /// more beside the truck's span, one beyond its extent behind its front, one ahead of its
-/// front, one beside the truck standing, one in another level, one behind the truck going away
-/// (the box of its hits may be its rear).
+/// front, one beside the truck standing, one in another level, one behind the truck going
+/// away (the box of its hits may be its rear), one behind a truck going aft beside the jet
+/// (away from its nose, where the sensor is), one behind a truck going slantwise (its box is
+/// wider than it), one whose truck was out of view for the second and a half before (its box
+/// then is not where it was).
 #[test]
 fn a_piece_lost_standing_where_a_trucks_body_was_is_let_go() {
     let config = AutonomyConfig::default();
     let (cfg, hidden_after_s) = (&config.traffic, config.hidden_after_s);
     let pose = Isometry2::identity();
-    // The truck's front at `t_s`: x from 14.0 to 16.6 m, at y = 11 - v (t - 7), going -y.
-    let truck = |t_s: f64, v: f64, levels: u32| {
-        let y = 11.0 - v * (t_s - 7.0);
-        let row = (y / 0.2).floor() as i64;
+    // A truck at `t_s` whose front is the box `(x0, y0)` to `(x1, y1)` (cells of 0.2 m) at 7 s,
+    // going `v` m/s; `levels`.
+    let truck = |t_s: f64, ((x0, y0), (x1, y1)): ((i64, i64), (i64, i64)), v: (f64, f64)| {
+        let dt = t_s - 7.0;
+        let shift = |c: i64, v: f64| c + (v * dt / 0.2).round() as i64;
+        let ((x0, x1), (y0, y1)) = (
+            (shift(x0, v.0), shift(x1, v.0)),
+            (shift(y0, v.1), shift(y1, v.1)),
+        );
+        let centre = (0.1 * (x0 + x1 + 1) as f64, 0.1 * (y0 + y1 + 1) as f64);
         TrackState {
             extent_m: 9.6,
             born_s: 0.0,
-            bbox: ((70, row), (82, row)),
-            size_m: [2.6, 0.2],
-            ..track(32, t_s, (15.3, y), (0.0, -v), levels)
+            bbox: ((x0, y0), (x1, y1)),
+            size_m: [0.2 * (x1 - x0 + 1) as f64, 0.2 * (y1 - y0 + 1) as f64],
+            ..track(32, t_s, centre, v, 0b01)
         }
     };
     // Whether the piece (1.8 m, at `at`, seen standing from 7 s, lost at 10 s) is kept as
-    // lost standing at each plan from 10.5 s to 20 s.
-    let kept = |at: (f64, f64), v: f64, levels: u32| {
+    // lost standing at each plan from 10.5 s to 20 s, the truck seen as `seen` says.
+    let kept = |at: (f64, f64), seen: &dyn Fn(f64) -> TrackState, levels: u32| {
         let mut r = rules();
         r.streaks.push(rules_tests::mover_streak(31, 6.0));
         (0..=26)
@@ -145,26 +154,44 @@ fn a_piece_lost_standing_where_a_trucks_body_was_is_let_go() {
                 let now = 7.0 + 0.5 * f64::from(k);
                 let piece = TrackState {
                     extent_m: 1.8,
-                    ..track(31, now.min(10.0), at, (0.0, 0.0), 0b01)
+                    ..track(31, now.min(10.0), at, (0.0, 0.0), levels)
                 };
-                let tracks = [piece, truck(now, v, levels)];
+                let tracks = [piece, seen(now)];
                 r.movers_at_body(&tracks, &pose, now, now > 10.0, cfg, hidden_after_s);
                 (now > 10.0).then(|| r.lost_standing.iter().any(|l| l.id == 31))
             })
             .collect::<Vec<_>>()
     };
-    let side = kept((14.1, 12.0), 2.0, 0b01);
+    // Coming on down (-y) across the jet's way 15 m ahead, its front at y = 5 at 10 s.
+    let front = ((70, 55), (82, 55));
+    let down = |now: f64| truck(now, front, (0.0, -2.0));
+    let side = kept((14.1, 12.0), &down, 0b01);
     assert!(side.iter().all(|k| !k), "{side:?}");
-    for (why, at, v, levels) in [
-        ("beside its span", (13.5, 12.0), 2.0, 0b01),
-        ("beyond its extent", (14.1, 15.0), 2.0, 0b01),
-        ("ahead of its front", (14.1, 0.0), 2.0, 0b01),
-        ("the truck standing", (14.1, 12.0), 0.0, 0b01),
-        ("in another level", (14.1, 12.0), 2.0, 0b10),
-        // Going +y, away: its box at 10 s at y = 17, the piece 7 m behind that.
-        ("behind it going away", (14.1, 10.0), -2.0, 0b01),
+    let standing = |now: f64| truck(now, front, (0.0, 0.0));
+    let away = |now: f64| truck(now, ((70, 43), (82, 43)), (0.0, 2.0));
+    // Going aft (-x) 4 m right of the jet, its box (its rear, x = 10.4) at 10 s by the nose.
+    let aft = |now: f64| truck(now, ((82, -27), (82, -14)), (-2.0, 0.0));
+    // Slantwise, down and back at 45 degrees, its box's centre at (15.3, 5) at 10 s.
+    let slant = |now: f64| truck(now, ((91, 40), (100, 49)), (-1.414, -1.414));
+    // Out of view from 8.5 s to 10.5 s.
+    let gap = |now: f64| down(if now > 8.5 && now < 10.5 { 8.5 } else { now });
+    for (why, at, seen, levels) in [
+        (
+            "beside its span",
+            (13.5, 12.0),
+            &down as &dyn Fn(f64) -> TrackState,
+            0b01,
+        ),
+        ("beyond its extent", (14.1, 15.0), &down, 0b01),
+        ("ahead of its front", (14.1, 0.0), &down, 0b01),
+        ("the truck standing", (14.1, 12.0), &standing, 0b01),
+        ("in another level", (14.1, 12.0), &down, 0b10),
+        ("behind it going away", (14.1, 10.0), &away, 0b01),
+        ("behind it going aft", (17.0, -4.0), &aft, 0b01),
+        ("behind it slantwise", (20.3, 10.0), &slant, 0b01),
+        ("its box out of date", (14.1, 12.0), &gap, 0b01),
     ] {
-        let k = kept(at, v, levels);
+        let k = kept(at, seen, levels);
         assert!(k.iter().all(|k| *k), "{why}: {k:?}");
     }
 }

@@ -238,9 +238,9 @@ pub struct TrafficRules {
     pub(super) lost_standing: Vec<TrackState>,
     /// The tracks seen moving as movers for `MOVER_FOR_S` on end at some time.
     pub(super) walked: Vec<u32>,
-    /// The tracks lost standing that were parts of another mover carried on or driven over
-    /// (see `carried_part`, `driven_over`): not kept as lost standing while they stay out of
-    /// view.
+    /// The tracks lost standing that were parts of another mover carried on, driven over or
+    /// standing where its body was (see `carried_part`, `driven_over`, `stood_in_its_body`):
+    /// not kept as lost standing while they stay out of view.
     pub(super) parts: Vec<u32>,
     /// The tracks taken for movers lost at the body seen again (see `seen_elsewhere`): each
     /// lets go of one only.
