@@ -162,7 +162,7 @@ impl TrafficRules {
             return false;
         };
         let then_s = t.t_s - HIDDEN_IN_PLACE_S;
-        let Some(&(s, (lo0, hi0))) = path.boxes.iter().rev().find(|&&(s, _)| s <= then_s) else {
+        let Some((s, (lo0, hi0))) = path.box_by(then_s) else {
             return false;
         };
         let at = |s: f64| {

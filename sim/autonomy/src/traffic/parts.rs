@@ -168,7 +168,7 @@ pub(super) fn stood_in_its_body(
         let (Some(at), Some(before)) = (path.at(t.t_s), path.at(t.t_s - 1.0)) else {
             return false;
         };
-        let Some(&(s, (lo, hi))) = path.boxes.iter().rev().find(|&&(s, _)| s <= t.t_s) else {
+        let Some((s, (lo, hi))) = path.box_by(t.t_s) else {
             return false;
         };
         let way = at - before;

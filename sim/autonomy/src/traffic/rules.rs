@@ -201,6 +201,11 @@ impl MoverPath {
         let &(s1, p1) = self.seen.get(i)?;
         Some(p0 + (p1 - p0) * ((t_s - s0) / (s1 - s0)))
     }
+
+    /// The last box of its hits kept at or before `t_s`, and when it was seen.
+    pub(super) fn box_by(&self, t_s: f64) -> Option<(f64, HitBox)> {
+        self.boxes.iter().rev().find(|&&(s, _)| s <= t_s).copied()
+    }
 }
 
 /// The rules about movers and their memory: lines held, movers seen at the body, lost
