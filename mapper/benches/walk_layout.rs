@@ -81,6 +81,16 @@ fn update(v: &mut f32) {
     }
 }
 
+/// One Bresenham step's error update (`d` = (|dx|, -|dy|)): whether x and y step, without
+/// branches, as `walk_free` steps.
+#[inline(always)]
+fn advance(err: &mut i64, (dx, dy): (i64, i64)) -> (i64, i64) {
+    let e2 = 2 * *err;
+    let (mx, my) = (i64::from(e2 >= dy), i64::from(e2 <= dx));
+    *err += mx * dy + my * dx;
+    (mx, my)
+}
+
 /// The line's Bresenham state after `first` steps (stepped, as the walks are short to start).
 fn start(line: &Line) -> (i64, i64, i64, (i64, i64), (i64, i64), i64) {
     let (a, b) = (line.from, line.to);
@@ -88,9 +98,7 @@ fn start(line: &Line) -> (i64, i64, i64, (i64, i64), (i64, i64), i64) {
     let (sx, sy) = ((b.0 - a.0).signum(), (b.1 - a.1).signum());
     let (mut x, mut y, mut err) = (a.0, a.1, dx + dy);
     for _ in 0..line.first {
-        let e2 = 2 * err;
-        let (mx, my) = (i64::from(e2 >= dy), i64::from(e2 <= dx));
-        err += mx * dy + my * dx;
+        let (mx, my) = advance(&mut err, (dx, dy));
         x += mx * sx;
         y += my * sy;
     }
@@ -104,9 +112,7 @@ fn walk_row_major(data: &mut [f32], lines: &[Line]) {
         let mut i = y * SIDE + x;
         for _ in 0..steps {
             update(&mut data[i as usize]);
-            let e2 = 2 * err;
-            let (mx, my) = (i64::from(e2 >= dy), i64::from(e2 <= dx));
-            err += mx * dy + my * dx;
+            let (mx, my) = advance(&mut err, (dx, dy));
             i += mx * sx + my * sy * SIDE;
         }
     }
@@ -127,9 +133,7 @@ fn walk_tiled<const T: i64>(data: &mut [f32], lines: &[Line]) {
         let (mut x, mut y, mut err, (dx, dy), (sx, sy), steps) = start(line);
         for _ in 0..steps {
             update(&mut data[tiled::<T>(x, y)]);
-            let e2 = 2 * err;
-            let (mx, my) = (i64::from(e2 >= dy), i64::from(e2 <= dx));
-            err += mx * dy + my * dx;
+            let (mx, my) = advance(&mut err, (dx, dy));
             x += mx * sx;
             y += my * sy;
         }
