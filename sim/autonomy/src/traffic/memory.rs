@@ -7,8 +7,8 @@ use nalgebra::{Isometry2, Point2, Vector2};
 
 use super::body::{box_gap_m, cell_m, hit_box};
 use super::parts::{
-    CARRIED_BACK_S, DRIVEN_THROUGH_M, LEFT_WITH_M_S, carried_part, driven_over, part_of_another,
-    read_back, stood_in_its_body,
+    CARRIED_BACK_S, DRIVEN_THROUGH_M, LEFT_WITH_M_S, carried_part, driven_over,
+    lost_on_a_standing_object, part_of_another, read_back, stood_in_its_body,
 };
 use super::rules::{AtBody, BodyHold, LostMover, MoverPath, MoverStreak, TrafficRules};
 use super::{
@@ -283,6 +283,7 @@ impl TrafficRules {
                     let reaches =
                         |o: &TrackState| may_reach_body(&self.model, pose, o, window, cfg);
                     !part_of_another(t, &others, &self.paths, now_s, reaches)
+                        && !lost_on_a_standing_object(t, &others, now_s, cfg.hidden_m)
                 })
                 .filter(|t| may_reach_body(&self.model, pose, t, window, cfg))
                 .map(|t| AtBody::of(t, LostMover::Coasting))

@@ -1,6 +1,7 @@
 //! Parts of one object tracked apart: a track dropped or lost standing that was part of
 //! another mover, found by where that one was, drove or carried it ([`part_of_another`],
-//! [`driven_over`], [`carried_part`], [`stood_in_its_body`]).
+//! [`driven_over`], [`carried_part`], [`stood_in_its_body`]), or where it stands
+//! ([`lost_on_a_standing_object`]).
 
 use mapper::TrackState;
 use nalgebra::{Point2, Vector2};
@@ -65,6 +66,36 @@ const PART_SMALLER: f64 = 0.1;
 /// A dropped track's other track, seen since but not now, was seen this long after it, seconds
 /// ([`part_of_another`]).
 const SEEN_AFTER_S: f64 = 0.5;
+
+/// Whether `t`, a track dropped, was last seen on another of `movers` (the movers, and the
+/// candidates that were movers lately) that stands there now: seen now, slower than
+/// [`LEFT_WITH_M_S`], first seen before `t` was last seen, never beyond its extent (and the
+/// sensor's hidden margin, `hidden_m`) from where it was first seen - a static object's hits by
+/// the tracker's own measure -, no smaller than `t` by more than [`PART_SMALLER`], hit in a
+/// level `t` was, `t`'s last position within half its extent of its centre. Two objects do not
+/// stand in one place: what slid along it and was lost there was the part of it the sensor saw
+/// at the time. The visible side of an A320 parked at a stand the survey never saw slid along
+/// its fuselage at 6.5 m/s as the airliner went by, was lost 0.9 m from the centre of the
+/// fuselage's own 6.3 m track, which was no mover then (so no kept path says where it was),
+/// and held the airliner until a pilot call
+/// (`tests/found/ksyr_survey_parked_fuselage_held_as_a_mover_lost_coasting.toml`).
+pub(super) fn lost_on_a_standing_object(
+    t: &TrackState,
+    movers: &[TrackState],
+    now_s: f64,
+    hidden_m: f64,
+) -> bool {
+    movers.iter().any(|o| {
+        o.id != t.id
+            && now_s - o.t_s <= 0.25
+            && o.velocity.norm() < LEFT_WITH_M_S
+            && o.born_s <= t.t_s
+            && o.travel_m <= o.extent_m + hidden_m
+            && o.levels & t.levels != 0
+            && o.extent_m >= (1.0 - PART_SMALLER) * t.extent_m
+            && (o.position - t.position).norm() <= 0.5 * o.extent_m
+    })
+}
 
 /// Whether `t`, a mover lost standing, was a part of another of `movers` (the movers, and the
 /// candidates that were movers lately), no smaller than it and hit in a level it was, that
