@@ -283,7 +283,7 @@ impl TrafficRules {
                     let reaches =
                         |o: &TrackState| may_reach_body(&self.model, pose, o, window, cfg);
                     !part_of_another(t, &others, &self.paths, now_s, reaches)
-                        && !lost_on_a_standing_object(t, &others, now_s, cfg.hidden_m)
+                        && !lost_on_a_standing_object(t, &others, now_s, cfg)
                 })
                 .filter(|t| may_reach_body(&self.model, pose, t, window, cfg))
                 .map(|t| AtBody::of(t, LostMover::Coasting))

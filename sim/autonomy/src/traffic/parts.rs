@@ -8,6 +8,7 @@ use nalgebra::{Point2, Vector2};
 
 use super::body::cell_m;
 use super::rules::MoverPath;
+use super::{TrafficConfig, moved_beyond_its_extent};
 
 /// A mover going at this speed or more, m/s (a slow walk; a train of carts at 1.2 m/s whose
 /// centre seemed to slow to 0.6 m/s as the airframe hid it), may have taken a part of it, or a
@@ -69,12 +70,11 @@ const SEEN_AFTER_S: f64 = 0.5;
 
 /// Whether `t`, a track dropped, was last seen on another of `movers` (the movers, and the
 /// candidates that were movers lately) that stands there now: seen now, slower than
-/// [`LEFT_WITH_M_S`], first seen before `t` was last seen, never beyond its extent (and the
-/// sensor's hidden margin, `hidden_m`) from where it was first seen - a static object's hits by
-/// the tracker's own measure -, no smaller than `t` by more than [`PART_SMALLER`], hit in a
-/// level `t` was, `t`'s last position within half its extent of its centre. Two objects do not
-/// stand in one place: what slid along it and was lost there was the part of it the sensor saw
-/// at the time. The visible side of an A320 parked at a stand the survey never saw slid along
+/// [`LEFT_WITH_M_S`], first seen before `t` was last seen, never beyond its extent from where it
+/// was first seen ([`moved_beyond_its_extent`]: a static object's hits by the tracker's own
+/// measure), no smaller than `t` by more than [`PART_SMALLER`], hit in a level `t` was, `t`'s
+/// last position within half its extent of its centre. Two objects do not stand in one place:
+/// what slid along it and was lost there was the part of it the sensor saw at the time. The visible side of an A320 parked at a stand the survey never saw slid along
 /// its fuselage at 6.5 m/s as the airliner went by, was lost 0.9 m from the centre of the
 /// fuselage's own 6.3 m track, which was no mover then (so no kept path says where it was),
 /// and held the airliner until a pilot call
@@ -83,14 +83,14 @@ pub(super) fn lost_on_a_standing_object(
     t: &TrackState,
     movers: &[TrackState],
     now_s: f64,
-    hidden_m: f64,
+    cfg: &TrafficConfig,
 ) -> bool {
     movers.iter().any(|o| {
         o.id != t.id
             && now_s - o.t_s <= 0.25
             && o.velocity.norm() < LEFT_WITH_M_S
             && o.born_s <= t.t_s
-            && o.travel_m <= o.extent_m + hidden_m
+            && !moved_beyond_its_extent(o, cfg)
             && o.levels & t.levels != 0
             && o.extent_m >= (1.0 - PART_SMALLER) * t.extent_m
             && (o.position - t.position).norm() <= 0.5 * o.extent_m

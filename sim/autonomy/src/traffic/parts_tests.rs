@@ -203,7 +203,8 @@ fn a_piece_lost_standing_where_a_trucks_body_was_is_let_go() {
 /// `airport_ksyr.toml`). Let go: two objects do not stand in one place. Held when the standing
 /// one was first seen after the van was last seen, is not seen now, moves, travelled beyond its
 /// extent, is a tenth smaller than the van, or stands farther than half its extent from where
-/// the van was lost. (Within 3 s the other's motion read back says where it was: [`part_of_another`].)
+/// the van was lost. (Within 3 s the other's motion read back says where it was:
+/// [`part_of_another`].)
 #[test]
 fn a_track_dropped_on_an_object_standing_there_is_let_go() {
     let config = AutonomyConfig::default();
