@@ -10,6 +10,8 @@
 //!   [`Odometry`] in, [`Command`] out.
 //! - [`localizer`]: the particle filter over the offline map (remission, likelihood field).
 //! - [`online_map`]: the offline map merged with live LiDAR data around the estimate.
+//! - [`beams_through`]: which beams of a revolution passed through a place (a lost track's way
+//!   seen empty).
 //! - [`planner`]: candidates, the avoider, the behaviour, pure pursuit.
 //! - [`route`]: route geometry and Frenet projection.
 //! - [`traffic`]: movers predicted over the horizon, the space-time check of the path, and the
@@ -17,6 +19,7 @@
 //!   and where to stop out).
 //! - [`stack`]: the [`Driver`], which ties them together and tracks its own route progress.
 
+pub mod beams_through;
 pub mod localizer;
 pub mod messages;
 pub mod online_map;

@@ -5,7 +5,12 @@ use mapper::{CollisionModel, MultiHeightMap, SeenFrom, Tracker, TrackerConfig, W
 use nalgebra::{Matrix3, Point2};
 use serde::{Deserialize, Serialize};
 
+use crate::beams_through::{ColumnIndex, WAY_CHECKED_EXTENT_M, way_seen_empty};
 use crate::messages::LidarRevolution;
+
+/// How long a lost track's way seen empty is kept, seconds: longer than a track coasts before
+/// the tracker drops it.
+const WAYS_KEPT_S: f64 = 30.0;
 
 /// How live occupancy the LiDAR no longer sees fades back to the offline map.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -65,6 +70,9 @@ pub struct OnlineMap {
     revolutions: u64,
     /// Whether the estimate has trusted a revolution out to the obstacle test's range yet.
     started: bool,
+    /// The lost tracks whose way a revolution saw empty since they were last seen, and when,
+    /// seconds ([`OnlineMap::ways_seen_empty`]).
+    ways_seen_empty: Vec<(u32, f64)>,
 }
 
 /// The cells a revolution hit, each with the levels it was hit in (bit `l`: level `l`).
@@ -121,6 +129,7 @@ impl OnlineMap {
             tracker,
             revolutions: 0,
             started: false,
+            ways_seen_empty: Vec::new(),
         }
     }
 
@@ -178,6 +187,7 @@ impl OnlineMap {
             .tracker
             .update_except(revolution.t_s, seen_from, &hits, &tops, is_static);
         self.map.clear_live(&clear);
+        self.note_ways_seen_empty(revolution);
         self.revolutions += 1;
         if self.revolutions.is_multiple_of(50) {
             // What the tracker remembers of cells: the window's square.
@@ -186,6 +196,39 @@ impl OnlineMap {
             self.tracker.prune(&at, half);
         }
         Ok(())
+    }
+
+    /// Notes the tracks lost from view (not seen in `revolution`), small enough to be checked
+    /// ([`WAY_CHECKED_EXTENT_M`]), whose way since the revolution saw empty
+    /// ([`way_seen_empty`]); forgets what is older than [`WAYS_KEPT_S`].
+    fn note_ways_seen_empty(&mut self, revolution: &LidarRevolution) {
+        let t_s = revolution.t_s;
+        self.ways_seen_empty
+            .retain(|&(_, s)| t_s - s <= WAYS_KEPT_S);
+        let seen = &self.ways_seen_empty;
+        let lost: Vec<mapper::TrackState> = (self.tracker.movers().into_iter())
+            .filter(|t| t.t_s < t_s && t.extent_m <= WAY_CHECKED_EXTENT_M)
+            .filter(|t| !seen.iter().any(|&(id, s)| id == t.id && s > t.t_s))
+            .collect();
+        if lost.is_empty() {
+            return;
+        }
+        let index = ColumnIndex::new(revolution.scans());
+        let ground_z = self.map.config().obstacle_test.ground_height_m;
+        let heights = self.map.levels().heights_m();
+        for t in &lost {
+            if way_seen_empty(&index, t, t_s, ground_z, heights) {
+                self.ways_seen_empty.retain(|&(id, _)| id != t.id);
+                self.ways_seen_empty.push((t.id, t_s));
+            }
+        }
+    }
+
+    /// The tracks lost from view whose way the sensor has seen empty since
+    /// ([`crate::beams_through::way_seen_empty`]: neither gone that way nor stopped on it), and
+    /// when it last did, seconds; kept for [`WAYS_KEPT_S`], after the tracker drops them too.
+    pub fn ways_seen_empty(&self) -> &[(u32, f64)] {
+        &self.ways_seen_empty
     }
 
     /// Each sensor's scan inserted from its own origin (the obstacle test compares beams of one

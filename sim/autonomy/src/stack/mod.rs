@@ -250,6 +250,7 @@ impl Driver {
             hidden_after_s: self.config.hidden_after_s,
             yielding: self.stood_for_movers,
             traffic: &config.traffic,
+            ways_seen_empty: map.ways_seen_empty(),
         });
         let conflict = decision.conflict;
         let mut chosen = p.chosen().clone();

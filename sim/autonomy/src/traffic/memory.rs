@@ -271,7 +271,9 @@ impl TrafficRules {
         }
         // A mover that coasted out of view toward a standing vehicle and whose track was then
         // dropped: if it may reach the body within `DROPPED_AT_BODY_S`, it is waited for as
-        // one lost there (a van that drove into the blind zone behind the wing has not gone).
+        // one lost there (a van that drove into the blind zone behind the wing has not gone) -
+        // unless it never moved as a mover and the sensor saw its way empty since
+        // (`no_mover_gone`).
         if stopped {
             let window = (now_s, now_s + DROPPED_AT_BODY_S);
             let dropped = self
@@ -284,6 +286,7 @@ impl TrafficRules {
                         |o: &TrackState| may_reach_body(&self.model, pose, o, window, cfg);
                     !part_of_another(t, &others, &self.paths, now_s, reaches)
                         && !lost_on_a_standing_object(t, &others, now_s, cfg)
+                        && !self.no_mover_gone(t)
                 })
                 .filter(|t| may_reach_body(&self.model, pose, t, window, cfg))
                 .map(|t| AtBody::of(t, LostMover::Coasting))
@@ -332,6 +335,22 @@ impl TrafficRules {
             last_seen_s: r.seen_s,
             why: r.why,
         })
+    }
+
+    /// Whether `t`, lost from view, was no mover and is gone: never seen moving as a mover for
+    /// [`MOVER_FOR_S`] on end (`walked`), and its way seen empty after it was last seen
+    /// ([`super::MoverInputs::ways_seen_empty`]: low beams passed through every place on it
+    /// from where it was lost to where its peak speed takes it) - it neither went on that way
+    /// nor stopped on it. The visible side of the tail cone of an aircraft parked at a stand
+    /// the survey never held slid along it for 0.8 s, was lost 58 m off where nothing stands
+    /// and, its straight-line prediction reaching the standing airliner, held it until a pilot
+    /// call (`tests/found/ksyr_survey_parked_tail_cone_held_as_a_mover_lost_coasting.toml`).
+    /// Not one seen walking: a person who walked on under the wing and turned left the way
+    /// ahead empty, and was struck as the jet moved off
+    /// (`tests/found/person_lost_walking_under_the_wing.toml`).
+    fn no_mover_gone(&self, t: &TrackState) -> bool {
+        !self.walked.contains(&t.id)
+            && (self.ways_seen_empty.iter()).any(|&(id, s)| id == t.id && s > t.t_s)
     }
 
     /// The track of `movers` that is `lost` - a mover held at the body of the vehicle at `pose`
@@ -558,10 +577,13 @@ impl TrafficRules {
                 self.walked.push(r.id);
             }
         }
-        // Those neither tracked nor kept are forgotten.
-        let lost = &self.lost_standing;
-        self.walked
-            .retain(|id| movers.iter().any(|t| t.id == *id) || lost.iter().any(|l| l.id == *id));
+        // Those neither tracked nor kept (lost standing, or coasting at the last plan: a
+        // dropped one is judged by it, `no_mover_gone`) are forgotten.
+        let (lost, coasting) = (&self.lost_standing, &self.coasting);
+        self.walked.retain(|id| {
+            (movers.iter().any(|t| t.id == *id) || lost.iter().any(|l| l.id == *id))
+                || coasting.iter().any(|c| c.id == *id)
+        });
         // A part seen again is a track like any other: judged afresh if lost again.
         self.parts
             .retain(|id| movers.iter().any(|t| t.id == *id && now_s - t.t_s > 0.25));

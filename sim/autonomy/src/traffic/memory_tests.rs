@@ -489,15 +489,7 @@ fn a_van_that_drove_up_unconfirmed_and_coasted_towards_the_standing_jet_is_waite
             confirmed: false,
             ..track(21, 10.0, (4.0, -13.0), (0.0, 4.0), 0b01)
         };
-        // Seen predicted for half a second on end (a streak, not a mover's second).
-        let mut r = rules();
-        r.streaks.push(MoverStreak {
-            id: 21,
-            last_s: 10.0,
-            since_s: 9.5,
-            mover_s: None,
-        });
-        r.predictions = predict(std::slice::from_ref(&van), 10.0, cfg);
+        let mut r = rules_with_a_half_second_streak(&van, cfg);
         if walked {
             r.walked.push(21);
         }
@@ -516,6 +508,62 @@ fn a_van_that_drove_up_unconfirmed_and_coasted_towards_the_standing_jet_is_waite
         "{held:?}"
     );
     assert_eq!(dropped(false), None);
+}
+
+/// Rules that saw `t` predicted for half a second on end up to when it was last seen (a
+/// streak, not a mover's second).
+fn rules_with_a_half_second_streak(t: &TrackState, cfg: &TrafficConfig) -> TrafficRules {
+    let mut r = rules();
+    r.streaks.push(MoverStreak {
+        id: t.id,
+        last_s: t.t_s,
+        since_s: t.t_s - 0.5,
+        mover_s: None,
+    });
+    r.predictions = predict(std::slice::from_ref(t), t.t_s, cfg);
+    r
+}
+
+/// A track lost coasting towards the standing vehicle, never seen moving as a mover for a
+/// second on end, whose way the sensor saw empty after it was last seen (`ways_seen_empty`) is
+/// not waited for when it drops; seen empty only before it was last seen, or another track's
+/// way, or one seen walking as a mover (it may have turned off its way), it is.
+#[test]
+fn a_track_lost_coasting_whose_way_was_seen_empty_is_not_waited_for_unless_it_walked() {
+    let config = AutonomyConfig::default();
+    let (cfg, hidden_after_s) = (&config.traffic, config.hidden_after_s);
+    let pose = Isometry2::identity();
+    let dropped = |seen_empty: Vec<(u32, f64)>, walked: bool| {
+        let cart = track(21, 10.0, (4.0, -13.0), (0.0, 4.0), 0b01);
+        let mut r = if walked {
+            rules_with_mover(&cart, cfg)
+        } else {
+            rules_with_a_half_second_streak(&cart, cfg)
+        };
+        r.ways_seen_empty = seen_empty;
+        r.movers_at_body(&[cart], &pose, 10.5, true, cfg, hidden_after_s);
+        r.movers_at_body(&[], &pose, 12.5, true, cfg, hidden_after_s)
+    };
+    assert_eq!(dropped(vec![(21, 11.0)], false), None);
+    let kept = [
+        (vec![], false),
+        (vec![(21, 9.9)], false),
+        (vec![(22, 11.0)], false),
+        (vec![(21, 11.0)], true),
+    ];
+    for (seen_empty, walked) in kept {
+        let held = dropped(seen_empty.clone(), walked);
+        assert!(
+            matches!(
+                held,
+                Some(BodyHold::Lost {
+                    why: LostMover::Coasting,
+                    ..
+                })
+            ),
+            "{seen_empty:?}, walked {walked}: {held:?}"
+        );
+    }
 }
 
 /// Only the stopping distance taken because it is too late for a standing van's reach is kept

@@ -88,6 +88,7 @@ pub use conflict::{
     StandStop, first_conflict, first_conflict_straightforward, first_within_standing_reach,
     passes_standing, stand_clear, stand_clear_why,
 };
+pub(crate) use predict::reach;
 pub use predict::{came_there, moved_beyond_its_extent, predict, predict_keeping, surely_moving};
 pub use rules::{BodyHold, LostMover, MoverDecision, MoverInputs, TrafficRules};
 

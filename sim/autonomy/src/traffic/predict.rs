@@ -113,7 +113,7 @@ impl Footprint {
 /// where its velocity now puts it (`slow`) to where it would be at the peak speed it was seen
 /// with lately (`fast`; [`TrackState::peak_speed_m_s`]: one that seemed to slow as it went into
 /// the shadow of a wing may not have), and the standard deviation of its position then.
-pub(super) fn reach(t: &TrackState, dt_s: f64) -> (Point2<f64>, Point2<f64>, f64) {
+pub(crate) fn reach(t: &TrackState, dt_s: f64) -> (Point2<f64>, Point2<f64>, f64) {
     let (slow, sigma) = t.predict(dt_s);
     let speed = t.velocity.norm();
     if speed < 1e-9 {

@@ -61,6 +61,10 @@ pub struct MoverInputs<'a> {
     pub yielding: bool,
     /// How the movers are predicted and checked (the plan's `traffic`).
     pub traffic: &'a TrafficConfig,
+    /// The tracks lost from view whose way the sensor has seen empty since, and when, seconds
+    /// (`crate::OnlineMap::ways_seen_empty`): a mover lost coasting that neither went on its
+    /// way nor stopped on it is not waited for.
+    pub ways_seen_empty: &'a [(u32, f64)],
 }
 
 /// A mover at, or within reach of, the standing vehicle's body: it does not move off.
@@ -271,6 +275,8 @@ pub struct TrafficRules {
     pub(super) stood: Option<(Point2<f64>, Vec<Sighting>)>,
     /// Where the vehicle was at each plan of the last few seconds (see `note_vehicle`).
     pub(super) vehicle_seen: Vec<(f64, Point2<f64>)>,
+    /// The plan's tracks lost whose way was seen empty ([`MoverInputs::ways_seen_empty`]).
+    pub(super) ways_seen_empty: Vec<(u32, f64)>,
 }
 
 /// A track, and where it was seen.
@@ -303,6 +309,7 @@ impl TrafficRules {
             stand_line: None,
             stood: None,
             vehicle_seen: Vec::new(),
+            ways_seen_empty: Vec::new(),
         }
     }
 
@@ -326,6 +333,7 @@ impl TrafficRules {
         self.stand_line = None;
         self.stood = None;
         self.vehicle_seen.clear();
+        self.ways_seen_empty.clear();
     }
 
     /// The decision about movers for the plan `i`: the caution cap, the conflict, the stop
@@ -360,6 +368,7 @@ impl TrafficRules {
         }
         stop_at_m = self.short_of_walkers(i, stop_at_m);
         self.candidates = i.candidates.to_vec();
+        self.ways_seen_empty = i.ways_seen_empty.to_vec();
         let body = self.movers_at_body(i.movers, &i.pose, now_s, v0 < 0.05, cfg, i.hidden_after_s);
         // Standing beside a known mover standing within its reach: it may walk or drive on
         // into the airframe (or it touches it already): the vehicle does not move off.

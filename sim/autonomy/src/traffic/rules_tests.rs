@@ -91,6 +91,7 @@ pub(super) fn inputs<'a>(
         hidden_after_s: config.hidden_after_s,
         yielding: false,
         traffic: &config.traffic,
+        ways_seen_empty: &[],
     }
 }
 
