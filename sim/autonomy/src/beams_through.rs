@@ -7,7 +7,7 @@
 //! return: its columns sorted by azimuth from the sensor.
 
 use mapper::{Scan, TrackState};
-use nalgebra::Point2;
+use nalgebra::{Point2, Vector2};
 
 use crate::traffic::reach;
 
@@ -151,11 +151,12 @@ impl<'a> ColumnIndex<'a> {
 
 /// Whether the way lost track `t` went by `now_s`, as far as its peak speed takes it, was seen
 /// empty by the revolution `index` holds: at every place on it from where it was last seen,
-/// [`WAY_STEP_M`] apart, [`BEAMS_PER_PLACE`] beams passed through, from [`LOWEST_M`] above the
+/// and across it as wide as the track, [`WAY_STEP_M`] apart or less, [`BEAMS_PER_PLACE`] beams
+/// passed through, from [`LOWEST_M`] above the
 /// ground at `ground_z` up to the lowest height (`level_heights_m`) of the highest level it was
 /// hit in, and went on beyond it. Then it neither went that way nor stopped on it: a part of a
 /// parked aircraft that seemed to slide as the vehicle went by, not a mover. Not a track larger
-/// than [`WAY_CHECKED_EXTENT_M`] (always `false`).
+/// than [`WAY_CHECKED_EXTENT_M`], nor one not hit in the lowest level (always `false`).
 pub fn way_seen_empty(
     index: &ColumnIndex,
     t: &TrackState,
@@ -163,7 +164,8 @@ pub fn way_seen_empty(
     ground_z: f64,
     level_heights_m: &[f64],
 ) -> bool {
-    if t.extent_m > WAY_CHECKED_EXTENT_M || t.levels == 0 {
+    // Not hit in the lowest level, it may be overhead (a wing passing): beams under it pass.
+    if t.extent_m > WAY_CHECKED_EXTENT_M || t.levels & 1 == 0 {
         return false;
     }
     let highest = 31 - t.levels.leading_zeros() as usize;
@@ -176,9 +178,18 @@ pub fn way_seen_empty(
     let (_, fast, _) = reach(t, (now_s - t.t_s).max(0.0));
     let way = fast - t.position;
     let n = (way.norm() / WAY_STEP_M).ceil().max(1.0);
+    // Across the way as wide as the track: a walker a little off the line read is still on it.
+    let along = if way.norm() > 1e-9 { way } else { t.velocity };
+    let across = match along.try_normalize(1e-12) {
+        Some(u) => Vector2::new(-u.y, u.x) * 0.5 * t.extent_m,
+        None => Vector2::zeros(),
+    };
+    let m = (0.5 * t.extent_m / WAY_STEP_M).ceil().max(1.0);
+    let offsets = (-(m as i64)..=m as i64).map(|j| across * (j as f64 / m));
+    let offsets: Vec<Vector2<f64>> = offsets.collect();
     (0..=n as usize).all(|i| {
         let at = t.position + way * (i as f64 / n);
-        index.beams_through(&at, &through) >= BEAMS_PER_PLACE
+        (offsets.iter()).all(|o| index.beams_through(&(at + o), &through) >= BEAMS_PER_PLACE)
     })
 }
 

@@ -140,14 +140,25 @@ fn a_small_tracks_way_is_seen_empty_only_where_beams_pass_every_place_of_it() {
     let ground = revolution_with(0.0, &dense, |_, _| None);
     // 2 s on: from (25, 0) to (25, 2).
     assert!(seen_empty(&ground, lost_track(0.8, 0b11), 12.0));
-    // Larger than a person or a cart: never.
+    // Larger than a person or a cart, or not hit in the lowest level (a wing passing over the
+    // beams?): never.
     assert!(!seen_empty(&ground, lost_track(2.5, 0b11), 12.0));
+    assert!(!seen_empty(&ground, lost_track(0.8, 0b10), 12.0));
     // Hit in the lowest level only: beams 0.15-0.3 m up; the columns a degree apart leave
     // places between them with fewer than two.
     assert!(!seen_empty(&ground, lost_track(0.8, 0b01), 12.0));
     // Something stands 24 m out at azimuth 0 (the column through where it was last seen).
     let wall = revolution_with(0.0, &dense, |az, _| (az == 0).then_some(24.0));
     assert!(!seen_empty(&wall, lost_track(0.8, 0b11), 12.0));
+    // ... or 0.44 m beside the way of one going away from the sensor (azimuth -1 degree):
+    // within the width of a 0.8 m track, not of a 0.3 m one.
+    let beside = revolution_with(0.0, &dense, |az, _| (az == -1).then_some(24.0));
+    let going_away = |extent_m: f64| TrackState {
+        velocity: Vector2::new(1.0, 0.0),
+        ..lost_track(extent_m, 0b11)
+    };
+    assert!(!seen_empty(&beside, going_away(0.8), 12.0));
+    assert!(seen_empty(&beside, going_away(0.3), 12.0));
     // ... or on its way 2 m on (azimuth 5 degrees, 25.1 m out), not yet reached at 11 s.
     let ahead = revolution_with(0.0, &dense, |az, _| (az == 5).then_some(25.0));
     assert!(seen_empty(&ahead, lost_track(0.8, 0b11), 11.0));

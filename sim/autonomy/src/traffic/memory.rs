@@ -345,8 +345,9 @@ impl TrafficRules {
     /// the survey never held slid along it for 0.8 s, was lost 58 m off where nothing stands
     /// and, its straight-line prediction reaching the standing airliner, held it until a pilot
     /// call (`tests/found/ksyr_survey_parked_tail_cone_held_as_a_mover_lost_coasting.toml`).
-    /// Not one seen walking: a person who walked on under the wing and turned left the way
-    /// ahead empty, and was struck as the jet moved off
+    /// Not one seen walking, which may have turned off its way: with that condition or the way
+    /// checked as wide as the track, a person lost walking under the wing a little off the line
+    /// read is waited for; with neither, they were struck as the jet moved off
     /// (`tests/found/person_lost_walking_under_the_wing.toml`).
     fn no_mover_gone(&self, t: &TrackState) -> bool {
         !self.walked.contains(&t.id)
