@@ -19,9 +19,13 @@ pub const WAY_CHECKED_EXTENT_M: f64 = 2.0;
 /// Places along a way are this far apart, metres.
 const WAY_STEP_M: f64 = 0.5;
 
-/// Beams that must pass through each place of a way ([`way_seen_empty`]): one beam may pass
-/// between a person's legs.
+/// Beams that must pass through each place of a way ([`way_seen_empty`]) - with none hitting
+/// something there: one beam may pass between a person's legs.
 const BEAMS_PER_PLACE: usize = 2;
+
+/// How much farther than its peak speed a lost track's way is checked: it may have gone faster
+/// than it was seen going (seen a moment only, its speed is least sure), ...
+const WAY_SPEED_MARGIN: f64 = 1.5;
 
 /// A beam passes through a place low enough to meet an object there from this above the
 /// ground, metres (the obstacle test's least height, and a little), ...
@@ -49,6 +53,9 @@ pub struct Through {
     /// Its return lies this much farther from the sensor than the place or more, metres (what
     /// it hit is not what stood there).
     pub beyond_m: f64,
+    /// A return within the band this near the place, metres, is something standing there: no
+    /// beam passed through it.
+    pub veto_m: f64,
 }
 
 /// How far a sensor may move in a revolution, metres (a vehicle at 10 m/s, a 10 Hz sensor):
@@ -85,19 +92,22 @@ impl<'a> ColumnIndex<'a> {
 
     /// How many returns passed through the place `p` as `through` says: from their sensor,
     /// their track over the ground passes within `lateral_m` of `p`, at a height within
-    /// `band_z` there, and they hit `beyond_m` or more farther on.
-    pub fn beams_through(&self, p: &Point2<f64>, through: &Through) -> usize {
+    /// `band_z` there, and they hit `beyond_m` or more farther on. `None` when a return within
+    /// the band hit something within `veto_m` of `p`.
+    pub fn beams_through(&self, p: &Point2<f64>, through: &Through) -> Option<usize> {
         let to = p - self.origin;
         let d = to.norm();
-        let half = if d <= through.lateral_m + SENSOR_TRAVEL_M {
+        let near = through.lateral_m.max(through.veto_m) + SENSOR_TRAVEL_M;
+        let half = if d <= near {
             std::f64::consts::PI
         } else {
-            ((through.lateral_m + SENSOR_TRAVEL_M) / d).asin()
+            (near / d).asin()
         };
         let az = to.y.atan2(to.x);
         self.columns_within(az - half, az + half)
-            .map(|(k, c)| self.through_in_column(k, c, p, through))
-            .sum()
+            .try_fold(0, |n, (k, c)| {
+                Some(n + self.through_in_column(k, c, p, through)?)
+            })
     }
 
     /// The (scan, column) pairs whose azimuth lies within `lo..=hi` (radians, wrapped).
@@ -120,43 +130,52 @@ impl<'a> ColumnIndex<'a> {
         (first.chain(second)).map(|i| (self.by_azimuth[i].1, self.by_azimuth[i].2))
     }
 
-    /// How many returns of column `c` of scan `k` passed through `p` ([`Self::beams_through`]).
-    fn through_in_column(&self, k: usize, c: usize, p: &Point2<f64>, through: &Through) -> usize {
-        let Some((col, returns)) = self.scans[k].column(c) else {
-            return 0;
-        };
+    /// How many returns of column `c` of scan `k` passed through `p`; `None` when one hit
+    /// something there ([`Self::beams_through`]).
+    fn through_in_column(
+        &self,
+        k: usize,
+        c: usize,
+        p: &Point2<f64>,
+        through: &Through,
+    ) -> Option<usize> {
+        let (col, returns) = self.scans[k].column(c)?;
         let o = col.world_from_sensor.translation.vector;
         let to_p = Point2::new(p.x - o.x, p.y - o.y);
         let d_p = to_p.coords.norm();
-        returns
-            .iter()
-            .flatten()
-            .filter(|r| {
-                let h = r.point_in_world.coords - o;
-                let d_h = h.x.hypot(h.y);
-                if d_h < d_p + through.beyond_m || d_h <= 0.0 {
-                    return false;
-                }
-                let (ux, uy) = (h.x / d_h, h.y / d_h);
-                let along = to_p.x * ux + to_p.y * uy;
-                let aside = (to_p.y * ux - to_p.x * uy).abs();
-                let z = o.z + h.z * along / d_h;
-                along > 0.0
-                    && aside <= through.lateral_m
-                    && (through.band_z.0..=through.band_z.1).contains(&z)
-            })
-            .count()
+        let in_band = |z: f64| (through.band_z.0..=through.band_z.1).contains(&z);
+        let mut n = 0;
+        for r in returns.iter().flatten() {
+            let w = r.point_in_world;
+            if in_band(w.z) && (w.x - p.x).hypot(w.y - p.y) <= through.veto_m {
+                return None;
+            }
+            let h = w.coords - o;
+            let d_h = h.x.hypot(h.y);
+            if d_h < d_p + through.beyond_m || d_h <= 0.0 {
+                continue;
+            }
+            let (ux, uy) = (h.x / d_h, h.y / d_h);
+            let along = to_p.x * ux + to_p.y * uy;
+            let aside = (to_p.y * ux - to_p.x * uy).abs();
+            if along > 0.0 && aside <= through.lateral_m && in_band(o.z + h.z * along / d_h) {
+                n += 1;
+            }
+        }
+        Some(n)
     }
 }
 
-/// Whether the way lost track `t` went by `now_s`, as far as its peak speed takes it, was seen
-/// empty by the revolution `index` holds: at every place on it from where it was last seen,
-/// and across it as wide as the track, [`WAY_STEP_M`] apart or less, [`BEAMS_PER_PLACE`] beams
-/// passed through, from [`LOWEST_M`] above the
-/// ground at `ground_z` up to the lowest height (`level_heights_m`) of the highest level it was
-/// hit in, and went on beyond it. Then it neither went that way nor stopped on it: a part of a
-/// parked aircraft that seemed to slide as the vehicle went by, not a mover. Not a track larger
-/// than [`WAY_CHECKED_EXTENT_M`], nor one not hit in the lowest level (always `false`).
+/// Whether the way lost track `t` went by `now_s`, as far as [`WAY_SPEED_MARGIN`] times its
+/// peak speed takes it, was seen empty by the revolution `index` holds: at every place on it
+/// from where it was last seen, and across it as wide as the track, [`WAY_STEP_M`] apart or
+/// less, [`BEAMS_PER_PLACE`] beams passed through, none hitting something there, from
+/// [`LOWEST_M`] above the ground at `ground_z` up to the lowest height (`level_heights_m`) of the
+/// highest level it was hit in, and went on beyond it. Then it neither went that way nor stopped
+/// on it: a part of a parked aircraft that seemed to slide as the vehicle went by, not a mover.
+/// Not a track larger than [`WAY_CHECKED_EXTENT_M`], nor one not hit in the lowest level (always
+/// `false`). `ground_z` is the map's ground (the obstacle test's): on a sloping apron the band
+/// sits higher or lower above the ground there.
 pub fn way_seen_empty(
     index: &ColumnIndex,
     t: &TrackState,
@@ -174,9 +193,15 @@ pub fn way_seen_empty(
         band_z: (ground_z + LOWEST_M, ground_z + top.max(HIGHEST_AT_LEAST_M)),
         lateral_m: 0.25,
         beyond_m: 0.5 * t.extent_m + 0.25,
+        veto_m: (0.5 * t.extent_m).max(0.25),
     };
+    // ... and its half-length past that.
     let (_, fast, _) = reach(t, (now_s - t.t_s).max(0.0));
-    let way = fast - t.position;
+    let peak = fast - t.position;
+    let way = match peak.try_normalize(1e-12) {
+        Some(u) => peak * WAY_SPEED_MARGIN + u * 0.5 * t.extent_m,
+        None => peak,
+    };
     let n = (way.norm() / WAY_STEP_M).ceil().max(1.0);
     // Across the way as wide as the track: a walker a little off the line read is still on it.
     let along = if way.norm() > 1e-9 { way } else { t.velocity };
@@ -189,7 +214,11 @@ pub fn way_seen_empty(
     let offsets: Vec<Vector2<f64>> = offsets.collect();
     (0..=n as usize).all(|i| {
         let at = t.position + way * (i as f64 / n);
-        (offsets.iter()).all(|o| index.beams_through(&(at + o), &through) >= BEAMS_PER_PLACE)
+        (offsets.iter()).all(|o| {
+            index
+                .beams_through(&(at + o), &through)
+                .is_some_and(|n| n >= BEAMS_PER_PLACE)
+        })
     })
 }
 

@@ -50,6 +50,7 @@ const LOW: Through = Through {
     band_z: (0.15, 0.5),
     lateral_m: 0.25,
     beyond_m: 0.5,
+    veto_m: 0.25,
 };
 
 /// At 30 m the 5-degree beam passes 0.38 m up and meets the ground at 34.3 m: one beam (the
@@ -59,38 +60,41 @@ const LOW: Through = Through {
 fn a_beam_passes_low_through_a_place_only_where_it_goes_on_to_the_ground_beyond() {
     let scan = revolution(0.0, None);
     let index = ColumnIndex::new([&scan]);
-    assert_eq!(index.beams_through(&Point2::new(30.0, 0.0), &LOW), 1);
-    assert_eq!(index.beams_through(&Point2::new(0.0, 30.0), &LOW), 1);
-    assert_eq!(index.beams_through(&Point2::new(20.0, 0.0), &LOW), 0);
+    assert_eq!(index.beams_through(&Point2::new(30.0, 0.0), &LOW), Some(1));
+    assert_eq!(index.beams_through(&Point2::new(0.0, 30.0), &LOW), Some(1));
+    assert_eq!(index.beams_through(&Point2::new(20.0, 0.0), &LOW), Some(0));
     let high = Through {
         band_z: (1.0, 1.5),
         ..LOW
     };
-    assert_eq!(index.beams_through(&Point2::new(20.0, 0.0), &high), 1);
+    assert_eq!(index.beams_through(&Point2::new(20.0, 0.0), &high), Some(1));
     // Wider, the columns a degree either side count too.
     let wide = Through {
         lateral_m: 0.6,
         ..LOW
     };
-    assert_eq!(index.beams_through(&Point2::new(30.0, 0.0), &wide), 3);
+    assert_eq!(index.beams_through(&Point2::new(30.0, 0.0), &wide), Some(3));
 }
 
-/// A beam that hits something before the place, or at it (within `beyond_m`), did not pass
-/// through it: an object standing in front, or one standing there.
+/// A beam that hits something before the place did not pass through it (an object standing
+/// in front); one that hits something at it, within the band, says something stands there
+/// (`None`, whatever other beams passed).
 #[test]
 fn a_beam_stopped_before_or_at_the_place_does_not_pass_through_it() {
-    for range in [25.0, 30.2] {
-        let scan = revolution(0.0, Some((0, 1, range)));
-        let index = ColumnIndex::new([&scan]);
-        assert_eq!(
-            index.beams_through(&Point2::new(30.0, 0.0), &LOW),
-            0,
-            "{range}"
-        );
-    }
+    let scan = revolution(0.0, Some((0, 1, 25.0)));
+    let index = ColumnIndex::new([&scan]);
+    assert_eq!(index.beams_through(&Point2::new(30.0, 0.0), &LOW), Some(0));
+    let scan = revolution(0.0, Some((0, 1, 30.2)));
+    let index = ColumnIndex::new([&scan]);
+    assert_eq!(index.beams_through(&Point2::new(30.0, 0.0), &LOW), None);
+    let wide = Through {
+        lateral_m: 0.6,
+        ..LOW
+    };
+    assert_eq!(index.beams_through(&Point2::new(30.0, 0.0), &wide), None);
     let scan = revolution(0.0, Some((0, 1, 40.0)));
     let index = ColumnIndex::new([&scan]);
-    assert_eq!(index.beams_through(&Point2::new(30.0, 0.0), &LOW), 1);
+    assert_eq!(index.beams_through(&Point2::new(30.0, 0.0), &LOW), Some(1));
 }
 
 /// Behind the sensor, where azimuths wrap from 180 to -180 degrees, and from a sensor that is
@@ -99,12 +103,20 @@ fn a_beam_stopped_before_or_at_the_place_does_not_pass_through_it() {
 fn places_behind_the_sensor_are_found_across_the_azimuths_wrap() {
     let scan = revolution(5.0, None);
     let index = ColumnIndex::new([&scan]);
-    assert_eq!(index.beams_through(&Point2::new(-25.0, 0.01), &LOW), 1);
-    assert_eq!(index.beams_through(&Point2::new(-25.0, -0.01), &LOW), 1);
-    assert_eq!(index.beams_through(&Point2::new(35.0, 0.0), &LOW), 1);
+    assert_eq!(
+        index.beams_through(&Point2::new(-25.0, 0.01), &LOW),
+        Some(1)
+    );
+    assert_eq!(
+        index.beams_through(&Point2::new(-25.0, -0.01), &LOW),
+        Some(1)
+    );
+    assert_eq!(index.beams_through(&Point2::new(35.0, 0.0), &LOW), Some(1));
+    // Off the axis: azimuths are taken from the sensor, not the world's origin.
+    assert_eq!(index.beams_through(&Point2::new(5.0, 30.0), &LOW), Some(1));
     let empty = Scan::new(3, Vec::new(), Vec::new()).unwrap();
     let index = ColumnIndex::new([&empty]);
-    assert_eq!(index.beams_through(&Point2::new(30.0, 0.0), &LOW), 0);
+    assert_eq!(index.beams_through(&Point2::new(30.0, 0.0), &LOW), Some(0));
 }
 
 /// A track of `extent_m` hit in `levels`, last seen at 10 s at (25, 0) going along y at 1 m/s.
@@ -138,14 +150,14 @@ fn a_small_tracks_way_is_seen_empty_only_where_beams_pass_every_place_of_it() {
         way_seen_empty(&ColumnIndex::new([scan]), &t, now_s, 0.0, &heights)
     };
     let ground = revolution_with(0.0, &dense, |_, _| None);
-    // 2 s on: from (25, 0) to (25, 2).
+    // 2 s on: from (25, 0) to (25, 3.4) (1.5 times its way at its peak, and its half-length).
     assert!(seen_empty(&ground, lost_track(0.8, 0b11), 12.0));
     // Larger than a person or a cart, or not hit in the lowest level (a wing passing over the
     // beams?): never.
     assert!(!seen_empty(&ground, lost_track(2.5, 0b11), 12.0));
     assert!(!seen_empty(&ground, lost_track(0.8, 0b10), 12.0));
-    // Hit in the lowest level only: beams 0.15-0.3 m up; the columns a degree apart leave
-    // places between them with fewer than two.
+    // Hit in the lowest level only: beams 0.15-0.3 m up; a place on a column (24.6 or 25.4 m
+    // out) has one, and no other column within 0.25 m.
     assert!(!seen_empty(&ground, lost_track(0.8, 0b01), 12.0));
     // Something stands 24 m out at azimuth 0 (the column through where it was last seen).
     let wall = revolution_with(0.0, &dense, |az, _| (az == 0).then_some(24.0));
@@ -159,8 +171,15 @@ fn a_small_tracks_way_is_seen_empty_only_where_beams_pass_every_place_of_it() {
     };
     assert!(!seen_empty(&beside, going_away(0.8), 12.0));
     assert!(seen_empty(&beside, going_away(0.3), 12.0));
-    // ... or on its way 2 m on (azimuth 5 degrees, 25.1 m out), not yet reached at 11 s.
+    // ... or on its way 2.2 m on (azimuth 5 degrees, 25 m out): not yet reached at 10.5 s
+    // (0.75 m, 1.5 times its peak speed, and its half-length: 1.15 m), reached at 12 s, or at
+    // 10.5 s had its peak been 2 m/s (it may have gone faster than it was seen going).
     let ahead = revolution_with(0.0, &dense, |az, _| (az == 5).then_some(25.0));
-    assert!(seen_empty(&ahead, lost_track(0.8, 0b11), 11.0));
+    assert!(seen_empty(&ahead, lost_track(0.8, 0b11), 10.5));
     assert!(!seen_empty(&ahead, lost_track(0.8, 0b11), 12.0));
+    let faster = TrackState {
+        peak_speed_m_s: 2.0,
+        ..lost_track(0.8, 0b11)
+    };
+    assert!(!seen_empty(&ahead, faster, 10.5));
 }

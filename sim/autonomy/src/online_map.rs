@@ -232,8 +232,9 @@ impl OnlineMap {
     }
 
     /// Each sensor's scan inserted from its own origin (the obstacle test compares beams of one
-    /// sensor; the main one's self-hits filtered by the circles, the others' by their masks); the cells they hit, by level, and their open
-    /// tops, merged as one scan's are (levels joined, the highest top kept).
+    /// sensor; the main one's self-hits filtered by the circles, the others' by their masks);
+    /// the cells they hit, by level, and their open tops, merged as one scan's are (levels
+    /// joined, the highest top kept).
     fn insert_every_sensor(
         &mut self,
         revolution: &LidarRevolution,

@@ -565,8 +565,8 @@ impl TrafficRules {
     /// Keeps the known movers out of view while standing (the tracker's confirmed movers, no
     /// larger than [`LOST_STANDING_EXTENT_M`], that were seen moving for [`MOVER_FOR_S`] on end
     /// and travelled more than twice their extent and 3 m: a person who walked up and stopped,
-    /// not a static object's sliding parts, which seem to move in bursts), as last seen, after their tracks drop; forgets one seen again,
-    /// or lost [`LOST_STANDING_FOR_S`] ago.
+    /// not a static object's sliding parts, which seem to move in bursts), as last seen, after
+    /// their tracks drop; forgets one seen again, or lost [`LOST_STANDING_FOR_S`] ago.
     pub(super) fn note_lost_standing(
         &mut self,
         movers: &[TrackState],
