@@ -166,6 +166,13 @@ impl<'a> ColumnIndex<'a> {
     }
 }
 
+/// Whether lost track `t`'s way is checked at all ([`way_seen_empty`]): no larger than
+/// [`WAY_CHECKED_EXTENT_M`], and hit in the lowest level - one that is not may be overhead (a
+/// wing passing), and beams pass under it.
+pub fn way_checked(t: &TrackState) -> bool {
+    t.extent_m <= WAY_CHECKED_EXTENT_M && t.levels & 1 != 0
+}
+
 /// Whether the way lost track `t` went by `now_s`, as far as [`WAY_SPEED_MARGIN`] times its
 /// peak speed takes it, was seen empty by the revolution `index` holds: at every place on it
 /// from where it was last seen, and across it as wide as the track, [`WAY_STEP_M`] apart or
@@ -183,8 +190,7 @@ pub fn way_seen_empty(
     ground_z: f64,
     level_heights_m: &[f64],
 ) -> bool {
-    // Not hit in the lowest level, it may be overhead (a wing passing): beams under it pass.
-    if t.extent_m > WAY_CHECKED_EXTENT_M || t.levels & 1 == 0 {
+    if !way_checked(t) {
         return false;
     }
     let highest = 31 - t.levels.leading_zeros() as usize;

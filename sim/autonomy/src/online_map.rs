@@ -5,7 +5,7 @@ use mapper::{CollisionModel, MultiHeightMap, SeenFrom, Tracker, TrackerConfig, W
 use nalgebra::{Matrix3, Point2};
 use serde::{Deserialize, Serialize};
 
-use crate::beams_through::{ColumnIndex, WAY_CHECKED_EXTENT_M, way_seen_empty};
+use crate::beams_through::{ColumnIndex, way_checked, way_seen_empty};
 use crate::messages::LidarRevolution;
 
 /// How long a lost track's way seen empty is kept, seconds: longer than a track coasts before
@@ -198,8 +198,8 @@ impl OnlineMap {
         Ok(())
     }
 
-    /// Notes the tracks lost from view (not seen in `revolution`), small enough to be checked
-    /// ([`WAY_CHECKED_EXTENT_M`]), whose way since the revolution saw empty
+    /// Notes the tracks lost from view (not seen in `revolution`) whose way is checked
+    /// ([`way_checked`]: small, hit in the lowest level) and which the revolution saw empty
     /// ([`way_seen_empty`]); forgets what is older than [`WAYS_KEPT_S`].
     fn note_ways_seen_empty(&mut self, revolution: &LidarRevolution) {
         let t_s = revolution.t_s;
@@ -207,7 +207,7 @@ impl OnlineMap {
             .retain(|&(_, s)| t_s - s <= WAYS_KEPT_S);
         let seen = &self.ways_seen_empty;
         let lost: Vec<mapper::TrackState> = (self.tracker.movers().into_iter())
-            .filter(|t| t.t_s < t_s && t.extent_m <= WAY_CHECKED_EXTENT_M)
+            .filter(|t| t.t_s < t_s && way_checked(t))
             .filter(|t| !seen.iter().any(|&(id, s)| id == t.id && s > t.t_s))
             .collect();
         if lost.is_empty() {

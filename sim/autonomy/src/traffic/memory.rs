@@ -340,7 +340,7 @@ impl TrafficRules {
     /// Whether `t`, lost from view, was no mover and is gone: never seen moving as a mover for
     /// [`MOVER_FOR_S`] on end (`walked`), and its way seen empty after it was last seen
     /// ([`super::MoverInputs::ways_seen_empty`]: low beams passed through every place on it
-    /// from where it was lost to where its peak speed takes it) - it neither went on that way
+    /// from where it was lost to past where its peak speed takes it) - it neither went on that way
     /// nor stopped on it. The visible side of the tail cone of an aircraft parked at a stand
     /// the survey never held slid along it for 0.8 s, was lost 58 m off where nothing stands
     /// and, its straight-line prediction reaching the standing airliner, held it until a pilot
