@@ -568,8 +568,11 @@ pub struct ObstacleSpec {
     /// near side less than this beyond the vehicle's widest part (measured from the vehicle's
     /// centre line), it backs along its path and pulls aside, away from that line, until it
     /// is; from there it yields beside its path as before and drives on once the vehicle has
-    /// passed. Only
-    /// with `yields_to_vehicle_m`, not with `train`. Default none: it stands where it stopped.
+    /// passed. Not head-on (crossing), standing 3 s for the vehicle with some of its body
+    /// ahead of the vehicle and less than this beyond its widest part, it clears the way: it
+    /// moves on along its path (or back, if that is shorter) until all of it is, and yields
+    /// there. Only with `yields_to_vehicle_m`, not with `train`. Default none: it stands where
+    /// it stopped.
     pub makes_room_m: Option<Spanned<Positive>>,
     /// A towed train: this mover is the lead (a tug) and `cars` cars follow it along `path_m`,
     /// each an obstacle `<id>_car1`, `<id>_car2`, ... Only with `path_m`. Default none.

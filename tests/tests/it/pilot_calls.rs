@@ -113,7 +113,8 @@ fn a_train_standing_at_the_nose_out_of_view_makes_a_call_that_was_needed() {
     assert!(!call.needless, "{call:?}");
 }
 
-/// A careful van standing in the path for good (variant 38 of `traffic_jet.toml`): the jet
+/// A careful van standing in the path for good (variant 38 of `traffic_jet.toml`, without the
+/// `makes_room_m` its careful vans have since: they clear the way now): the jet
 /// stands short of its reach, stood for as an obstacle - a minute of it is a blocked way and a
 /// pilot is called, with the van there - not yielding to no conflict, silent to the time limit.
 #[test]

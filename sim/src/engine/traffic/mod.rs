@@ -24,7 +24,13 @@
 //!   [`MAKE_ROOM_SPEED_M_S`] over three times the shift it needs (8-30 m), pulling aside on a
 //!   smooth curve away from that line, its nose along the curve; from there on its path is
 //!   shifted by as much, and it yields on it as before (it may come on until the stretch ahead
-//!   is near the vehicle again) and drives on once the vehicle has passed. Once per run.
+//!   is near the vehicle again) and drives on once the vehicle has passed. **Clearing the
+//!   way** (the same field, the ramp rule for a vehicle caught in an aircraft's way): once it
+//!   has stood as long for a vehicle it is not head-on to, with some of its body ahead of the
+//!   vehicle and less than `makes_room_m` beyond its widest part from its centre line, it
+//!   moves along its path at up to [`MAKE_ROOM_SPEED_M_S`] - on, or back if that is shorter -
+//!   to the nearest place where all of its body is, and yields there as before. Once per run,
+//!   either.
 //! - a train's car: it keeps its place behind its lead (`TrainLink::behind_m` along the path)
 //!   whatever the lead does - profiles, stops, waits for the vehicle.
 //!
@@ -44,7 +50,7 @@ const SAME_PLACE_M: f64 = 1e-9;
 /// A driver that makes room does so once it has stood this long for the vehicle, seconds.
 pub const MAKE_ROOM_AFTER_S: f64 = 3.0;
 
-/// ... backing at up to this speed, m/s.
+/// ... backing (or clearing the way along its path) at up to this speed, m/s.
 pub const MAKE_ROOM_SPEED_M_S: f64 = 2.0;
 
 /// Making room: where it started backing, how far it backs, and the shift it pulls aside by.
@@ -52,7 +58,8 @@ pub const MAKE_ROOM_SPEED_M_S: f64 = 2.0;
 struct Room {
     /// Arc length it started backing from, metres.
     from_arc_m: f64,
-    /// How far it backs along its path, metres.
+    /// How far it backs along its path, metres (negative: it goes on along it, clearing the
+    /// way).
     back_m: f64,
     /// Its full sideways shift, metres (world frame).
     shift: Vector2<f64>,
@@ -330,7 +337,7 @@ fn advance(
         0.0
     };
     if r.room.is_none() && r.stood_s >= MAKE_ROOM_AFTER_S {
-        r.room = make_room(r, m, size_m[1], vehicle);
+        r.room = make_room(r, m, size_m, vehicle);
     }
     r.speed_m_s = if r.yielding {
         (r.speed_m_s - a * dt).max(0.0)
@@ -358,12 +365,14 @@ fn placed(r: &Reactive, m: &ObstacleMotion, speed_m_s: f64) -> MoverState {
     state
 }
 
-/// The room a driver standing head-on to the vehicle makes, if it must: `None` when the
-/// vehicle does not come towards it or it already stands `makes_room_m` clear.
+/// The room a driver of `size_m` (length, width) standing for the vehicle makes, if it must:
+/// head-on, it backs and pulls aside ([`Room`]'s shift); otherwise it clears the vehicle's way
+/// along its path ([`clear_way`]). `None` when it stands `makes_room_m` clear already, or
+/// cannot.
 fn make_room(
     r: &Reactive,
     m: &ObstacleMotion,
-    width_m: f64,
+    size_m: [f64; 2],
     vehicle: &VehicleView,
 ) -> Option<Room> {
     let clear_m = m.makes_room_m?;
@@ -372,10 +381,10 @@ fn make_room(
     // Headings within 45 degrees of opposite: the vehicle comes towards it.
     let opposite = -(here.heading_rad - v.rotation.angle()).cos();
     if opposite < std::f64::consts::FRAC_1_SQRT_2 {
-        return None;
+        return clear_way(r, m, size_m, vehicle, clear_m);
     }
     let local = v.inverse() * Point2::new(here.x_m, here.y_m);
-    let wanted_m = vehicle.half_span_m + 0.5 * width_m + clear_m;
+    let wanted_m = vehicle.half_span_m + 0.5 * size_m[1] + clear_m;
     let need_m = wanted_m - local.y.abs();
     if need_m <= 0.0 {
         return None;
@@ -391,22 +400,77 @@ fn make_room(
     })
 }
 
-/// One step of `dt` backing to make `room`: up to [`MAKE_ROOM_SPEED_M_S`], braking to stand
-/// at the curve's end, where the room is made.
+/// Where a driver of `size_m` (length, width) at arc length `r.arc_m` clears the vehicle's
+/// way, as a [`Room`] with no shift (`back_m` negative: on along its path): `None` when none of
+/// its body is ahead of the vehicle's origin, it is `clear_m` beyond the vehicle's widest part
+/// from its centre line already, or no place on its path is.
+fn clear_way(
+    r: &Reactive,
+    m: &ObstacleMotion,
+    size_m: [f64; 2],
+    vehicle: &VehicleView,
+    clear_m: f64,
+) -> Option<Room> {
+    let v = &vehicle.world_from_vehicle;
+    let vehicle_from_world = v.inverse();
+    // Its body's centre in the vehicle frame and its half extents along and across that frame.
+    let body = |arc_m: f64| {
+        let s = m.state_at_arc(arc_m, 0.0);
+        let c = vehicle_from_world * Point2::new(s.x_m, s.y_m);
+        let (sin, cos) = (s.yaw_rad - v.rotation.angle()).sin_cos();
+        let along = 0.5 * (size_m[0] * cos.abs() + size_m[1] * sin.abs());
+        let across = 0.5 * (size_m[0] * sin.abs() + size_m[1] * cos.abs());
+        (c, along, across)
+    };
+    let clear = |arc_m: f64| {
+        let (c, _, across) = body(arc_m);
+        c.y.abs() - across >= vehicle.half_span_m + clear_m
+    };
+    let (c, along, _) = body(r.arc_m);
+    if c.x + along <= 0.0 || clear(r.arc_m) {
+        return None;
+    }
+    const STEP_M: f64 = 0.25;
+    let path_m = m.length_m();
+    let steps = (path_m / STEP_M).ceil() as usize;
+    let on = (1..=steps)
+        .map(|k| (r.arc_m + k as f64 * STEP_M).min(path_m))
+        .find(|&a| clear(a));
+    let back = (1..=steps)
+        .map(|k| (r.arc_m - k as f64 * STEP_M).max(0.0))
+        .find(|&a| clear(a));
+    let to_m = match (on, back) {
+        (Some(on), Some(back)) if r.arc_m - back < on - r.arc_m => back,
+        (Some(on), _) => on,
+        (None, back) => back?,
+    };
+    Some(Room {
+        from_arc_m: r.arc_m,
+        back_m: r.arc_m - to_m,
+        shift: Vector2::zeros(),
+        done: false,
+    })
+}
+
+/// One step of `dt` making `room`: along its path (back, or on when clearing the way forward)
+/// at up to [`MAKE_ROOM_SPEED_M_S`], braking to stand at the curve's end, where the room is
+/// made.
 fn backing(r: &mut Reactive, room: Room, m: &ObstacleMotion, a: f64, dt: f64) -> MoverState {
-    let left_m = (r.arc_m - (room.from_arc_m - room.back_m)).max(0.0);
+    let to_m = room.from_arc_m - room.back_m;
+    let left_m = (r.arc_m - to_m).abs();
+    let sign = if to_m < r.arc_m { -1.0 } else { 1.0 };
     let speed = (r.speed_m_s.abs() + a * dt)
         .min(MAKE_ROOM_SPEED_M_S)
         .min((2.0 * a * left_m).sqrt());
     r.yielding = true;
     if left_m - speed * dt <= SAME_PLACE_M {
-        r.arc_m = room.from_arc_m - room.back_m;
+        r.arc_m = to_m;
         r.speed_m_s = 0.0;
         r.room = Some(Room { done: true, ..room });
         return placed(r, m, 0.0);
     }
-    r.arc_m -= speed * dt;
-    r.speed_m_s = -speed;
+    r.arc_m += sign * speed * dt;
+    r.speed_m_s = sign * speed;
     placed(r, m, r.speed_m_s)
 }
 
@@ -474,215 +538,4 @@ fn footprint_segment_distance(f: &Footprint, a: &Point2<f64>, b: &Point2<f64>) -
 }
 
 #[cfg(test)]
-mod tests {
-    use std::path::Path;
-
-    use super::*;
-    use crate::scenario::Scenario;
-
-    /// The fake-wing car at the origin heading +x; a van crossing x = 20 northwards, yielding
-    /// within 5 m.
-    fn scenario(extra: &str) -> Scenario {
-        let text = format!(
-            r#"name = "yield"
-[world]
-min_m = [-50.0, -50.0]
-max_m = [100.0, 50.0]
-[vehicle]
-description = "iara_car_fake_wing"
-[route]
-waypoints_m = [[0.0, 0.0], [90.0, 0.0]]
-speed_m_s = 3.0
-[[obstacles]]
-id = "van"
-kind = "vehicle"
-expect = "yield"
-path_m = [[20.0, -30.0], [20.0, 30.0]]
-speed_m_s = 3.0
-{extra}
-"#
-        );
-        Scenario::from_str(&text, Path::new("yield.toml")).unwrap_or_else(|e| panic!("{e}"))
-    }
-
-    fn run(traffic: &mut Traffic, from_s: f64, to_s: f64, pose: &Isometry2<f64>) -> f64 {
-        let dt = 0.01;
-        let mut t = from_s;
-        while t < to_s - 1e-9 {
-            t += dt;
-            traffic.step(t, pose);
-        }
-        t
-    }
-
-    #[test]
-    fn a_yielding_driver_stops_short_of_a_standing_vehicle_and_goes_once_it_is_clear() {
-        let s = scenario("yields_to_vehicle_m = 5.0");
-        let mut traffic = Traffic::new(&s.obstacles, &s.vehicle.vehicle);
-        // The car stands across the van's path, its rear axle on it.
-        let across = Isometry2::new(nalgebra::Vector2::new(20.0, 0.0), 0.0);
-        traffic.step(0.0, &across);
-        let t = run(&mut traffic, 0.0, 30.0, &across);
-        let van = traffic.state(0).expect("present");
-        assert_eq!(van.speed_m_s, 0.0, "stands");
-        assert!(traffic.yielding(0));
-        let front = van.y_m + 2.25;
-        // Across the van's line (x = 20) the car's body reaches y = -0.88 (its wing, 3.3 m
-        // ahead, is farther): the van's stretch (front + its length, 4.5 m, standing) stays
-        // 5 m off it, give or take a step.
-        assert!(
-            (-0.88 - 5.0 - 4.5 - 0.1..-0.88 - 5.0 - 4.5 + 0.3).contains(&front),
-            "front at {front}"
-        );
-        let stood = van.y_m;
-        // Still there 20 s later; then the car drives off and the van goes on to its end.
-        let t = run(&mut traffic, t, t + 20.0, &across);
-        assert_eq!(traffic.state(0).map(|v| v.y_m), Some(stood));
-        let gone = Isometry2::new(nalgebra::Vector2::new(80.0, 0.0), 0.0);
-        let t = run(&mut traffic, t, t + 5.0, &gone);
-        let van = traffic.state(0).expect("present");
-        assert!(!traffic.yielding(0));
-        assert!(van.y_m > stood + 5.0, "moved on to {}", van.y_m);
-        run(&mut traffic, t, t + 30.0, &gone);
-        assert_eq!(traffic.state(0).map(|v| (v.x_m, v.y_m)), Some((20.0, 30.0)));
-    }
-
-    #[test]
-    fn a_yielding_driver_ignores_a_vehicle_far_off_and_a_plain_mover_never_yields() {
-        let s = scenario("yields_to_vehicle_m = 5.0");
-        let mut traffic = Traffic::new(&s.obstacles, &s.vehicle.vehicle);
-        let far = Isometry2::new(nalgebra::Vector2::new(0.0, 0.0), 0.0);
-        traffic.step(0.0, &far);
-        run(&mut traffic, 0.0, 30.0, &far);
-        // From rest at 2 m/s^2 to 3 m/s and braking to its end: 60 m in 21.5 s.
-        assert_eq!(traffic.state(0).map(|v| (v.x_m, v.y_m)), Some((20.0, 30.0)));
-        let plain = scenario("");
-        let mut traffic = Traffic::new(&plain.obstacles, &plain.vehicle.vehicle);
-        let across = Isometry2::new(nalgebra::Vector2::new(20.0, 0.0), 0.0);
-        for k in 0..=1000 {
-            let t = f64::from(k) * 0.01;
-            traffic.step(t, &across);
-            assert_eq!(
-                traffic.state(0).map(|v| (v.x_m, v.y_m, v.yaw_rad)),
-                plain.obstacles[0].pose_at(t)
-            );
-        }
-    }
-
-    /// A driver that makes room, head-on to the standing vehicle: it stands 3 s, backs and
-    /// pulls aside until its near side is `makes_room_m` beyond the vehicle's widest part,
-    /// nose along its path, then yields on beside its path as before, and once the vehicle is
-    /// gone drives on to its end.
-    /// Crossing the vehicle's path (not head-on) it only waits, as before.
-    #[test]
-    fn a_driver_head_on_makes_room_and_drives_on_beside_its_path() {
-        let head_on =
-            scenario("yields_to_vehicle_m = 30.0\nmakes_room_m = 3.0\n").obstacles[0].clone();
-        let mut van = head_on.clone();
-        let m = van.motion.as_mut().expect("moves");
-        m.path_m = vec![Point2::new(80.0, 0.5), Point2::new(-40.0, 0.5)];
-        let s = scenario("yields_to_vehicle_m = 30.0\nmakes_room_m = 3.0\n");
-        let mut traffic = Traffic::new(std::slice::from_ref(&van), &s.vehicle.vehicle);
-        let here = Isometry2::identity();
-        traffic.step(0.0, &here);
-        let mut t = 0.0;
-        // Until it first stands for the vehicle, then 2.9 s on: it has not moved.
-        while !(traffic.yielding(0) && traffic.state(0).is_some_and(|v| v.speed_m_s == 0.0)) {
-            t = run(&mut traffic, t, t + 0.01, &here);
-        }
-        let first = traffic.state(0).expect("present");
-        t = run(&mut traffic, t, t + 2.9, &here);
-        assert_eq!(traffic.state(0), Some(first));
-        let mut farthest = first.x_m;
-        for _ in 0..6000 {
-            t = run(&mut traffic, t, t + 0.01, &here);
-            farthest = farthest.max(traffic.state(0).expect("present").x_m);
-        }
-        let stood = traffic.state(0).expect("present");
-        assert_eq!(stood.speed_m_s, 0.0);
-        assert!(traffic.yielding(0));
-        // Its near side (half its 1.9 m width in) stands 3 m beyond the widest part, on the
-        // side it was (+y), its nose along its path (-x).
-        let near_side = stood.y_m - 0.5 * van.solid.shape.width_m();
-        assert!(
-            (near_side - traffic.half_span_m - 3.0).abs() < 1e-9,
-            "near side at {near_side}, span {}",
-            traffic.half_span_m
-        );
-        assert!((stood.heading_rad.abs() - std::f64::consts::PI).abs() < 1e-9);
-        // Backed three times the shift (at least 8 m) from where it stopped first, then came
-        // on beside its path as far as the yield rule lets it: 30 m from the vehicle again.
-        let shift = stood.y_m - first.y_m;
-        let back = farthest - first.x_m;
-        assert!(
-            (stood.x_m - first.x_m).abs() < 1.0,
-            "stands at {}",
-            stood.x_m
-        );
-        assert!(
-            (back - (3.0 * shift).clamp(8.0, 30.0)).abs() < 1e-9,
-            "backed {back} for {shift}"
-        );
-        // The vehicle gone, it drives on to its path's end, shifted aside.
-        let gone = Isometry2::new(nalgebra::Vector2::new(200.0, 0.0), 0.0);
-        run(&mut traffic, t, t + 60.0, &gone);
-        let end = traffic.state(0).expect("present");
-        assert_eq!((end.x_m, end.y_m), (-40.0, stood.y_m));
-        // Crossing the vehicle's path, the same driver only waits (the yield test's van).
-        let mut traffic = Traffic::new(&s.obstacles, &s.vehicle.vehicle);
-        let across = Isometry2::new(nalgebra::Vector2::new(20.0, 0.0), 0.0);
-        traffic.step(0.0, &across);
-        run(&mut traffic, 0.0, 30.0, &across);
-        let van = traffic.state(0).expect("present");
-        assert_eq!((van.x_m, van.speed_m_s), (20.0, 0.0));
-    }
-
-    /// A plain mover and a yielding driver, halted (they touched the vehicle), stand where
-    /// they were for good, speed 0; a static obstacle or an absent one is left alone.
-    #[test]
-    fn a_halted_mover_stands_for_good() {
-        for extra in ["", "yields_to_vehicle_m = 5.0"] {
-            let s = scenario(extra);
-            let mut traffic = Traffic::new(&s.obstacles, &s.vehicle.vehicle);
-            let far = Isometry2::new(nalgebra::Vector2::new(-200.0, 0.0), 0.0);
-            traffic.halt(0); // not there yet: nothing to halt
-            let t = run(&mut traffic, -0.01, 5.0, &far);
-            let before = traffic.state(0).expect("present");
-            assert!(before.speed_m_s > 0.0, "{extra}: moving");
-            traffic.halt(0);
-            run(&mut traffic, t, t + 20.0, &far);
-            let after = traffic.state(0).expect("present");
-            assert_eq!(
-                (after.x_m, after.y_m, after.speed_m_s),
-                (before.x_m, before.y_m, 0.0),
-                "{extra}"
-            );
-        }
-    }
-
-    #[test]
-    fn distances_between_segments_and_footprints() {
-        let p = |x, y| Point2::new(x, y);
-        assert_eq!(
-            segments_distance(&p(0.0, -1.0), &p(0.0, 1.0), &p(-1.0, 0.0), &p(1.0, 0.0)),
-            0.0
-        );
-        let d = segments_distance(&p(0.0, 0.0), &p(1.0, 0.0), &p(2.0, 1.0), &p(2.0, 3.0));
-        assert!((d - 2f64.sqrt()).abs() < 1e-12);
-        let square = aircraft::footprint::ConvexPolygon::hull(&[
-            p(0.0, 0.0),
-            p(1.0, 0.0),
-            p(1.0, 1.0),
-            p(0.0, 1.0),
-        ])
-        .map(Footprint::Polygon)
-        .expect("a square");
-        // A segment passing through without an end inside.
-        assert_eq!(
-            footprint_segment_distance(&square, &p(-1.0, 0.5), &p(2.0, 0.5)),
-            0.0
-        );
-        let d = footprint_segment_distance(&square, &p(3.0, -1.0), &p(3.0, 2.0));
-        assert!((d - 2.0).abs() < 1e-12);
-    }
-}
+mod tests;
