@@ -27,10 +27,13 @@
 //!   is near the vehicle again) and drives on once the vehicle has passed. **Clearing the
 //!   way** (the same field, the ramp rule for a vehicle caught in an aircraft's way): once it
 //!   has stood as long for a vehicle it is not head-on to, with some of its body ahead of the
-//!   vehicle and less than `makes_room_m` beyond its widest part from its centre line, it
-//!   moves along its path at up to [`MAKE_ROOM_SPEED_M_S`] - on, or back if that is shorter -
-//!   to the nearest place where all of its body is, and yields there as before. Once per run,
-//!   either.
+//!   vehicle's origin and less than `makes_room_m` beyond the vehicle's widest part from its
+//!   centre line, it moves along its path at up to [`MAKE_ROOM_SPEED_M_S`] - on, or back if
+//!   that is shorter - to the nearest place where all of its body is that far aside, the way
+//!   there passing [`CLEAR_WAY_MARGIN_M`] clear of the vehicle's parts as they stood (it does
+//!   not look again while it moves), and yields there as before; having backed out, it also
+//!   stands while its body is still ahead of the vehicle's origin (the vehicle has not passed),
+//!   however far the vehicle is. Stops it moved past are passed. Once per run, either.
 //! - a train's car: it keeps its place behind its lead (`TrainLink::behind_m` along the path)
 //!   whatever the lead does - profiles, stops, waits for the vehicle.
 //!
@@ -53,23 +56,28 @@ pub const MAKE_ROOM_AFTER_S: f64 = 3.0;
 /// ... backing (or clearing the way along its path) at up to this speed, m/s.
 pub const MAKE_ROOM_SPEED_M_S: f64 = 2.0;
 
-/// Making room: where it started backing, how far it backs, and the shift it pulls aside by.
+/// A driver clearing the way moves only along a stretch of its path this far from every part
+/// of the vehicle (beyond half its width), metres.
+pub const CLEAR_WAY_MARGIN_M: f64 = 2.0;
+
+/// Making room: where it started moving, how far it backs (or goes on), and the shift it pulls
+/// aside by (zero when it clears the way).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Room {
-    /// Arc length it started backing from, metres.
+    /// Arc length it started moving from, metres.
     from_arc_m: f64,
     /// How far it backs along its path, metres (negative: it goes on along it, clearing the
     /// way).
     back_m: f64,
     /// Its full sideways shift, metres (world frame).
     shift: Vector2<f64>,
-    /// True once it has backed the whole way.
+    /// True once it has moved the whole way.
     done: bool,
 }
 
 impl Room {
     /// How far aside it is at arc length `arc_m` (0 to 1, smoothstep), and that fraction's
-    /// rate per metre of arc (negative: it grows as the arc falls).
+    /// rate per metre of arc (negative for a room made backing: it grows as the arc falls).
     fn blend(&self, arc_m: f64) -> (f64, f64) {
         if self.done {
             return (1.0, 0.0);
@@ -273,8 +281,9 @@ impl Traffic {
         self.states.get(k).copied().flatten()
     }
 
-    /// True when obstacle `k` is a driver that yields and it braked or stood for the vehicle
-    /// at the last step (a train's car: when its lead did).
+    /// True when obstacle `k` is a driver that yields and it braked or stood for the vehicle,
+    /// or moved to make room or clear its way, at the last step (a train's car: when its lead
+    /// did).
     pub fn yielding(&self, k: usize) -> bool {
         match self.drives.get(k) {
             Some(Drive::Yielding(r)) => r.yielding,
@@ -330,14 +339,20 @@ fn advance(
     let front_m = r.arc_m + 0.5 * length_m;
     let reach_m = front_m + r.speed_m_s * r.speed_m_s / (2.0 * a) + length_m;
     let within_m = m.yields_to_vehicle_m.unwrap_or(0.0);
-    r.yielding = front_m < path_m && near(front_m, reach_m.min(path_m), within_m);
+    r.yielding = front_m < path_m
+        && (near(front_m, reach_m.min(path_m), within_m)
+            || backed_out_ahead(r, m, size_m, vehicle));
     r.stood_s = if r.yielding && r.speed_m_s <= 0.0 {
         r.stood_s + dt
     } else {
         0.0
     };
     if r.room.is_none() && r.stood_s >= MAKE_ROOM_AFTER_S {
-        r.room = make_room(r, m, size_m, vehicle);
+        // Once a second after the first try: a way it cannot clear is looked for again.
+        let since = |s: f64| ((s - MAKE_ROOM_AFTER_S) / 1.0).floor();
+        let search =
+            r.stood_s - dt < MAKE_ROOM_AFTER_S || since(r.stood_s) != since(r.stood_s - dt);
+        r.room = make_room(r, m, size_m, vehicle, (&near, search));
     }
     r.speed_m_s = if r.yielding {
         (r.speed_m_s - a * dt).max(0.0)
@@ -369,11 +384,14 @@ fn placed(r: &Reactive, m: &ObstacleMotion, speed_m_s: f64) -> MoverState {
 /// head-on, it backs and pulls aside ([`Room`]'s shift); otherwise it clears the vehicle's way
 /// along its path ([`clear_way`]). `None` when it stands `makes_room_m` clear already, or
 /// cannot.
+/// `near` is the yield test's; `search`: whether to look for a way to clear now (a head-on
+/// driver's room is found at every call).
 fn make_room(
     r: &Reactive,
     m: &ObstacleMotion,
     size_m: [f64; 2],
     vehicle: &VehicleView,
+    (near, search): (&impl Fn(f64, f64, f64) -> bool, bool),
 ) -> Option<Room> {
     let clear_m = m.makes_room_m?;
     let here = m.state_at_arc(r.arc_m, 0.0);
@@ -381,7 +399,11 @@ fn make_room(
     // Headings within 45 degrees of opposite: the vehicle comes towards it.
     let opposite = -(here.heading_rad - v.rotation.angle()).cos();
     if opposite < std::f64::consts::FRAC_1_SQRT_2 {
-        return clear_way(r, m, size_m, vehicle, clear_m);
+        return if search {
+            clear_way(r, m, size_m, vehicle, (clear_m, near))
+        } else {
+            None
+        };
     }
     let local = v.inverse() * Point2::new(here.x_m, here.y_m);
     let wanted_m = vehicle.half_span_m + 0.5 * size_m[1] + clear_m;
@@ -400,45 +422,80 @@ fn make_room(
     })
 }
 
+/// A driver's body of `size_m` (length, width) at arc length `arc_m` of `m`, seen from the
+/// vehicle: its centre in the vehicle frame, and its half extents along and across that frame.
+fn body_seen(
+    m: &ObstacleMotion,
+    arc_m: f64,
+    size_m: [f64; 2],
+    vehicle: &VehicleView,
+) -> (Point2<f64>, f64, f64) {
+    let v = &vehicle.world_from_vehicle;
+    let s = m.state_at_arc(arc_m, 0.0);
+    let c = v.inverse() * Point2::new(s.x_m, s.y_m);
+    let (sin, cos) = (s.yaw_rad - v.rotation.angle()).sin_cos();
+    let along = 0.5 * (size_m[0] * cos.abs() + size_m[1] * sin.abs());
+    let across = 0.5 * (size_m[0] * sin.abs() + size_m[1] * cos.abs());
+    (c, along, across)
+}
+
+/// True when `r` backed out of the vehicle's way (a room with no shift, made backing) and some
+/// of its body is still ahead of the vehicle's origin: the vehicle has not passed it yet.
+fn backed_out_ahead(
+    r: &Reactive,
+    m: &ObstacleMotion,
+    size_m: [f64; 2],
+    vehicle: &VehicleView,
+) -> bool {
+    r.room
+        .is_some_and(|room| room.done && room.shift == Vector2::zeros() && room.back_m > 0.0)
+        && {
+            let (c, along, _) = body_seen(m, r.arc_m, size_m, vehicle);
+            c.x + along > 0.0
+        }
+}
+
 /// Where a driver of `size_m` (length, width) at arc length `r.arc_m` clears the vehicle's
 /// way, as a [`Room`] with no shift (`back_m` negative: on along its path): `None` when none of
 /// its body is ahead of the vehicle's origin, it is `clear_m` beyond the vehicle's widest part
-/// from its centre line already, or no place on its path is.
+/// from its centre line already, or no place on its path is that it reaches along a stretch
+/// `near` (the yield test's) finds [`CLEAR_WAY_MARGIN_M`] clear of the vehicle.
 fn clear_way(
     r: &Reactive,
     m: &ObstacleMotion,
     size_m: [f64; 2],
     vehicle: &VehicleView,
-    clear_m: f64,
+    (clear_m, near): (f64, &impl Fn(f64, f64, f64) -> bool),
 ) -> Option<Room> {
-    let v = &vehicle.world_from_vehicle;
-    let vehicle_from_world = v.inverse();
-    // Its body's centre in the vehicle frame and its half extents along and across that frame.
-    let body = |arc_m: f64| {
-        let s = m.state_at_arc(arc_m, 0.0);
-        let c = vehicle_from_world * Point2::new(s.x_m, s.y_m);
-        let (sin, cos) = (s.yaw_rad - v.rotation.angle()).sin_cos();
-        let along = 0.5 * (size_m[0] * cos.abs() + size_m[1] * sin.abs());
-        let across = 0.5 * (size_m[0] * sin.abs() + size_m[1] * cos.abs());
-        (c, along, across)
-    };
     let clear = |arc_m: f64| {
-        let (c, _, across) = body(arc_m);
+        let (c, _, across) = body_seen(m, arc_m, size_m, vehicle);
         c.y.abs() - across >= vehicle.half_span_m + clear_m
     };
-    let (c, along, _) = body(r.arc_m);
+    let (c, along, _) = body_seen(m, r.arc_m, size_m, vehicle);
     if c.x + along <= 0.0 || clear(r.arc_m) {
         return None;
     }
     const STEP_M: f64 = 0.25;
     let path_m = m.length_m();
     let steps = (path_m / STEP_M).ceil() as usize;
+    // The stretch its body sweeps on the way to `to_m` passes clear of the vehicle.
+    let free = |to_m: f64| {
+        let half = 0.5 * size_m[0];
+        let (lo, hi) = (r.arc_m.min(to_m) - half, r.arc_m.max(to_m) + half);
+        !near(
+            lo.max(0.0),
+            hi.min(path_m),
+            CLEAR_WAY_MARGIN_M + 0.5 * size_m[1],
+        )
+    };
     let on = (1..=steps)
         .map(|k| (r.arc_m + k as f64 * STEP_M).min(path_m))
-        .find(|&a| clear(a));
+        .find(|&a| clear(a))
+        .filter(|&a| free(a));
     let back = (1..=steps)
         .map(|k| (r.arc_m - k as f64 * STEP_M).max(0.0))
-        .find(|&a| clear(a));
+        .find(|&a| clear(a))
+        .filter(|&a| free(a));
     let to_m = match (on, back) {
         (Some(on), Some(back)) if r.arc_m - back < on - r.arc_m => back,
         (Some(on), _) => on,
@@ -467,6 +524,14 @@ fn backing(r: &mut Reactive, room: Room, m: &ObstacleMotion, a: f64, dt: f64) ->
         r.arc_m = to_m;
         r.speed_m_s = 0.0;
         r.room = Some(Room { done: true, ..room });
+        // Stops it went on past are passed.
+        while m
+            .stops
+            .get(r.next_stop)
+            .is_some_and(|s| s.at_m < r.arc_m - SAME_PLACE_M)
+        {
+            r.next_stop += 1;
+        }
         return placed(r, m, 0.0);
     }
     r.arc_m += sign * speed * dt;

@@ -98,7 +98,7 @@ fn a_yielding_driver_ignores_a_vehicle_far_off_and_a_plain_mover_never_yields() 
 /// pulls aside until its near side is `makes_room_m` beyond the vehicle's widest part,
 /// nose along its path, then yields on beside its path as before, and once the vehicle is
 /// gone drives on to its end.
-/// Crossing the vehicle's path beside it (none of its body ahead of the vehicle) it only waits.
+/// Crossing the vehicle's path where it stands clear of the vehicle's way already, it only waits.
 #[test]
 fn a_driver_head_on_makes_room_and_drives_on_beside_its_path() {
     let head_on = scenario("yields_to_vehicle_m = 30.0\nmakes_room_m = 3.0\n").obstacles[0].clone();
@@ -235,6 +235,38 @@ fn a_crossing_driver_caught_in_the_vehicles_way_clears_it() {
         traffic.state(0).map(|v| (v.x_m, v.y_m)),
         Some((20.0, -40.0))
     );
+    // The same, the vehicle standing at the origin once the van is 1 m south of its line: it
+    // stands south of the line and goes on, the short way (south).
+    let mut traffic = Traffic::new(std::slice::from_ref(&van), &s.vehicle.vehicle);
+    traffic.step(0.0, &gone);
+    let mut t = 0.0;
+    while traffic.state(0).expect("present").y_m > -1.0 {
+        t = run(&mut traffic, t, t + 0.01, &gone);
+    }
+    let t = run(&mut traffic, t, t + 40.0, &here);
+    let v = traffic.state(0).expect("present");
+    let on_side = -v.y_m - 0.5 * length_m;
+    assert!(
+        v.speed_m_s == 0.0 && (wanted..wanted + 0.25 + 1e-9).contains(&on_side),
+        "went on to {on_side}, wanted {wanted}"
+    );
+    assert!(t > 0.0);
+    // The vehicle standing across its way on (its origin 6 m north of the van, on the van's
+    // line): it does not drive into it, and cannot back (its path's start): it stands.
+    let across_way = Isometry2::new(nalgebra::Vector2::new(20.0, 5.0), 0.0);
+    let s2 = scenario(makes_room);
+    let mut start = s2.obstacles[0].clone();
+    start.motion.as_mut().expect("moves").path_m =
+        vec![Point2::new(20.0, -1.0), Point2::new(20.0, 40.0)];
+    let mut traffic = Traffic::new(std::slice::from_ref(&start), &s2.vehicle.vehicle);
+    traffic.step(0.0, &across_way);
+    run(&mut traffic, 0.0, 20.0, &across_way);
+    assert_eq!(traffic.state(0).map(|v| v.y_m), Some(-1.0));
+    // A stop it went on past (at y = 2) is passed: it stays where it cleared the way.
+    let with_stop = format!("{makes_room}stops = [{{ at_m = 3.0, wait_s = 1.0 }}]\n");
+    let (traffic, ..) = stand(&with_stop, &[[20.0, -1.0], [20.0, 40.0]], 20.0);
+    let v = traffic.state(0).expect("present");
+    assert!(v.y_m - 0.5 * length_m >= wanted, "at {}", v.y_m);
     // Already that far aside: it only waits where it stands.
     let aside = wanted + 0.5 * length_m + 0.1;
     let (traffic, ..) = stand(makes_room, &[[20.0, aside], [20.0, 40.0]], 20.0);
@@ -246,6 +278,59 @@ fn a_crossing_driver_caught_in_the_vehicles_way_clears_it() {
         20.0,
     );
     assert_eq!(traffic.state(0).map(|v| v.y_m), Some(-1.0));
+}
+
+/// Having backed out of the vehicle's way, a driver stands while some of its body is ahead of
+/// the vehicle's origin, however far the vehicle; not once it is behind, nor after going on.
+#[test]
+fn a_driver_that_backed_out_of_the_way_waits_for_the_vehicle_to_pass() {
+    let s = scenario("yields_to_vehicle_m = 5.0\nmakes_room_m = 6.0\n");
+    let o = &s.obstacles[0];
+    let m = o.motion.as_ref().expect("moves");
+    let size_m = [o.solid.shape.length_m(), o.solid.shape.width_m()];
+    // The van at arc 10 (x = 20, y = -20), having backed 5 m.
+    let backed = Room {
+        from_arc_m: 15.0,
+        back_m: 5.0,
+        shift: Vector2::zeros(),
+        done: true,
+    };
+    let r = Reactive {
+        arc_m: 10.0,
+        started: true,
+        room: Some(backed),
+        ..Reactive::default()
+    };
+    let view = |x: f64| VehicleView {
+        world_from_vehicle: Isometry2::new(nalgebra::Vector2::new(x, 0.0), 0.0),
+        half_span_m: 2.0,
+    };
+    assert!(backed_out_ahead(&r, m, size_m, &view(-500.0)));
+    // Its near edge (half its width) 0.95 m past x = 20: passed once the origin is beyond.
+    assert!(backed_out_ahead(&r, m, size_m, &view(20.9)));
+    assert!(!backed_out_ahead(&r, m, size_m, &view(21.0)));
+    let on = Reactive {
+        room: Some(Room {
+            back_m: -5.0,
+            ..backed
+        }),
+        ..r
+    };
+    assert!(!backed_out_ahead(&on, m, size_m, &view(-500.0)));
+    let head_on = Reactive {
+        room: Some(Room {
+            shift: Vector2::new(0.0, 3.0),
+            ..backed
+        }),
+        ..r
+    };
+    assert!(!backed_out_ahead(&head_on, m, size_m, &view(-500.0)));
+    assert!(!backed_out_ahead(
+        &Reactive { room: None, ..r },
+        m,
+        size_m,
+        &view(-500.0)
+    ));
 }
 
 /// A plain mover and a yielding driver, halted (they touched the vehicle), stand where
