@@ -227,6 +227,7 @@ pub fn failures_of(scenario: &Scenario, r: &RunReport) -> (Vec<String>, usize) {
         ExpectedEnd::WaitingForHiddenObstacle => r.end == EndReason::WaitingForHiddenObstacle,
         ExpectedEnd::WaitingForWalkAround => r.end == EndReason::WaitingForWalkAround,
         ExpectedEnd::StoppedForGood => r.end != EndReason::Completed,
+        ExpectedEnd::Struck => r.end == EndReason::Struck,
         ExpectedEnd::Any => true,
     };
     if !end_met {

@@ -106,6 +106,9 @@ impl Rig<'_> {
             for (t, event) in self.judge.drain_events() {
                 observer.event(t, &event)?;
             }
+            if self.external.is_none() {
+                self.feel_strikes();
+            }
             observer.step(&StepFrame {
                 t_s: self.t_s,
                 state: &self.state,
@@ -145,7 +148,23 @@ impl Rig<'_> {
             PilotCall::HiddenObstacle => EndReason::WaitingForHiddenObstacle,
             PilotCall::Blocked => EndReason::Blocked,
             PilotCall::WalkAround => EndReason::WaitingForWalkAround,
+            PilotCall::Struck => EndReason::Struck,
         })
+    }
+
+    /// The strike sensor: a contact begun since the last step with an object the airframe
+    /// feels ([`crate::world::ObjectKind::felt_on_contact`]) is told to the shipped stack as a
+    /// strike at its time - not where, nor with what.
+    fn feel_strikes(&mut self) {
+        let contacts = self.world.contacts();
+        let felt = contacts[self.contacts_felt..]
+            .iter()
+            .find(|c| c.kind.felt_on_contact())
+            .map(|c| c.time_s);
+        self.contacts_felt = contacts.len();
+        if let Some(t_s) = felt {
+            self.driver.on_strike(t_s);
+        }
     }
 
     /// The shipped stack's part of a step: a revolution when one is due, the late ones

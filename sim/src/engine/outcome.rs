@@ -76,6 +76,10 @@ pub enum EndReason {
     /// Stood for obstacles in its path (in view or hidden) for `blocked_call_after_s` (60 s),
     /// the vehicle called for a pilot: its way is blocked (an aircraft never steers round).
     Blocked,
+    /// The airframe felt a strike (a contact with anything but a person, a cone, a marker,
+    /// debris or an edge light), the vehicle stood and called for a pilot: it is inspected
+    /// before it moves again.
+    Struck,
     /// A stack outside the process ([`super::external`]) gave no command for a control step
     /// within its transport's timeout, under the strict policy.
     StackTimeout,
@@ -99,6 +103,7 @@ impl EndReason {
             EndReason::WaitingForWalkAround => {
                 Some("waiting for a walk-around of ground it cannot see: pilot called")
             }
+            EndReason::Struck => Some("struck: pilot called to inspect the airframe"),
             EndReason::StackTimeout => Some("the external stack did not answer in time"),
             EndReason::StackFailed => Some("the external stack failed"),
         }

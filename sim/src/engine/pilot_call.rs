@@ -57,6 +57,11 @@ pub enum Hold {
         /// Its area, square metres.
         unseen_m2: f64,
     },
+    /// A strike the airframe felt ([`autonomy::Driver::on_strike`]).
+    Struck {
+        /// When, seconds.
+        at_s: f64,
+    },
 }
 
 impl Hold {
@@ -80,11 +85,12 @@ impl Hold {
             DriverStatus::WaitingForWalkAround { unseen_m2, .. } => {
                 Some((Hold::UnseenGround { unseen_m2 }, None))
             }
+            DriverStatus::Struck { at_s } => Some((Hold::Struck { at_s }, None)),
         }
     }
 
     /// A short name for tables: `obstacle`, `lost_obstacle` (map cells), `mover_lost_at_body`,
-    /// `mover_lost_coasting`, `mover_lost_standing`, `mover`, `unseen_ground`.
+    /// `mover_lost_coasting`, `mover_lost_standing`, `mover`, `unseen_ground`, `struck`.
     pub fn name(&self) -> &'static str {
         match self {
             Hold::Obstacle { .. } => "obstacle",
@@ -96,6 +102,7 @@ impl Hold {
             },
             Hold::Mover { .. } => "mover",
             Hold::UnseenGround { .. } => "unseen_ground",
+            Hold::Struck { .. } => "struck",
         }
     }
 }
@@ -105,7 +112,7 @@ impl Hold {
 pub struct PilotCallReport {
     /// When, seconds.
     pub t_s: f64,
-    /// Which rule called: `hidden_obstacle`, `blocked` or `walk_around`.
+    /// Which rule called: `hidden_obstacle`, `blocked`, `walk_around` or `struck`.
     pub call: &'static str,
     /// What held the vehicle last before the call, as the stack believed it (`None`: it was not
     /// held by anything it could name - blocked while driving slowly).
@@ -154,6 +161,9 @@ impl HoldLog {
         movers: &[usize],
     ) -> PilotCallReport {
         let last = self.held.back();
+        if matches!(call, PilotCall::Struck) {
+            return struck_report(t_s, last.map(|(_, h, _)| *h), world);
+        }
         let mut points: Vec<Point2<f64>> = self.held.iter().filter_map(|(_, _, p)| *p).collect();
         if matches!(call, PilotCall::WalkAround) {
             points.extend(unseen.unwrap_or_default());
@@ -201,11 +211,31 @@ impl HoldLog {
                 PilotCall::HiddenObstacle => "hidden_obstacle",
                 PilotCall::Blocked => "blocked",
                 PilotCall::WalkAround => "walk_around",
+                PilotCall::Struck => "struck",
             },
             hold: last.map(|(_, h, _)| *h),
             at_m: last.and_then(|(_, _, p)| p.map(|p| [p.x, p.y])),
             needless: nearest.is_none_or(|(_, d, within)| d > within),
             nearest_object: nearest.map(|(i, d, _)| (world.scene().solids[i].id.clone(), d)),
         }
+    }
+}
+
+/// A strike's call: what struck the airframe first (ground truth, the contact the sensor felt)
+/// and how far it is now. Never needless: the sensor feels only real contacts.
+fn struck_report(t_s: f64, hold: Option<Hold>, world: &World) -> PilotCallReport {
+    let felt = (world.contacts().iter()).find(|c| c.kind.felt_on_contact());
+    let nearest = felt.and_then(|c| {
+        let i = (world.scene().solids.iter()).position(|s| s.id == c.object)?;
+        let d = world.distances_to(i).into_iter().reduce(f64::min)?;
+        Some((c.object.clone(), d))
+    });
+    PilotCallReport {
+        t_s,
+        call: "struck",
+        hold,
+        at_m: None,
+        needless: false,
+        nearest_object: nearest,
     }
 }

@@ -223,6 +223,8 @@ pub(super) struct Rig<'a> {
     pub(super) walk_around_at_s: Option<f64>,
     /// Whether the observer has been told of the ground the start-up rule found unseen.
     pub(super) start_unseen_told: bool,
+    /// How many of the world's contacts the strike sensor has read.
+    pub(super) contacts_felt: usize,
     /// What held the vehicle in the last seconds, for the pilot call's report.
     pub(super) holds: super::pilot_call::HoldLog,
     /// The pilot call that ended the run, if one did.
@@ -348,6 +350,7 @@ impl<'a> Rig<'a> {
                 _ => None,
             },
             start_unseen_told: false,
+            contacts_felt: 0,
             holds: Default::default(),
             pilot_call: None,
             towing: scenario
@@ -390,6 +393,7 @@ impl<'a> Rig<'a> {
                 | EndReason::WaitingForWalkAround
                 | EndReason::StackTimeout
                 | EndReason::StackFailed
+                | EndReason::Struck
         ) {
             // The vehicle may stand before an obstacle: its pass closes as it stands.
             self.judge.close_open_passes(self.t_s, end);

@@ -143,6 +143,8 @@ pub enum TodayEnd {
     WaitingForWalkAround,
     /// Blocked for good: a pilot called.
     Blocked,
+    /// Struck: a pilot called to inspect the airframe.
+    Struck,
 }
 
 impl TodayEnd {
@@ -154,6 +156,7 @@ impl TodayEnd {
             TodayEnd::WaitingForHiddenObstacle => "waiting_for_hidden_obstacle",
             TodayEnd::WaitingForWalkAround => "waiting_for_walk_around",
             TodayEnd::Blocked => "blocked",
+            TodayEnd::Struck => "struck",
         }
     }
 }
@@ -185,9 +188,11 @@ pub enum ExpectedEnd {
     /// Never moved off, waiting for a walk-around, calling for a pilot.
     WaitingForWalkAround,
     /// Stopped for good before an obstacle that never goes: the run ends timed out or calling
-    /// for a pilot (waiting for a hidden obstacle, or blocked), the vehicle still standing - or
+    /// for a pilot (waiting for a hidden obstacle, blocked, or struck), the vehicle still standing - or
     /// never having moved off.
     StoppedForGood,
+    /// The airframe felt a strike, stood and called for a pilot to inspect it.
+    Struck,
     /// However it ends: only contacts and the obstacles' expectations count.
     Any,
 }

@@ -151,6 +151,22 @@ pub enum ObjectKind {
 }
 
 impl ObjectKind {
+    /// Whether the airframe feels a contact with this kind of object (the strike sensor,
+    /// `EndReason::Struck`): everything but what weighs too little to jolt it - a person, a
+    /// cone, a marker, debris, an edge light. A tug, a van, a cart, a building do.
+    pub fn felt_on_contact(self) -> bool {
+        !matches!(
+            self,
+            ObjectKind::Person
+                | ObjectKind::Cone
+                | ObjectKind::Marker
+                | ObjectKind::Debris
+                | ObjectKind::EdgeLight
+        )
+    }
+}
+
+impl ObjectKind {
     /// The snake_case name of the kind, as in files.
     pub fn name(self) -> &'static str {
         match self {

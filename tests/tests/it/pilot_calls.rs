@@ -127,3 +127,28 @@ fn a_van_standing_in_the_path_is_a_blocked_way_not_a_silent_yield() {
     assert!(matches!(call.hold, Some(Hold::Obstacle { .. })), "{call:?}");
     assert!(!call.needless, "{call:?}");
 }
+
+/// A tug towing three carts drives into the standing nose, under the LiDAR's lowest beam
+/// (variant 826 of `traffic_jet_speed_profiles.toml`; the jet moved off against it before the
+/// strike sensor): the airframe feels the strike, the jet stands and calls a pilot at once -
+/// the call names the strike and, from ground truth, the tug against the nose - and never moves
+/// while the tug touches it.
+#[test]
+fn a_tug_run_into_the_standing_nose_is_a_strike_the_jet_stands_for() {
+    let r = run(&file(
+        "found/tug_train_against_the_nose_the_jet_moves_off.toml",
+    ));
+    assert_eq!(r.end, sim::engine::EndReason::Struck);
+    assert_eq!((r.contacts_at_fault, r.contacts_struck), (0, 1));
+    let call = r.pilot_call.expect("a pilot call");
+    assert_eq!(call.call, "struck");
+    let Some(Hold::Struck { at_s }) = call.hold else {
+        panic!("{call:?}");
+    };
+    // Called as soon as it stood: the tug struck the already standing jet.
+    assert!((call.t_s - at_s).abs() < 0.05, "{call:?}");
+    assert_eq!(r.contacts[0].time_s, at_s, "{:?}", r.contacts);
+    let (id, d) = call.nearest_object.clone().unwrap();
+    assert!(id == "tug_1" && d < 0.1, "{call:?}");
+    assert!(!call.needless, "{call:?}");
+}

@@ -21,6 +21,7 @@ use crate::traffic::{Conflict, MoverInputs, Prediction, TrafficRules};
 
 mod start;
 mod status;
+mod strike;
 #[cfg(test)]
 mod tests;
 
@@ -93,6 +94,8 @@ pub struct Driver {
     start_unseen_m2: Option<f64>,
     /// Its cells (centres in the world) and their side, metres.
     start_unseen_cells: Option<(Vec<Point2<f64>>, f64)>,
+    /// When the airframe felt a strike ([`Driver::on_strike`]), seconds: it stands from then on.
+    struck_at_s: Option<f64>,
 }
 
 impl Driver {
@@ -132,6 +135,7 @@ impl Driver {
             start: StartRule::Done,
             start_unseen_m2: None,
             start_unseen_cells: None,
+            struck_at_s: None,
         }
     }
 
@@ -193,6 +197,11 @@ impl Driver {
     /// to the obstacle test's range: [`OnlineMap::mapping_started`]), the vehicle is held
     /// (speed 0): blind to what the offline map does not hold, it would drive into it.
     pub fn plan(&mut self, map: &mut OnlineMap) -> Result<PlanTimes, MapError> {
+        if let Some(at_s) = self.struck_at_s {
+            self.speed_command_m_s = 0.0;
+            self.status = DriverStatus::Struck { at_s };
+            return Ok(PlanTimes::default());
+        }
         let Some(estimate) = self.estimate.filter(|_| map.mapping_started()) else {
             self.speed_command_m_s = 0.0;
             return Ok(PlanTimes::default());
@@ -345,7 +354,8 @@ impl Driver {
         };
         Command {
             // Blind (no fresh revolution), the vehicle stops; it drives on when they return.
-            speed_m_s: if self.watchdog_tripped() {
+            // Struck, it stands.
+            speed_m_s: if self.watchdog_tripped() || self.struck_at_s.is_some() {
                 0.0
             } else {
                 self.speed_command_m_s

@@ -51,6 +51,12 @@ pub enum DriverStatus {
         /// Where the mover is predicted to be when the vehicle would meet it, metres.
         mover_at: Point2<f64>,
     },
+    /// The airframe felt a strike ([`Driver::on_strike`]): it stands, and once it stands the run
+    /// calls for a pilot to inspect it - whatever struck it, it does not move on its own again.
+    Struck {
+        /// When it felt the strike, seconds.
+        at_s: f64,
+    },
 }
 
 /// Why the driver calls for a pilot (the thesis' pilot intervention).
@@ -62,6 +68,8 @@ pub enum PilotCall {
     Blocked,
     /// It has waited at the start for a walk-around of ground its sensors cannot see.
     WalkAround,
+    /// It felt a strike and stands: the airframe must be inspected before it moves again.
+    Struck,
 }
 
 impl Driver {
@@ -131,10 +139,13 @@ impl Driver {
         self.status
     }
 
-    /// Whether the driver calls for a pilot at `now_s`, and why: it has waited for a hidden
-    /// obstacle or a walk-around longer than `pilot_call_after_s`, or stood for obstacles longer than
-    /// `blocked_call_after_s`.
+    /// Whether the driver calls for a pilot at `now_s`, and why: it felt a strike and stands, it
+    /// has waited for a hidden obstacle or a walk-around longer than `pilot_call_after_s`, or
+    /// stood for obstacles longer than `blocked_call_after_s`.
     pub fn calls_for_pilot(&self, now_s: f64) -> Option<PilotCall> {
+        if self.struck_at_s.is_some() && self.standing() {
+            return Some(PilotCall::Struck);
+        }
         if matches!(self.status, DriverStatus::WaitingForWalkAround { since_s, .. }
             if now_s - since_s >= self.config.pilot_call_after_s)
         {

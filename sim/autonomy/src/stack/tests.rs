@@ -355,3 +355,53 @@ fn blind_ground_behind_the_vehicle_does_not_hold_it() {
     assert_eq!(d.speed_command_m_s(), 5.0);
     assert_eq!(d.start_unseen_m2(), Some(0.0));
 }
+
+/// A strike felt while driving: the vehicle is commanded to stand at once, calls for a pilot
+/// only once odometry says it stands, and plans on a clear road do not move it again; a
+/// second strike does not move the time of the first.
+#[test]
+fn a_felt_strike_stands_the_vehicle_and_calls_a_pilot_once_it_stands() {
+    let mut d = driver();
+    let mut map = empty_map();
+    d.on_pose(at(0.0, 10.0, 0.0, 0.0));
+    d.plan(&mut map).unwrap();
+    assert_eq!(d.command().speed_m_s, 5.0);
+    assert_eq!(d.calls_for_pilot(0.0), None);
+    let moving = |t_s, speed_m_s| Odometry {
+        t_s,
+        speed_m_s,
+        steering_rad: 0.0,
+    };
+    d.on_odometry(moving(1.0, 4.0));
+    d.on_strike(1.0);
+    assert_eq!(d.command().speed_m_s, 0.0);
+    assert_eq!(d.status(), DriverStatus::Struck { at_s: 1.0 });
+    // Still rolling: no call yet.
+    assert_eq!(d.calls_for_pilot(1.0), None);
+    d.on_odometry(moving(2.0, 0.01));
+    d.on_pose(at(2.0, 12.0, 0.0, 0.0));
+    d.plan(&mut map).unwrap();
+    assert_eq!(d.speed_command_m_s(), 0.0);
+    assert_eq!(d.command().speed_m_s, 0.0);
+    assert_eq!(d.status(), DriverStatus::Struck { at_s: 1.0 });
+    assert_eq!(d.calls_for_pilot(2.0), Some(PilotCall::Struck));
+    d.on_strike(3.0);
+    assert_eq!(d.struck_at_s(), Some(1.0));
+}
+
+/// A strike felt standing (a tug into the standing nose): the call comes at once.
+#[test]
+fn a_strike_felt_standing_calls_a_pilot_at_once() {
+    let mut d = driver();
+    let mut map = empty_map();
+    d.on_pose(at(0.0, 10.0, 0.0, 0.0));
+    d.on_odometry(Odometry {
+        t_s: 0.0,
+        speed_m_s: 0.0,
+        steering_rad: 0.0,
+    });
+    d.on_strike(0.5);
+    d.plan(&mut map).unwrap();
+    assert_eq!(d.command().speed_m_s, 0.0);
+    assert_eq!(d.calls_for_pilot(0.5), Some(PilotCall::Struck));
+}

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context as _;
-use sim::engine::RunReport;
+use sim::engine::{Hold, RunReport};
 use sim::engine::{NoObserver, Observer, Observers};
 use sim::engine::{RunHandles, RunSetup};
 use sim::offline_map::default_map_dir;
@@ -588,11 +588,13 @@ fn pilot_call_line(t: &mut String, r: &RunReport) {
         return;
     };
     let held = match (&c.hold, c.at_m) {
+        (Some(Hold::Struck { at_s }), _) => format!("a strike it felt at {at_s:.1} s"),
         (Some(h), Some([x, y])) => format!("{} at ({x:.1}, {y:.1}) m", h.name().replace('_', " ")),
         (Some(h), None) => h.name().replace('_', " "),
         (None, _) => "nothing it named".to_string(),
     };
     let truth = match &c.nearest_object {
+        Some((id, d)) if c.call == "struck" => format!("struck by {id}, now {d:.2} m off"),
         Some((id, d)) => format!("nearest object {id} {d:.2} m"),
         None => "no object".to_string(),
     };

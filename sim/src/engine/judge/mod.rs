@@ -345,11 +345,15 @@ impl Judge {
             }
             ExpectedEnd::WaitingForHiddenObstacle => end == EndReason::WaitingForHiddenObstacle,
             ExpectedEnd::WaitingForWalkAround => end == EndReason::WaitingForWalkAround,
+            ExpectedEnd::Struck => end == EndReason::Struck,
             ExpectedEnd::Any => end != EndReason::Interrupted,
             ExpectedEnd::StoppedForGood => {
                 matches!(
                     end,
-                    EndReason::TimedOut | EndReason::WaitingForHiddenObstacle | EndReason::Blocked
+                    EndReason::TimedOut
+                        | EndReason::WaitingForHiddenObstacle
+                        | EndReason::Blocked
+                        | EndReason::Struck
                 ) && (self.stops.last().is_some_and(|s| s.end_s.is_none()) || !self.started)
             }
         };
