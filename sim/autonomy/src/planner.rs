@@ -84,6 +84,10 @@ pub struct AutonomyConfig {
     /// taxiway), and an aircraft never steers round. The run ends, seconds. Default 60: longer
     /// than any wait for a mover to clear.
     pub blocked_call_after_s: f64,
+    /// The strike rule ([`crate::Driver::on_strike`]): a vehicle whose airframe felt a strike
+    /// stands and calls for a pilot. Default true; false: strikes are ignored (a regression
+    /// that checks what the stack does about a mover at its body without it).
+    pub stand_when_struck: bool,
     /// The range at which the smallest obstacle the vehicle must avoid is surely mapped, metres
     /// (`taxi-sim small-obstacles` measures it): the avoider never goes faster than it can
     /// stop within it. Default none (no cap): for the IARA car, every obstacle of 0.12 m and up
@@ -148,6 +152,7 @@ impl Default for AutonomyConfig {
             hidden_after_s: 2.0,
             pilot_call_after_s: 10.0,
             blocked_call_after_s: 60.0,
+            stand_when_struck: true,
             detection_range_m: None,
             watchdog_s: 0.3,
             uncertainty_sigmas: 2.0,

@@ -18,8 +18,8 @@ pub struct RunReport {
     /// True when every expectation held and every lap was completed.
     pub expectations_met: bool,
     /// Why the run ended: `completed`, `timed_out`, `interrupted`,
-    /// `waiting_for_hidden_obstacle`, `waiting_for_walk_around` or `blocked` (the last three call
-    /// for a pilot).
+    /// `waiting_for_hidden_obstacle`, `waiting_for_walk_around`, `blocked` or `struck` (the last
+    /// four call for a pilot), or an external stack's `stack_timeout` or `stack_failed`.
     pub end: EndReason,
     /// When the run ended waiting for a hidden obstacle: which, and since when.
     pub waiting_for: Option<HiddenObstacle>,

@@ -39,7 +39,7 @@ fn the_smoke_campaign_runs_every_variant_under_every_setting() {
     for r in records.iter() {
         let called = matches!(
             r.end.as_str(),
-            "waiting_for_hidden_obstacle" | "blocked" | "waiting_for_walk_around"
+            "waiting_for_hidden_obstacle" | "blocked" | "waiting_for_walk_around" | "struck"
         );
         assert_eq!(
             r.pilot_call.is_some(),

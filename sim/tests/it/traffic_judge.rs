@@ -92,13 +92,12 @@ fn a_van_striking_a_standing_car_is_struck_not_at_fault() {
     assert_eq!(contact_events.len(), r.contacts.len());
     assert!(contact_events.iter().all(|c| !c.at_fault));
     // The car feels the strike, stands and calls a pilot: the run ends on the van's first
-    // contact, the time to collision last measured a step before it, and the van never left
-    // the place it struck (no post-encroachment time).
+    // contact - a collision: time to collision and post-encroachment time 0.
     assert_eq!(r.end, sim::engine::EndReason::Struck);
     assert_eq!(r.contacts.len(), 1, "{:?}", r.contacts);
     let van = &r.obstacles[0];
-    assert!(van.min_ttc_s.is_some_and(|t| t < 0.1), "{van:?}");
-    assert_eq!(van.pet_s, None, "{van:?}");
+    assert_eq!(van.min_ttc_s, Some(0.0), "{van:?}");
+    assert_eq!(van.pet_s, Some(0.0), "{van:?}");
     let conflicts: Vec<f64> = events
         .0
         .iter()

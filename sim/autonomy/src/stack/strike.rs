@@ -15,9 +15,9 @@ const STANDING_M_S: f64 = 0.05;
 impl Driver {
     /// The airframe felt a strike at `t_s`: from now on the vehicle is commanded to stand
     /// ([`DriverStatus::Struck`]); once it stands, [`Driver::calls_for_pilot`] calls for a
-    /// pilot. A later strike changes nothing.
+    /// pilot. A later strike changes nothing; nor does any with `stand_when_struck` off.
     pub fn on_strike(&mut self, t_s: f64) {
-        if self.struck_at_s.is_none() {
+        if self.struck_at_s.is_none() && self.config.stand_when_struck {
             self.struck_at_s = Some(t_s);
             self.speed_command_m_s = 0.0;
             self.status = DriverStatus::Struck { at_s: t_s };

@@ -405,3 +405,17 @@ fn a_strike_felt_standing_calls_a_pilot_at_once() {
     assert_eq!(d.command().speed_m_s, 0.0);
     assert_eq!(d.calls_for_pilot(0.5), Some(PilotCall::Struck));
 }
+
+/// With `stand_when_struck` off a strike is ignored: the vehicle drives on, no call.
+#[test]
+fn with_the_strike_rule_off_a_strike_is_ignored() {
+    let mut d = driver();
+    d.config.stand_when_struck = false;
+    let mut map = empty_map();
+    d.on_pose(at(0.0, 10.0, 0.0, 0.0));
+    d.on_strike(0.5);
+    d.plan(&mut map).unwrap();
+    assert_eq!(d.struck_at_s(), None);
+    assert_eq!(d.command().speed_m_s, 5.0);
+    assert_eq!(d.calls_for_pilot(0.5), None);
+}

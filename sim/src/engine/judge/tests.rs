@@ -76,6 +76,7 @@ fn judged_crossing(mover_at_s: f64, stop: Option<(f64, f64)>) -> (YieldFacts, Yi
         last: None,
         velocity: Vector2::zeros(),
         min_ttc_s: None,
+        touched: false,
         armed: true,
         poses: Vec::new(),
     };

@@ -30,8 +30,11 @@ pub(super) struct Mover {
     pub(super) last: Option<(f64, Point2<f64>)>,
     /// Its velocity, by differencing over the last step, m/s.
     pub(super) velocity: Vector2<f64>,
-    /// Its smallest time to collision so far, seconds.
+    /// Its smallest time to collision so far, seconds (0 once it touched the vehicle).
     pub(super) min_ttc_s: Option<f64>,
+    /// Whether it touched the vehicle: its TTC and PET are 0, however soon the run ends after
+    /// (a strike ends it: `EndReason::Struck`).
+    pub(super) touched: bool,
     /// Whether a TTC under 3 s would start a new conflict.
     pub(super) armed: bool,
     /// Its pose at each sample (`None`: absent).
@@ -100,6 +103,10 @@ impl Judge {
                 _ => {}
             }
             m.last = pose.map(|p| (t_s, Point2::from(p.translation.vector)));
+            if world.touches_vehicle(m.solid_index) {
+                m.touched = true;
+                m.min_ttc_s = Some(0.0);
+            }
             if !sample {
                 continue;
             }
@@ -137,7 +144,11 @@ impl Judge {
             let e = window_encroachment(&self.samples, mover, 0..self.samples.t_s.len());
             let report = &mut self.obstacles[k];
             report.min_ttc_s = mover.min_ttc_s;
-            report.pet_s = e.map(|e| e.pet_s);
+            report.pet_s = if mover.touched {
+                Some(0.0)
+            } else {
+                e.map(|e| e.pet_s)
+            };
             report.pet_mover_first = e.and_then(|e| e.mover_first);
         }
     }
@@ -162,6 +173,7 @@ pub(super) fn movers(scenario: &Scenario, first_obstacle: usize) -> Vec<Mover> {
                 last: None,
                 velocity: Vector2::zeros(),
                 min_ttc_s: None,
+                touched: false,
                 armed: true,
                 poses: Vec::new(),
             }
