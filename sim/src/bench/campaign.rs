@@ -44,6 +44,7 @@ fn in_process(campaign: &Campaign, n: u64, jobs: usize, dir: &Path) -> Result<f6
             out: dir.to_path_buf(),
             jobs,
             runs: Some(n),
+            variants: None,
             stop: &stop,
             record_failures: false,
             progress: &|_| {},

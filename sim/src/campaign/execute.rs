@@ -35,6 +35,8 @@ pub struct RunOptions<'a> {
     pub jobs: usize,
     /// Variants: indices `0..runs` (default the campaign's `runs`).
     pub runs: Option<u64>,
+    /// Of those, only these (sorted; `None`: all): `campaign run --variants`.
+    pub variants: Option<&'a [u64]>,
     /// Set from outside (Ctrl-C) to stop: runs in flight end and are not recorded.
     pub stop: &'a AtomicBool,
     /// Run each failure again (runs are reproducible from their seed) writing it as a ROS 2
@@ -332,6 +334,11 @@ pub fn run_campaign(campaign: &Campaign, opts: &RunOptions<'_>) -> Result<Outcom
             "--shard: the falsify sampler's generations depend on every earlier run, so it cannot be split; use random or halton".into(),
         ));
     }
+    if opts.variants.is_some() && campaign.sampler == SamplerKind::Falsify {
+        return Err(Error::Invalid(
+            "--variants: the falsify sampler's variants depend on every earlier run, so an index names no variant on its own; use random, halton or grid".into(),
+        ));
+    }
     let total = total_runs(campaign, opts.runs);
     claim(campaign, dir, opts.shard, total)?;
     let mut records = read_results(dir)?;
@@ -359,6 +366,7 @@ pub fn run_campaign(campaign: &Campaign, opts: &RunOptions<'_>) -> Result<Outcom
         let have: std::collections::HashSet<u64> = records.iter().map(|r| r.index).collect();
         let todo: Vec<Variant> = (start..end)
             .filter(|i| !have.contains(i) && opts.shard.is_none_or(|s| s.holds(*i)))
+            .filter(|i| opts.variants.is_none_or(|v| v.binary_search(i).is_ok()))
             .map(|i| variant(campaign, i, &records))
             .collect();
         let fresh = run_parallel(&todo, opts.jobs.max(1), opts.stop, &|v, pool, worker| {

@@ -9,12 +9,14 @@
 //! distributions into a plain scenario text ([`Campaign::variant`]) that `taxi-sim run` runs
 //! alone. [`execute`] runs them in parallel into `results.jsonl`; [`summary`] reads that back.
 
+pub mod compare;
 pub mod dist;
 mod execute;
 mod map_cache;
 pub mod merge;
 mod record;
 pub mod sampler;
+pub mod select;
 mod shard;
 pub mod summary;
 

@@ -412,19 +412,30 @@ pub fn read_results(dir: &Path) -> Result<Vec<RunRecord>> {
             });
         }
     };
+    let (records, cut) = parse_results(&text, &path)?;
+    if cut {
+        // Every line but the last, cut short.
+        let whole = text.lines().count() - 1;
+        let kept: String = text.lines().take(whole).map(|l| format!("{l}\n")).collect();
+        mapper::write_atomically(&path, kept.as_bytes())?;
+    }
+    Ok(records)
+}
+
+/// The run records of `text`, the lines of a `results.jsonl` read from `path` (named in
+/// errors), sorted by index, one per variant; and whether its last line was cut short (a killed
+/// process: dropped). Any other bad line is an error naming it.
+pub(crate) fn parse_results(text: &str, path: &Path) -> Result<(Vec<RunRecord>, bool)> {
     let lines: Vec<&str> = text.lines().collect();
     let mut records = Vec::with_capacity(lines.len());
+    let mut cut = false;
     for (i, line) in lines.iter().enumerate() {
         match serde_json::from_str::<RunRecord>(line) {
             Ok(r) => records.push(r),
-            Err(_) if i + 1 == lines.len() && !text.ends_with('\n') => {
-                let mut kept: String = lines[..i].iter().map(|l| format!("{l}\n")).collect();
-                kept.shrink_to_fit();
-                mapper::write_atomically(&path, kept.as_bytes())?;
-            }
+            Err(_) if i + 1 == lines.len() && !text.ends_with('\n') => cut = true,
             Err(e) => {
                 return Err(Error::BadFile {
-                    path,
+                    path: path.to_path_buf(),
                     message: format!("line {}: not a run record: {e}", i + 1),
                 });
             }
@@ -432,5 +443,5 @@ pub fn read_results(dir: &Path) -> Result<Vec<RunRecord>> {
     }
     records.sort_by_key(|r| r.index);
     records.dedup_by_key(|r| r.index);
-    Ok(records)
+    Ok((records, cut))
 }

@@ -14,7 +14,7 @@ use crate::error::Result;
 const MAX_ROWS: usize = 100;
 
 /// The `p`-quantile (0..1) of sorted values, nearest rank.
-fn quantile(sorted: &[f64], p: f64) -> Option<f64> {
+pub(super) fn quantile(sorted: &[f64], p: f64) -> Option<f64> {
     if sorted.is_empty() {
         return None;
     }

@@ -132,6 +132,35 @@ fn results_are_the_same_whatever_jobs() {
     }
 }
 
+/// `--variants`: variants named (`2,7`) run alone into another directory are the same runs
+/// as in the full campaign, and nothing else runs.
+#[test]
+fn picked_variants_run_alone_as_they_ran_in_the_full_campaign() {
+    let (_, records) = full();
+    let picked = sim::campaign::select::parse_variants("2,7").unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let campaign = smoke();
+    let stop = AtomicBool::new(false);
+    let options = RunOptions {
+        shard: None,
+        maps_dir: None,
+        out: dir.path().to_path_buf(),
+        jobs: 2,
+        runs: None,
+        variants: Some(&picked),
+        stop: &stop,
+        record_failures: false,
+        progress: &|_| {},
+        stack: None,
+    };
+    let outcome = run_campaign(&campaign, &options).unwrap();
+    let got: Vec<u64> = outcome.records.iter().map(|r| r.index).collect();
+    assert_eq!(got, picked);
+    for r in &outcome.records {
+        assert_eq!(r.timeless(), records[r.index as usize].timeless());
+    }
+}
+
 #[test]
 fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
     let (_, records) = full();
@@ -153,6 +182,7 @@ fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
             out: dir.path().to_path_buf(),
             jobs: 2,
             runs: Some(5),
+            variants: None,
             stop: &stop,
             record_failures: false,
             progress: &|_| {},
@@ -192,6 +222,7 @@ fn a_campaign_resumes_over_a_cut_line_without_running_a_variant_twice() {
             out: dir.path().to_path_buf(),
             jobs: 1,
             runs: Some(1),
+            variants: None,
             stop: &stop,
             record_failures: false,
             progress: &|_| {},
@@ -220,6 +251,7 @@ fn a_stop_keeps_only_whole_runs_and_the_rest_runs_later() {
             out: dir.path().to_path_buf(),
             jobs: 1,
             runs: Some(4),
+            variants: None,
             stop: &stop,
             record_failures: false,
             progress: &|_| stop.store(true, Ordering::Relaxed),
@@ -421,6 +453,7 @@ fn the_falsifier_cannot_be_sharded() {
             out: dir.path().to_path_buf(),
             jobs: 1,
             runs: Some(2),
+            variants: None,
             stop: &stop,
             record_failures: false,
             progress: &|_| {},

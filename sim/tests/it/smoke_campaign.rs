@@ -45,6 +45,7 @@ pub fn run_recording(
             out: out.to_path_buf(),
             jobs,
             runs,
+            variants: None,
             stop: &stop,
             record_failures,
             progress: &|_| {},

@@ -1,5 +1,6 @@
-//! `taxi-sim campaign run | show`: runs a campaign's variants in parallel with a progress bar
-//! (runs done, failures so far, ETA), Ctrl-C stopping cleanly, and prints its summary.
+//! `taxi-sim campaign run | show | compare | merge`: runs a campaign's variants in parallel with a
+//! progress bar (runs done, failures so far, ETA), Ctrl-C stopping cleanly, and prints its
+//! summary; compares two runs of it; merges its shards.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -26,6 +27,21 @@ pub enum CampaignCommand {
     Show {
         /// The campaign's output directory.
         dir: PathBuf,
+    },
+    /// Compare two runs of one campaign - two builds, or a `--set` - on the variants both hold:
+    /// runs at fault, pilot calls (by cause, needless ones), clearance, TTC, PET and lap times
+    /// side by side, and the variants whose outcome changed. Each is a campaign directory or a
+    /// kept record (`NAME.jsonl.gz` beside `NAME.campaign.json`). Exit code 0 when AFTER has no
+    /// more runs at fault, pilot calls or needless calls than BEFORE, 1 when it has, 2 on bad
+    /// input.
+    Compare {
+        /// The run to compare against (e.g. a record in docs/campaigns/records/).
+        before: PathBuf,
+        /// The run compared.
+        after: PathBuf,
+        /// Also write the comparison (Markdown) here.
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Merge the output directories of a campaign's shards into one (as if run on one
     /// machine). Exit code 0 when every variant is in, 1 when some are missing (it says which,
@@ -74,6 +90,13 @@ pub struct CampaignRunArgs {
     /// that is a digest of what they depend on.
     #[arg(long)]
     pub maps_dir: Option<PathBuf>,
+    /// Only these variants: indices and ranges (`266,338,400-410`), or `WHAT@RUN` - those of an
+    /// earlier run of this campaign (its directory, or a kept record `NAME.jsonl.gz`) that
+    /// `failed`, made a contact `at-fault`, were `called` (a pilot call ended them), made a
+    /// `needless` call, or `any` it holds: to run them again on this build or with `--set`,
+    /// into another --out (then `campaign compare RUN OUT`). Not with the falsify sampler.
+    #[arg(long, value_name = "LIST")]
+    pub variants: Option<String>,
     /// Complete a merged directory: run only the variants missing from it (refuses a directory
     /// with no results).
     #[arg(long)]
@@ -105,6 +128,17 @@ pub fn run(cmd: &CampaignCommand) -> anyhow::Result<bool> {
             Ok(records.iter().all(|r| !r.failed))
         }
         CampaignCommand::Merge { out, shards } => merge(out, shards),
+        CampaignCommand::Compare { before, after, out } => {
+            use sim::campaign::compare::{Side, compare, render};
+            let (before, after) = (Side::read(before)?, Side::read(after)?);
+            let c = compare(&before, &after)?;
+            let text = render(&c, &before, &after);
+            if let Some(out) = out {
+                mapper::write_atomically(out, text.as_bytes())?;
+            }
+            crate::emit(&text)?;
+            Ok(c.worse().is_empty())
+        }
         CampaignCommand::Run(args) => {
             let (failed, interrupted) = run_args(args)?;
             Ok(failed == 0 && !interrupted)
@@ -154,7 +188,24 @@ pub(crate) fn run_args(args: &CampaignRunArgs) -> anyhow::Result<(usize, bool)> 
         }
     }
     let total = total_runs(&campaign, runs);
-    let mine = |i: u64| i < total && shard.is_none_or(|s| s.holds(i));
+    let variants = match &args.variants {
+        Some(text) => {
+            let v = sim::campaign::select::parse_variants(text)?;
+            if let Some(last) = v.last().filter(|&&i| i >= total) {
+                anyhow::bail!(
+                    "--variants: variant {last} is beyond the {total} asked for (give --runs)"
+                );
+            }
+            Some(v)
+        }
+        None => None,
+    };
+    let picked = |i: u64| {
+        variants
+            .as_ref()
+            .is_none_or(|v| v.binary_search(&i).is_ok())
+    };
+    let mine = |i: u64| i < total && shard.is_none_or(|s| s.holds(i)) && picked(i);
     let before = existing.iter().filter(|r| mine(r.index)).count();
     let bar = ProgressBar::new((0..total).filter(|i| mine(*i)).count() as u64);
     bar.set_style(
@@ -186,6 +237,7 @@ pub(crate) fn run_args(args: &CampaignRunArgs) -> anyhow::Result<(usize, bool)> 
             maps_dir: args.maps_dir.clone(),
             jobs,
             runs,
+            variants: variants.as_deref(),
             stop: &stop,
             record_failures: args.record_failures,
             progress: &|r| {
