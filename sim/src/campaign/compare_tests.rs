@@ -30,6 +30,8 @@ fn side(name: &str, digest: &str, records: Vec<RunRecord>) -> Side {
         path: PathBuf::from(name),
         meta: serde_json::json!({"name": "traffic", "digest": digest, "sampler": "random", "seed": 7}),
         records,
+        calls_recorded: true,
+        meta_missing: None,
     }
 }
 
@@ -64,13 +66,14 @@ fn the_figures_are_over_the_common_variants_and_the_changed_ones_are_listed() {
     );
     let c = compare(&before, &after).expect("comparable");
     assert_eq!((c.common, c.only), (4, (1, 1)));
-    assert!(!c.digests_differ);
+    assert!(!c.file_changed && !c.sets_differ && !c.falsify);
     let (o, n) = &c.figures;
     assert_eq!((o.at_fault, o.calls, o.completed), ((1, 1), (2, 1), 2));
     assert_eq!((n.at_fault, n.calls, n.completed), ((0, 0), (1, 1), 3));
-    // Laps of the completed common runs: 70 and 73 before; 70, 71 and 73 after.
+    // Laps over the variants both completed (0 and 3: 70 and 73 s), not 1, which completes
+    // after only.
     assert_eq!(o.lap_s, [Some(70.0), Some(73.0)]);
-    assert_eq!(n.lap_s, [Some(71.0), Some(73.0)]);
+    assert_eq!(n.lap_s, o.lap_s);
     assert_eq!(o.clearance_m, [Some(1.0), Some(2.0)]);
     assert_eq!(c.causes[LOST], [(1, 1), (1, 1)]);
     assert_eq!(c.causes["struck/struck"], [(1, 0), (0, 0)]);
@@ -149,7 +152,22 @@ fn what_cannot_be_compared_is_refused_by_name() {
     let e = compare(&a, &b).unwrap_err().to_string();
     assert!(e.contains("no variant in common with old"), "{e}");
     let b = side("new", "d2", vec![record(0, "completed", None, 0)]);
-    assert!(compare(&a, &b).unwrap().digests_differ);
+    assert!(compare(&a, &b).unwrap().file_changed);
+    // The same file run with a --set: not a changed file.
+    let b = side(
+        "new",
+        "d1-set0abc1234",
+        vec![record(0, "completed", None, 0)],
+    );
+    let c = compare(&a, &b).unwrap();
+    assert!(!c.file_changed && c.sets_differ);
+    let mut b = side("new", "d1-halton", vec![record(0, "completed", None, 0)]);
+    b.meta["sampler"] = "halton".into();
+    let e = compare(&a, &b).unwrap_err().to_string();
+    assert!(
+        e.contains("a run of sampler \"halton\", not of \"random\""),
+        "{e}"
+    );
     let root = tempfile::tempdir().unwrap();
     let bad = root.path().join("x.jsonl");
     let good = serde_json::to_string(&record(0, "completed", None, 0)).unwrap();
@@ -162,5 +180,67 @@ fn what_cannot_be_compared_is_refused_by_name() {
     assert!(
         e.contains("notes.txt: not a campaign directory, nor a record"),
         "{e}"
+    );
+}
+
+/// What a comparison cannot trust is left out and said: variants not valid on a side (valid
+/// before, invalid after is worse), a side that recorded no pilot calls (an older build: its
+/// calls would read as none), a falsifier's variants (compared by figures only), a record
+/// with no `campaign.json` beside it, and a last line cut short by a killed process.
+#[test]
+fn what_cannot_be_trusted_is_left_out_and_said() {
+    let mut invalid = record(1, "invalid", None, 0);
+    invalid.failed = false;
+    let a = side(
+        "old",
+        "d1",
+        vec![
+            record(0, "completed", None, 0),
+            record(1, "struck", Some(("struck/struck", false)), 1),
+        ],
+    );
+    let b = side("new", "d1", vec![record(0, "completed", None, 0), invalid]);
+    let c = compare(&a, &b).unwrap();
+    assert_eq!((c.common, c.invalid), (1, (0, 0, 1)));
+    assert_eq!(c.worse(), ["variants no longer valid 0 -> 1"]);
+    let mut old = side("old", "d1", vec![record(0, "completed", None, 0)]);
+    old.calls_recorded = false;
+    let new = side(
+        "new",
+        "d1",
+        vec![record(0, "blocked", Some(("blocked/mover", false)), 0)],
+    );
+    let c = compare(&old, &new).unwrap();
+    assert!(!c.calls_known && c.worse().is_empty() && c.causes.is_empty());
+    assert_eq!(c.changed[0].2.call, None);
+    let text = render(&c, &old, &new);
+    assert!(text.contains("`old` records no pilot calls"), "{text}");
+    assert!(
+        text.contains("| pilot calls | not recorded | not recorded |"),
+        "{text}"
+    );
+    let (mut f1, mut f2) = (new.clone(), new.clone());
+    f1.meta["sampler"] = "falsify".into();
+    f2.meta["sampler"] = "falsify".into();
+    f2.records[0] = record(0, "completed", None, 0);
+    let c = compare(&f1, &f2).unwrap();
+    assert!(c.falsify && c.changed.is_empty());
+    assert!(render(&c, &f1, &f2).contains("not variant for variant"));
+
+    let root = tempfile::tempdir().unwrap();
+    let kept = root.path().join("lone.jsonl");
+    let line = serde_json::to_string(&record(0, "completed", None, 0)).unwrap();
+    std::fs::write(&kept, format!("{line}\n{{\"index\": 1, \"sam")).unwrap();
+    let lone = Side::read(&kept).unwrap();
+    assert_eq!(lone.records.len(), 1, "the cut line dropped");
+    assert!(lone.calls_recorded);
+    assert_eq!(
+        lone.meta_missing,
+        Some(root.path().join("lone.campaign.json"))
+    );
+    let text = render(&compare(&lone, &lone).unwrap(), &lone, &lone);
+    assert!(
+        text.contains("lone.campaign.json`: its campaign, sampler and digest are not known"),
+        "{text}"
     );
 }

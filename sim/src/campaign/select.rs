@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use super::Campaign;
 use super::compare::Side;
 use super::record::RunRecord;
 use crate::error::{Error, Result};
@@ -20,13 +21,21 @@ const PICKS: [(&str, Pick); 5] = [
     ("any", |_| true),
 ];
 
-/// The variants `text` names, sorted, each once: indices and ranges (`266,338,400-410`), or
-/// `WHAT@RUN` - those of an earlier run of the campaign (a directory, or a kept record
-/// `NAME.jsonl.gz`) that `failed`, made a contact `at-fault`, were `called` (a pilot call ended
-/// them), made a `needless` call, or `any` it holds.
-pub fn parse_variants(text: &str) -> Result<Vec<u64>> {
+/// The variants `text` names, sorted, each once, all below `total` (the variants asked for):
+/// indices and ranges (`266,338,400-410`), or `WHAT@RUN` - those of an earlier run of the
+/// campaign (a directory, or a kept record `NAME.jsonl.gz`) that `failed`, made a contact
+/// `at-fault`, were `called` (a pilot call ended them), made a `needless` call, or `any` it
+/// holds; with that run's `campaign.json`, to check it is a run of this campaign
+/// ([`check_same_campaign`]).
+pub fn parse_variants(text: &str, total: u64) -> Result<(Vec<u64>, Option<serde_json::Value>)> {
     let bad = |message: String| Error::Invalid(format!("--variants {text}: {message}"));
+    let beyond = |i: u64| {
+        bad(format!(
+            "variant {i} is beyond the {total} variants of this run (more with --runs, unless a grid ends sooner)"
+        ))
+    };
     let mut out = Vec::new();
+    let mut meta = None;
     if let Some((what, run)) = text.split_once('@') {
         let Some((_, pick)) = PICKS.iter().find(|(name, _)| *name == what) else {
             let names: Vec<&str> = PICKS.iter().map(|(n, _)| *n).collect();
@@ -40,6 +49,7 @@ pub fn parse_variants(text: &str) -> Result<Vec<u64>> {
         if out.is_empty() {
             return Err(bad(format!("no variant of {run} is {what}")));
         }
+        meta = Some(side.meta);
     } else {
         for part in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
             let index = |s: &str| {
@@ -47,16 +57,17 @@ pub fn parse_variants(text: &str) -> Result<Vec<u64>> {
                     .parse::<u64>()
                     .map_err(|_| bad(format!("`{s}` is not a variant index")))
             };
-            match part.split_once('-') {
-                Some((a, b)) => {
-                    let (a, b) = (index(a)?, index(b)?);
-                    if a > b {
-                        return Err(bad(format!("`{part}`: a range runs upwards")));
-                    }
-                    out.extend(a..=b);
-                }
-                None => out.push(index(part)?),
+            let (a, b) = match part.split_once('-') {
+                Some((a, b)) => (index(a)?, index(b)?),
+                None => (index(part)?, index(part)?),
+            };
+            if a > b {
+                return Err(bad(format!("`{part}`: a range runs upwards")));
             }
+            if b >= total {
+                return Err(beyond(b));
+            }
+            out.extend(a..=b);
         }
         if out.is_empty() {
             return Err(bad("no variant named".into()));
@@ -64,7 +75,57 @@ pub fn parse_variants(text: &str) -> Result<Vec<u64>> {
     }
     out.sort_unstable();
     out.dedup();
-    Ok(out)
+    if let Some(&last) = out.last().filter(|&&i| i >= total) {
+        return Err(beyond(last));
+    }
+    Ok((out, meta))
+}
+
+/// Whether the run described by `meta` (its `campaign.json`) is a run of `campaign` as it is
+/// run now: an error when its campaign, sampler or campaign file (the first part of its digest)
+/// differs - its indices would name other scenarios -; a note when only its `--set`s differ
+/// (`None`: the same, or no `campaign.json` to tell).
+pub fn check_same_campaign(
+    meta: &serde_json::Value,
+    campaign: &Campaign,
+) -> Result<Option<String>> {
+    if meta.is_null() {
+        return Ok(Some(
+            "--variants: the earlier run has no campaign.json; its indices are taken as this campaign's".into(),
+        ));
+    }
+    let text = |k: &str| {
+        meta.get(k)
+            .and_then(|v| v.as_str())
+            .unwrap_or("?")
+            .to_string()
+    };
+    let digest = text("digest");
+    let (theirs, ours) = (
+        digest.split('-').collect::<Vec<_>>(),
+        campaign.digest.split('-').collect::<Vec<_>>(),
+    );
+    let differs = [
+        ("campaign", text("name"), campaign.name.clone()),
+        (
+            "sampler",
+            text("sampler"),
+            campaign.sampler.as_str().to_string(),
+        ),
+        (
+            "campaign file (digest)",
+            theirs[0].to_string(),
+            ours[0].to_string(),
+        ),
+    ];
+    if let Some((what, a, b)) = differs.iter().find(|(_, a, b)| a != b) {
+        return Err(Error::Invalid(format!(
+            "--variants: the earlier run is of another {what} (\"{a}\", not \"{b}\"): its indices name other scenarios"
+        )));
+    }
+    Ok((theirs[1..] != ours[1..]).then(|| {
+        "--variants: the earlier run had other --set values (the same variants with something changed)".to_string()
+    }))
 }
 
 #[cfg(test)]
@@ -74,7 +135,7 @@ mod tests {
     #[test]
     fn indices_and_ranges_are_read_and_bad_ones_named() {
         assert_eq!(
-            parse_variants("266, 338,400-402,338").unwrap(),
+            parse_variants("266, 338,400-402,338", 1000).unwrap().0,
             [266, 338, 400, 401, 402]
         );
         for (text, says) in [
@@ -85,8 +146,12 @@ mod tests {
                 "slow@dir",
                 "`slow`: expected one of failed, at-fault, called, needless, any",
             ),
+            (
+                "5,0-99999999999",
+                "variant 99999999999 is beyond the 1000 variants",
+            ),
         ] {
-            let e = parse_variants(text).unwrap_err().to_string();
+            let e = parse_variants(text, 1000).unwrap_err().to_string();
             assert!(e.contains(says), "{text}: {e}");
         }
     }
@@ -112,14 +177,18 @@ mod tests {
             + &line(8, Some("hidden_obstacle/lost_obstacle"), true, 0)
             + &line(9, None, false, 2);
         std::fs::write(dir.path().join("results.jsonl"), text).unwrap();
-        let at = |what: &str| parse_variants(&format!("{what}@{}", dir.path().display()));
-        assert_eq!(at("called").unwrap(), [5, 8]);
-        assert_eq!(at("needless").unwrap(), [8]);
-        assert_eq!(at("failed").unwrap(), [9]);
-        assert_eq!(at("at-fault").unwrap(), [9]);
-        assert_eq!(at("any").unwrap(), [3, 5, 8, 9]);
+        let at = |what: &str, total: u64| {
+            parse_variants(&format!("{what}@{}", dir.path().display()), total).map(|p| p.0)
+        };
+        assert_eq!(at("called", 10).unwrap(), [5, 8]);
+        assert_eq!(at("needless", 10).unwrap(), [8]);
+        assert_eq!(at("failed", 10).unwrap(), [9]);
+        assert_eq!(at("at-fault", 10).unwrap(), [9]);
+        assert_eq!(at("any", 10).unwrap(), [3, 5, 8, 9]);
+        let e = at("any", 9).unwrap_err().to_string();
+        assert!(e.contains("variant 9 is beyond the 9 variants"), "{e}");
         std::fs::write(dir.path().join("results.jsonl"), line(3, None, false, 0)).unwrap();
-        let e = at("needless").unwrap_err().to_string();
+        let e = at("needless", 10).unwrap_err().to_string();
         assert!(e.contains("is needless"), "{e}");
     }
 }

@@ -137,7 +137,7 @@ fn results_are_the_same_whatever_jobs() {
 #[test]
 fn picked_variants_run_alone_as_they_ran_in_the_full_campaign() {
     let (_, records) = full();
-    let picked = sim::campaign::select::parse_variants("2,7").unwrap();
+    let picked = sim::campaign::select::parse_variants("2,7", 12).unwrap().0;
     let dir = tempfile::tempdir().unwrap();
     let campaign = smoke();
     let stop = AtomicBool::new(false);
@@ -159,6 +159,22 @@ fn picked_variants_run_alone_as_they_ran_in_the_full_campaign() {
     for r in &outcome.records {
         assert_eq!(r.timeless(), records[r.index as usize].timeless());
     }
+    // Picked from that run, for this campaign as it is run now: the same; with a --set, the
+    // same variants changed (a note); sampled another way, refused.
+    use sim::campaign::select::check_same_campaign;
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("campaign.json")).unwrap())
+            .unwrap();
+    assert_eq!(check_same_campaign(&meta, &campaign).unwrap(), None);
+    let mut set = smoke();
+    set.set_field("route.speed_m_s", toml::Value::Float(2.0))
+        .unwrap();
+    let note = check_same_campaign(&meta, &set).unwrap().expect("a note");
+    assert!(note.contains("other --set values"), "{note}");
+    let mut random = smoke();
+    random.set_sampler(sim::campaign::SamplerKind::Random); // the file's is halton
+    let e = check_same_campaign(&meta, &random).unwrap_err().to_string();
+    assert!(e.contains("another sampler"), "{e}");
 }
 
 #[test]

@@ -188,18 +188,7 @@ pub(crate) fn run_args(args: &CampaignRunArgs) -> anyhow::Result<(usize, bool)> 
         }
     }
     let total = total_runs(&campaign, runs);
-    let variants = match &args.variants {
-        Some(text) => {
-            let v = sim::campaign::select::parse_variants(text)?;
-            if let Some(last) = v.last().filter(|&&i| i >= total) {
-                anyhow::bail!(
-                    "--variants: variant {last} is beyond the {total} asked for (give --runs)"
-                );
-            }
-            Some(v)
-        }
-        None => None,
-    };
+    let variants = picked_variants(args.variants.as_deref(), &campaign, total)?;
     let picked = |i: u64| {
         variants
             .as_ref()
@@ -213,6 +202,12 @@ pub(crate) fn run_args(args: &CampaignRunArgs) -> anyhow::Result<(usize, bool)> 
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar.set_position(before as u64);
+    if variants.is_some() && bar.length() == Some(before as u64) {
+        eprintln!(
+            "--variants: every variant named is already in {} or outside this shard: nothing to run",
+            args.out.display()
+        );
+    }
     eprintln!(
         "campaign {}{}: {} runs ({} already in {}), {} random dimensions, {} parameter settings, {} at a time",
         campaign.name,
@@ -268,6 +263,24 @@ pub(crate) fn run_args(args: &CampaignRunArgs) -> anyhow::Result<(usize, bool)> 
         args.out.join("summary.md").display()
     ))?;
     Ok((failed, outcome.interrupted))
+}
+
+/// The variants `--variants` names (`None`: all), checked against `campaign` as it is run now.
+fn picked_variants(
+    text: Option<&str>,
+    campaign: &Campaign,
+    total: u64,
+) -> anyhow::Result<Option<Vec<u64>>> {
+    let Some(text) = text else {
+        return Ok(None);
+    };
+    let (v, meta) = sim::campaign::select::parse_variants(text, total)?;
+    if let Some(meta) = meta
+        && let Some(note) = sim::campaign::select::check_same_campaign(&meta, campaign)?
+    {
+        eprintln!("{note}");
+    }
+    Ok(Some(v))
 }
 
 /// `taxi-sim campaign merge`: returns whether every variant is in.

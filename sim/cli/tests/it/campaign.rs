@@ -183,3 +183,61 @@ fn shards_merged_equal_the_single_machine_run_and_a_lost_shard_is_named_and_reru
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("holds no results"));
 }
+
+/// `taxi-sim campaign compare`: the smoke campaign's run against a copy in which one variant
+/// ends in a needless pilot call - exit 1 one way (worse, and why), 0 the other - and a side
+/// that is no run, exit 2 naming it; `campaign run --variants` beyond the campaign, exit 2.
+#[test]
+fn compare_exits_by_whether_the_second_run_is_worse() {
+    let (dir, records) = full();
+    let work = tempfile::tempdir().unwrap();
+    let worse = work.path().join("worse");
+    std::fs::create_dir_all(&worse).unwrap();
+    std::fs::copy(
+        dir.path().join("campaign.json"),
+        worse.join("campaign.json"),
+    )
+    .unwrap();
+    let i = records.iter().position(|r| r.pilot_call.is_none()).unwrap();
+    let mut changed = records.to_vec();
+    changed[i].end = "waiting_for_hidden_obstacle".into();
+    changed[i].pilot_call = Some("hidden_obstacle/lost_obstacle".into());
+    changed[i].needless_pilot_call = true;
+    let text: String = (changed.iter())
+        .map(|r| serde_json::to_string(r).unwrap() + "\n")
+        .collect();
+    std::fs::write(worse.join("results.jsonl"), text).unwrap();
+    let compare = |a: &Path, b: &Path| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_taxi-sim"))
+            .args(["campaign", "compare"])
+            .args([a, b])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).to_string()
+            + &String::from_utf8_lossy(&out.stderr);
+        (out.status.code(), text)
+    };
+    let (code, text) = compare(dir.path(), &worse);
+    assert_eq!(code, Some(1), "{text}");
+    assert!(text.contains("**After is worse**"), "{text}");
+    assert!(text.contains(&format!("| {i} | ")), "{text}");
+    let (code, text) = compare(&worse, dir.path());
+    assert_eq!(code, Some(0), "{text}");
+    let (code, text) = compare(dir.path(), &work.path().join("nothing"));
+    assert_eq!(code, Some(2), "{text}");
+    assert!(text.contains("nothing"), "{text}");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_taxi-sim"))
+        .args(["campaign", "run"])
+        .arg(smoke_path())
+        .arg("--out")
+        .arg(work.path().join("out"))
+        .args(["--variants", "3,40"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("variant 40 is beyond the 12 variants"),
+        "{err}"
+    );
+}
