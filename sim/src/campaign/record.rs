@@ -168,21 +168,31 @@ fn as_json<'a>(
         .collect()
 }
 
-/// One failure line per contact that counts (with `no_contact_at_fault`, a contact struck while
-/// standing does not); returns how many contacts began during a stop.
+/// One failure line per judged contact that counts (with `no_contact_at_fault`, a contact struck
+/// does not); returns how many contacts began during a stop.
 fn contact_failures(scenario: &Scenario, r: &RunReport, failures: &mut Vec<String>) -> usize {
     let standing = |t: f64| {
         r.stops
             .iter()
             .any(|s| s.start_s <= t && s.end_s.is_none_or(|e| t <= e))
     };
-    let mut contacts_while_stopped = 0;
-    for (k, c) in r.contacts.iter().enumerate() {
+    let contacts_while_stopped = r.contacts.iter().filter(|c| standing(c.time_s)).count();
+    // Each judgement (a pair driven into while it lasts is judged again); contacts no judge
+    // saw (none, as the loop runs) count as at fault.
+    let judged = r
+        .contacts_judged
+        .iter()
+        .map(|j| (&j.contact, j.at_fault))
+        .chain(
+            r.contacts
+                .iter()
+                .skip(r.contacts_judged.len())
+                .map(|c| (c, true)),
+        );
+    for (c, at_fault) in judged {
         let still = standing(c.time_s);
-        contacts_while_stopped += usize::from(still);
-        let at_fault = r.contacts_judged.get(k).is_none_or(|j| j.at_fault);
         if scenario.no_contact_at_fault && !at_fault {
-            // Struck while standing: not a failure by this scenario's rule.
+            // Struck, standing or while moving: not a failure by this scenario's rule.
             continue;
         }
         let how = match (still, at_fault) {

@@ -151,8 +151,9 @@ pub struct ObstacleReport {
     pub pet_mover_first: Option<bool>,
 }
 
-/// A ground-truth contact and who was at fault: the vehicle moving when it began (the stack's
-/// fault) or standing (struck by a mover).
+/// A ground-truth contact and who was at fault: the vehicle moving into it when it began (the
+/// stack's fault), standing (struck by a mover), or moving while the object came into room the
+/// vehicle already held (struck while moving: the object's doing, see [`HELD_ROOM_S`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct JudgedContact {
     /// The contact.
@@ -160,22 +161,43 @@ pub struct JudgedContact {
     pub contact: Contact,
     /// The vehicle's true speed at the step the contact began, m/s (signed along its heading).
     pub vehicle_speed_m_s: f64,
-    /// True when the vehicle was moving then (|speed| > 0.05 m/s): the stack's fault; false:
-    /// it stood and was struck.
+    /// True when the vehicle was moving then (|speed| > 0.05 m/s) and the object, where it
+    /// touched, did not already touch the vehicle as it stood [`HELD_ROOM_S`] before: the
+    /// stack's fault; false: it stood and was struck, or was struck while moving.
     pub at_fault: bool,
+    /// True when the vehicle was moving but the object, where it touched, already touched the
+    /// vehicle as it stood [`HELD_ROOM_S`] before: it drove into room the vehicle held (a van
+    /// into the tail of a jet moving off), not the vehicle into it.
+    pub struck_while_moving: bool,
 }
 
 /// Above this true speed (m/s) the vehicle was moving when a contact began: the contact was the
-/// stack's fault.
+/// stack's fault unless the object came into room the vehicle held.
 pub const AT_FAULT_SPEED_M_S: f64 = 0.05;
 
+/// How far back the judge looks for the room the vehicle held, seconds: a contact that begins
+/// while the vehicle moves is the object's doing when the object, where it touched, would also
+/// touch the vehicle placed where it was this long before. At 8 m/s the vehicle was 4 m back:
+/// anything it drives into is at fault; at 0.3 m/s, 0.15 m: a mover into its side or tail is not.
+pub const HELD_ROOM_S: f64 = 0.5;
+
 impl JudgedContact {
-    /// `contact`, which began while the vehicle's true speed was `vehicle_speed_m_s`.
+    /// `contact`, which began while the vehicle's true speed was `vehicle_speed_m_s` (at fault
+    /// when moving).
     pub fn new(contact: Contact, vehicle_speed_m_s: f64) -> Self {
+        Self::judged(contact, vehicle_speed_m_s, false)
+    }
+
+    /// `contact`, which began while the vehicle's true speed was `vehicle_speed_m_s`;
+    /// `into_held_room`: the object, where it touched, touched the vehicle as it stood
+    /// [`HELD_ROOM_S`] before.
+    pub fn judged(contact: Contact, vehicle_speed_m_s: f64, into_held_room: bool) -> Self {
+        let moving = vehicle_speed_m_s.abs() > AT_FAULT_SPEED_M_S;
         JudgedContact {
             contact,
             vehicle_speed_m_s,
-            at_fault: vehicle_speed_m_s.abs() > AT_FAULT_SPEED_M_S,
+            at_fault: moving && !into_held_room,
+            struck_while_moving: moving && into_held_room,
         }
     }
 }

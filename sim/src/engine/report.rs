@@ -46,13 +46,16 @@ pub struct RunReport {
     pub lap_times_s: Vec<f64>,
     /// Ground-truth contacts.
     pub contacts: Vec<Contact>,
-    /// The same contacts in the same order, each with the vehicle's true speed when it began and
-    /// whether the vehicle was at fault (moving, |speed| > 0.05 m/s) or struck (standing).
+    /// The contacts judged, each with the vehicle's true speed then and whether the vehicle was
+    /// at fault (moving into it), struck standing, or struck while moving (the object came into
+    /// room the vehicle held); a pair driven into while it lasts is judged again, once.
     pub contacts_judged: Vec<JudgedContact>,
-    /// Contacts that began while the vehicle moved: the stack's fault.
+    /// Judged at fault: the stack's.
     pub contacts_at_fault: usize,
-    /// Contacts that began while the vehicle stood: struck by a mover.
+    /// Judged struck: by a mover, the vehicle standing or moving.
     pub contacts_struck: usize,
+    /// Of those, struck while the vehicle moved.
+    pub contacts_struck_while_moving: usize,
     /// Per run-time obstacle.
     pub obstacles: Vec<ObstacleReport>,
     /// Stops, once the vehicle has first moved (held at the start while the localizer settles

@@ -441,6 +441,7 @@ impl<'a> Rig<'a> {
             contacts_judged: verdict.contacts,
             contacts_at_fault: verdict.contacts_at_fault,
             contacts_struck: verdict.contacts_struck,
+            contacts_struck_while_moving: verdict.contacts_struck_while_moving,
             obstacles: verdict.obstacles,
             stops: verdict.stops,
             min_clearance_m: verdict.min_clearance_m,

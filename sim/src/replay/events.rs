@@ -46,6 +46,8 @@ pub(super) fn event_line(event: &Event) -> (String, &'static str) {
             let c = &j.contact;
             let fault = if j.at_fault {
                 format!("at fault, moving at {:.2} m/s", j.vehicle_speed_m_s)
+            } else if j.struck_while_moving {
+                format!("struck while moving at {:.2} m/s", j.vehicle_speed_m_s)
             } else {
                 "struck while standing".to_string()
             };

@@ -90,6 +90,8 @@ pub struct World {
     ground: super::ground::GroundTexture,
     objects: Vec<ColliderHandle>,
     object_active: Vec<bool>,
+    /// When each object last became present (minus infinity: from the start), seconds.
+    active_since_s: Vec<f64>,
     owners: HashMap<ColliderHandle, Owner>,
     vehicle: RigidBodyHandle,
     parts: Vec<(ColliderHandle, String)>,
@@ -194,6 +196,7 @@ impl World {
             scene,
             objects,
             object_active: vec![true; n],
+            active_since_s: vec![f64::NEG_INFINITY; n],
             owners,
             vehicle: vehicle_body,
             parts,
@@ -257,6 +260,9 @@ impl World {
             self.object_active.get_mut(i),
         ) {
             c.set_enabled(active);
+            if active && !*a {
+                self.active_since_s[i] = self.time_s;
+            }
             *a = active;
         }
     }
@@ -367,6 +373,43 @@ impl World {
                     .map_or(f64::INFINITY, |d| d.distance as f64)
             })
             .collect()
+    }
+
+    /// Signed separation of object `i`, where it is now, from the vehicle's part (URDF link)
+    /// `part` placed where `pose` puts it, metres: negative when they overlap (the penetration
+    /// depth), infinity beyond 1 m, when the object is absent or the shapes unsupported. The
+    /// judge's "did the vehicle's own motion bring them together".
+    pub fn part_separation_at_m(&self, i: usize, part: &str, pose: &Isometry2<f64>) -> f64 {
+        let (Some(obj), Some(body)) = (
+            self.objects
+                .get(i)
+                .filter(|_| self.object_active(i))
+                .and_then(|h| self.physics.colliders.get(*h)),
+            self.physics.bodies.get(self.vehicle),
+        ) else {
+            return f64::INFINITY;
+        };
+        let moved = to_pose(&planar_to_3d(pose)) * body.position().inverse();
+        self.parts
+            .iter()
+            .filter(|(_, name)| name == part)
+            .filter_map(|(h, _)| self.physics.colliders.get(*h))
+            .filter_map(|c| {
+                let at = moved * *c.position();
+                parry3d::query::contact(&at, c.shape(), obj.position(), obj.shape(), 1.0)
+                    .ok()
+                    .flatten()
+                    .map(|k| k.dist as f64)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// When object `i` last became present, seconds (minus infinity: present from the start).
+    pub fn object_active_since_s(&self, i: usize) -> f64 {
+        self.active_since_s
+            .get(i)
+            .copied()
+            .unwrap_or(f64::NEG_INFINITY)
     }
 
     /// The vehicle's reference point in the world (x, y).

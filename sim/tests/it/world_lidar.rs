@@ -741,3 +741,60 @@ fn the_bicycle_at_100_hz_drives_the_kinematic_body_into_a_cone() {
     );
     assert!(state.y_m > 0.5, "the arc bent left: y = {}", state.y_m);
 }
+
+/// The judge's "did the vehicle's own motion bring them together": an object's signed
+/// separation from a vehicle part placed at another pose is its separation from that part where
+/// the pose puts it (negative: overlapping), and leaves the vehicle where it is.
+#[test]
+fn an_objects_separation_from_a_part_at_another_pose() {
+    let v = car();
+    // The car at a turned, offset pose; a van beside it on its left, parallel to it.
+    let here = Isometry2::new(Vector2::new(10.0, 5.0), 0.6);
+    let left = here * nalgebra::Point2::new(1.0, 2.5);
+    let van = solid(
+        "van",
+        ObjectKind::Vehicle,
+        SolidShape::Box {
+            size_m: [4.0, 2.0, 2.0],
+        },
+        left.x,
+        left.y,
+        0.6,
+    );
+    let mut world = World::with_obstacles(&scene(vec![van]), &v, &here);
+    world.set_vehicle_pose(&here, 0.0);
+    let (d0, part) = v
+        .parts
+        .iter()
+        .map(|p| {
+            (
+                world.part_separation_at_m(0, &p.link, &here),
+                p.link.clone(),
+            )
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .unwrap();
+    let exact = world
+        .distances_to(0)
+        .into_iter()
+        .fold(f64::INFINITY, f64::min);
+    assert!((d0 - exact).abs() < 2e-3, "{d0} against {exact} ({part})");
+    assert!(d0 > 0.2 && d0 < 1.0, "the van beside the car: {d0}");
+    // Half a metre along its heading: the van beside its flat side, as far.
+    let ahead = here * Isometry2::new(Vector2::new(0.5, 0.0), 0.0);
+    assert!((world.part_separation_at_m(0, &part, &ahead) - d0).abs() < 2e-3);
+    // Sideways towards the van: 0.1 m short, then 0.1 m into it.
+    let nearer = here * Isometry2::new(Vector2::new(0.0, d0 - 0.1), 0.0);
+    assert!((world.part_separation_at_m(0, &part, &nearer) - 0.1).abs() < 2e-3);
+    let into = here * Isometry2::new(Vector2::new(0.0, d0 + 0.1), 0.0);
+    assert!((world.part_separation_at_m(0, &part, &into) + 0.1).abs() < 2e-3);
+    // Away from it beyond the query's metre: infinity.
+    let away = here * Isometry2::new(Vector2::new(0.0, -2.0), 0.0);
+    assert_eq!(world.part_separation_at_m(0, &part, &away), f64::INFINITY);
+    // The vehicle itself did not move.
+    let after = world
+        .distances_to(0)
+        .into_iter()
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(exact, after);
+}

@@ -461,14 +461,18 @@ pub fn table(r: &RunReport) -> String {
     pilot_call_line(&mut t, r);
     obstacle_rows(&mut t, r);
     closest_static_row(&mut t, r);
-    for (k, c) in r.contacts.iter().enumerate() {
-        let fault = r.contacts_judged.get(k).map_or(String::new(), |j| {
-            if j.at_fault {
-                format!(" (at fault: moving at {:.2} m/s)", j.vehicle_speed_m_s)
-            } else {
-                " (struck while standing)".to_string()
-            }
-        });
+    for j in &r.contacts_judged {
+        let c = &j.contact;
+        let fault = if j.at_fault {
+            format!(" (at fault: moving at {:.2} m/s)", j.vehicle_speed_m_s)
+        } else if j.struck_while_moving {
+            format!(
+                " (struck while moving at {:.2} m/s: it came into room the vehicle held)",
+                j.vehicle_speed_m_s
+            )
+        } else {
+            " (struck while standing)".to_string()
+        };
         let _ = writeln!(
             t,
             "contact at {:.2} s: {} ({:?}) touched by {}{fault}",

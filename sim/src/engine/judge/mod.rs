@@ -13,6 +13,11 @@
 //!
 //! A contact is judged when it begins, and again, once, if the vehicle moves while it lasts (a
 //! mover that struck the standing vehicle and halted against it, then driven into: at fault).
+//! One that begins while the vehicle moves is at fault unless the object, where it touched,
+//! overlaps the touching part placed where the vehicle was half a second before
+//! (`HELD_ROOM_S`) at least as deeply: then the object came into room the vehicle held - a van
+//! into the tail of a jet moving off at 0.3 m/s - and the contact is struck while moving, asked
+//! again each step while the vehicle moves (`contacts`).
 //!
 //! `[expectations] no_contact_at_fault = true`: a contact while the vehicle moved fails the run
 //! whatever the obstacles expect; a contact while it stood (struck) counts against neither the
@@ -33,7 +38,9 @@ mod yielding;
 mod tests;
 
 use autonomy::RoutePath;
-use nalgebra::Point2;
+use std::collections::VecDeque;
+
+use nalgebra::{Isometry2, Point2};
 
 use super::outcome::{EndReason, Event, JudgedContact, ObstacleReport, Stop};
 use crate::scenario::{ExpectedEnd, Scenario};
@@ -78,8 +85,11 @@ pub struct Judge {
     s_total: f64,
     deviating: bool,
     contacts_seen: usize,
-    /// The (object, part) pairs touching now already judged at fault while they touch.
-    pushing: Vec<(String, String)>,
+    /// The (object, part) pairs touching now already judged, and how.
+    touching: contacts::Touching,
+    /// The vehicle's true poses of the last [`super::outcome::HELD_ROOM_S`] (and the latest
+    /// older one).
+    recent_poses: VecDeque<(f64, Isometry2<f64>)>,
     events: Vec<(f64, Event)>,
     /// Every contact judged, in the world's order.
     contacts: Vec<JudgedContact>,
@@ -173,7 +183,8 @@ impl Judge {
             s_total: 0.0,
             deviating: false,
             contacts_seen: 0,
-            pushing: Vec::new(),
+            touching: contacts::Touching::default(),
+            recent_poses: VecDeque::new(),
             events: Vec::new(),
             contacts: Vec::new(),
             no_contact_at_fault: scenario.no_contact_at_fault,
@@ -227,7 +238,9 @@ impl Judge {
         let stopped = state.speed_m_s.abs() < 0.05 && speed_command_m_s == 0.0;
         self.judge_stops(t_s, state, stopped);
         self.speed_now_m_s = state.speed_m_s;
-        self.judge_contacts(state.speed_m_s, world);
+        let pose = state.world_from_vehicle();
+        self.remember_pose(t_s, pose);
+        self.judge_contacts(t_s, &pose, state.speed_m_s, world);
         self.watch_traffic(t_s, state, world);
         self.judge_passes(t_s, d_now, stopped, world);
         self.clearance_now_m.fill(f64::INFINITY);
@@ -299,6 +312,7 @@ impl Judge {
         self.s_now = self.s_start;
         self.s_total = 0.0;
         self.samples.jumped = true;
+        self.forget_poses();
     }
 
     /// Smallest ground-truth clearance per level to any object near the vehicle now, metres.
@@ -373,6 +387,11 @@ impl Judge {
             min_clearance_m: self.min_clearance_m,
             contacts_at_fault,
             contacts_struck: self.contacts.len() - contacts_at_fault,
+            contacts_struck_while_moving: self
+                .contacts
+                .iter()
+                .filter(|c| c.struck_while_moving)
+                .count(),
             contacts: self.contacts,
         }
     }
@@ -394,8 +413,12 @@ pub struct Verdict {
     pub min_clearance_m: Vec<f64>,
     /// Every contact with who was at fault, in the world's order.
     pub contacts: Vec<JudgedContact>,
-    /// Contacts that began while the vehicle moved.
+    /// Contacts at fault: begun while the vehicle moved into them, or driven into while they
+    /// lasted.
     pub contacts_at_fault: usize,
-    /// Contacts that began while it stood (struck by a mover).
+    /// The others: struck by a mover while the vehicle stood, or while it moved (the mover
+    /// came into room it held).
     pub contacts_struck: usize,
+    /// Of those, struck while the vehicle moved.
+    pub contacts_struck_while_moving: usize,
 }

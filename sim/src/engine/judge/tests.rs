@@ -29,21 +29,66 @@ fn a_contact_lasting_while_the_vehicle_moves_is_at_fault_once() {
         kind: ObjectKind::FuelTruck,
         part: "wing_left".into(),
     };
-    let mut pushing = Vec::new();
-    let j = judge_contacts(&mut pushing, &[c(1.0)], &[c(1.0)], 0.0);
+    let mut pushing = contacts::Touching::default();
+    let never = |_: &Contact| false;
+    let judge = |p: &mut contacts::Touching, begun: &[Contact], touching: &[Contact], v: f64| {
+        judge_contacts(p, begun, touching, v, &never)
+    };
+    let j = judge(&mut pushing, &[c(1.0)], &[c(1.0)], 0.0);
     assert_eq!(j.len(), 1);
     assert!(!j[0].at_fault);
-    assert!(judge_contacts(&mut pushing, &[], &[c(2.0)], 0.0).is_empty());
-    let j = judge_contacts(&mut pushing, &[], &[c(3.0)], 0.8);
+    assert!(judge(&mut pushing, &[], &[c(2.0)], 0.0).is_empty());
+    let j = judge(&mut pushing, &[], &[c(3.0)], 0.8);
     assert_eq!(j.len(), 1);
     assert!(j[0].at_fault && j[0].contact.time_s == 3.0);
-    assert!(judge_contacts(&mut pushing, &[], &[c(3.1)], 0.9).is_empty());
+    assert!(judge(&mut pushing, &[], &[c(3.1)], 0.9).is_empty());
     // Apart, then touching again while moving: a new contact, judged once.
-    assert!(judge_contacts(&mut pushing, &[], &[], 0.9).is_empty());
-    let j = judge_contacts(&mut pushing, &[c(5.0)], &[c(5.0)], 0.9);
+    assert!(judge(&mut pushing, &[], &[], 0.9).is_empty());
+    let j = judge(&mut pushing, &[c(5.0)], &[c(5.0)], 0.9);
     assert_eq!(j.len(), 1);
     assert!(j[0].at_fault);
-    assert!(judge_contacts(&mut pushing, &[], &[c(5.1)], 0.9).is_empty());
+    assert!(judge(&mut pushing, &[], &[c(5.1)], 0.9).is_empty());
+}
+
+/// A van drives into the side of the jet moving off at 0.3 m/s: it overlaps the jet as it stood
+/// half a second before at least as deeply - struck while moving, not at fault, and asked again
+/// while they touch: at fault once the jet's own motion deepens it. The same contact where the
+/// jet's half second made it (the jet into the van) is at fault; standing, the pair is one
+/// struck standing, at fault when driven into.
+#[test]
+fn a_mover_into_room_the_moving_vehicle_held_is_struck_while_moving() {
+    let c = |t: f64| Contact {
+        time_s: t,
+        object: "van".into(),
+        kind: ObjectKind::Vehicle,
+        part: "tail_cone".into(),
+    };
+    let mut state = contacts::Touching::default();
+    let held = |_: &Contact| true;
+    let not_held = |_: &Contact| false;
+    let j = judge_contacts(&mut state, &[c(1.0)], &[c(1.0)], 0.3, &held);
+    assert_eq!(j.len(), 1);
+    assert!(!j[0].at_fault && j[0].struck_while_moving, "{:?}", j[0]);
+    assert!(judge_contacts(&mut state, &[], &[c(1.1)], 0.25, &held).is_empty());
+    // The jet's own motion deepens it: at fault, once while it lasts.
+    let j = judge_contacts(&mut state, &[], &[c(1.2)], 0.25, &not_held);
+    assert!(j.len() == 1 && j[0].at_fault, "{j:?}");
+    assert!(judge_contacts(&mut state, &[], &[c(1.3)], 0.25, &not_held).is_empty());
+    // Apart, then touching anew where the jet's own motion made it: at fault.
+    assert!(judge_contacts(&mut state, &[], &[], 0.2, &held).is_empty());
+    let j = judge_contacts(&mut state, &[c(3.0)], &[c(3.0)], 0.3, &not_held);
+    assert!(j[0].at_fault && !j[0].struck_while_moving, "{:?}", j[0]);
+    // Struck while moving, the jet stands, then moves while they still touch: at fault.
+    let mut state = contacts::Touching::default();
+    let j = judge_contacts(&mut state, &[c(5.0)], &[c(5.0)], 0.3, &held);
+    assert!(j[0].struck_while_moving, "{:?}", j[0]);
+    assert!(judge_contacts(&mut state, &[], &[c(5.5)], 0.0, &held).is_empty());
+    let j = judge_contacts(&mut state, &[], &[c(6.0)], 0.2, &held);
+    assert!(j.len() == 1 && j[0].at_fault, "{j:?}");
+    // Standing, the held room is not asked: struck, as before.
+    let mut state = contacts::Touching::default();
+    let j = judge_contacts(&mut state, &[c(7.0)], &[c(7.0)], 0.01, &held);
+    assert!(!j[0].at_fault && !j[0].struck_while_moving, "{:?}", j[0]);
 }
 
 #[test]
