@@ -72,12 +72,18 @@ pub struct RunRecord {
     /// Contacts that began while the vehicle stood still (something ran into it).
     #[serde(default)]
     pub contacts_while_stopped: usize,
-    /// Contacts that began while the vehicle moved (|true speed| > 0.05 m/s): the stack's fault.
+    /// Contacts judged at fault: the vehicle moving into them (|true speed| > 0.05 m/s), or
+    /// driven into while they lasted. Records before 2026-12-08 held every contact begun while
+    /// the vehicle moved at fault.
     #[serde(default)]
     pub contacts_at_fault: usize,
-    /// Contacts that began while the vehicle stood: struck by a mover.
+    /// Contacts judged struck by a mover: the vehicle standing, or moving while the mover came
+    /// into room it held.
     #[serde(default)]
     pub contacts_struck: usize,
+    /// Of those, struck while the vehicle moved (0 in records before 2026-12-08).
+    #[serde(default)]
+    pub contacts_struck_while_moving: usize,
     /// Smallest time to collision with any mover, seconds (`None`: never on a collision course,
     /// or no mover).
     #[serde(default)]
@@ -332,6 +338,7 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
         contacts_while_stopped,
         contacts_at_fault: r.contacts_at_fault,
         contacts_struck: r.contacts_struck,
+        contacts_struck_while_moving: r.contacts_struck_while_moving,
         min_ttc_s: min_of(&mut r.obstacles.iter().filter_map(|o| o.min_ttc_s)),
         min_pet_s: min_of(&mut r.obstacles.iter().filter_map(|o| o.pet_s)),
         obstacles,
@@ -384,6 +391,7 @@ pub(super) fn invalid(campaign: &Campaign, v: &Variant, why: &str) -> RunRecord 
         contacts_while_stopped: 0,
         contacts_at_fault: 0,
         contacts_struck: 0,
+        contacts_struck_while_moving: 0,
         min_ttc_s: None,
         min_pet_s: None,
         obstacles: Vec::new(),

@@ -1,5 +1,5 @@
 //! A campaign directory's `summary.md`, from its `results.jsonl`: per parameter setting the
-//! runs, failures, contacts (standing; at fault / struck), unmet expectations, false stops and needless deviations, clearance
+//! runs, failures, contacts (standing; at fault / struck, of them while moving), unmet expectations, false stops and needless deviations, clearance
 //! percentiles and lap times; for the falsifier, the generations; the error table of the
 //! failing variants. `taxi-sim campaign show DIR` prints it.
 
@@ -80,7 +80,7 @@ pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
         1000.0 * failed.len() as f64 / records.len().max(1) as f64,
         first.map_or("none yet".into(), |n| n.to_string())
     );
-    s += "## Per parameter setting\n\n| setting | runs | failed | runs with contact | contacts (standing) | at fault / struck | unmet expectations | false stops | needless deviations | obstacle clearance p0 / p5 / p50 (m) | mover TTC / PET p0 (s) | lap time p50 / max (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    s += "## Per parameter setting\n\n| setting | runs | failed | runs with contact | contacts (standing) | at fault / struck (while moving) | unmet expectations | false stops | needless deviations | obstacle clearance p0 / p5 / p50 (m) | mover TTC / PET p0 (s) | lap time p50 / max (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     let mut by_setting: BTreeMap<usize, Vec<&RunRecord>> = BTreeMap::new();
     for r in records {
         by_setting.entry(r.setting).or_default().push(r);
@@ -96,11 +96,12 @@ pub fn render(meta: &serde_json::Value, records: &[RunRecord]) -> String {
         let standing: usize = rs.iter().map(|r| r.contacts_while_stopped).sum();
         let at_fault: usize = rs.iter().map(|r| r.contacts_at_fault).sum();
         let struck: usize = rs.iter().map(|r| r.contacts_struck).sum();
+        let moving: usize = rs.iter().map(|r| r.contacts_struck_while_moving).sum();
         let ttc = rs.iter().filter_map(|r| r.min_ttc_s).reduce(f64::min);
         let pet = rs.iter().filter_map(|r| r.min_pet_s).reduce(f64::min);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} ({standing}) | {at_fault} / {struck} | {} | {} | {} | {} / {} / {} | {} / {} | {} / {} |",
+            "| {} | {} | {} | {} | {} ({standing}) | {at_fault} / {struck} ({moving}) | {} | {} | {} | {} / {} / {} | {} / {} | {} / {} |",
             setting_label(rs[0]),
             rs.len(),
             rs.iter().filter(|r| r.failed).count(),
@@ -311,4 +312,31 @@ fn needless_calls(records: &[RunRecord]) -> String {
         );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The per-setting row counts contacts at fault, struck, and of those struck while moving.
+    #[test]
+    fn the_setting_row_counts_contacts_struck_while_moving() {
+        let record = |at_fault: usize, struck: usize, moving: usize| -> RunRecord {
+            serde_json::from_value(serde_json::json!({
+                "index": 0, "sample": 0, "setting": 0, "seed": 3, "sampled": {},
+                "parameters": {}, "u": [], "end": "struck", "expectations_met": at_fault == 0,
+                "failed": at_fault > 0, "failures": [], "contacts": at_fault + struck,
+                "contacts_with": ["van"], "contacts_at_fault": at_fault,
+                "contacts_struck": struck, "contacts_struck_while_moving": moving,
+                "min_ttc_s": null, "min_pet_s": null, "obstacles": [], "min_clearance_m": [0.0],
+                "obstacle_clearance_m": 0.0, "static_clearance_m": 1.0, "stops": 1,
+                "deviations": 0, "false_stops": 0, "needless_deviations": 0, "lap_times_s": [],
+                "sim_time_s": 40.0, "wall_time_s": 4.0, "score": 0.0, "failure_file": null,
+            }))
+            .expect("a record")
+        };
+        let meta = serde_json::json!({"name": "t", "sampler": "random", "total": 2});
+        let text = render(&meta, &[record(1, 0, 0), record(0, 2, 1)]);
+        assert!(text.contains("| 1 / 2 (1) |"), "{text}");
+    }
 }
