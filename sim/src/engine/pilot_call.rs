@@ -161,8 +161,11 @@ impl HoldLog {
         movers: &[usize],
     ) -> PilotCallReport {
         let last = self.held.back();
-        if matches!(call, PilotCall::Struck) {
-            return struck_report(t_s, last.map(|(_, h, _)| *h), world);
+        // A call made while a strike holds the vehicle (the tow's strike, called at the tug's
+        // release) is the strike's, whichever rule made it: never needless.
+        let held_by_a_strike = matches!(last, Some((_, Hold::Struck { .. }, _)));
+        if matches!(call, PilotCall::Struck) || held_by_a_strike {
+            return struck_report(t_s, call_name(call), last.map(|(_, h, _)| *h), world);
         }
         let mut points: Vec<Point2<f64>> = self.held.iter().filter_map(|(_, _, p)| *p).collect();
         if matches!(call, PilotCall::WalkAround) {
@@ -207,12 +210,7 @@ impl HoldLog {
             .min_by(|a, b| (a.1 - a.2).total_cmp(&(b.1 - b.2)));
         PilotCallReport {
             t_s,
-            call: match call {
-                PilotCall::HiddenObstacle => "hidden_obstacle",
-                PilotCall::Blocked => "blocked",
-                PilotCall::WalkAround => "walk_around",
-                PilotCall::Struck => "struck",
-            },
+            call: call_name(call),
             hold: last.map(|(_, h, _)| *h),
             at_m: last.and_then(|(_, _, p)| p.map(|p| [p.x, p.y])),
             needless: nearest.is_none_or(|(_, d, within)| d > within),
@@ -221,9 +219,25 @@ impl HoldLog {
     }
 }
 
-/// A strike's call: what struck the airframe first (ground truth, the contact the sensor felt)
-/// and how far it is now. Never needless: the sensor feels only real contacts.
-fn struck_report(t_s: f64, hold: Option<Hold>, world: &World) -> PilotCallReport {
+/// The call's name in reports.
+fn call_name(call: PilotCall) -> &'static str {
+    match call {
+        PilotCall::HiddenObstacle => "hidden_obstacle",
+        PilotCall::Blocked => "blocked",
+        PilotCall::WalkAround => "walk_around",
+        PilotCall::Struck => "struck",
+    }
+}
+
+/// A strike's call (`call`: the rule that made it): what struck the airframe first (ground
+/// truth, the contact the sensor felt) and how far it is now. Never needless: the sensor feels
+/// only real contacts.
+fn struck_report(
+    t_s: f64,
+    call: &'static str,
+    hold: Option<Hold>,
+    world: &World,
+) -> PilotCallReport {
     let felt = (world.contacts().iter()).find(|c| c.kind.felt_on_contact());
     let nearest = felt.and_then(|c| {
         let i = (world.scene().solids.iter()).position(|s| s.id == c.object)?;
@@ -232,10 +246,81 @@ fn struck_report(t_s: f64, hold: Option<Hold>, world: &World) -> PilotCallReport
     });
     PilotCallReport {
         t_s,
-        call: "struck",
+        call,
         hold,
         at_m: None,
         needless: false,
         nearest_object: nearest,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::Scenario;
+    use nalgebra::{Isometry2, Vector2};
+
+    const SCENE: &str = r#"
+name = "a call held by a strike"
+seed = 1
+[world]
+min_m = [-20.0, -20.0]
+max_m = [40.0, 20.0]
+[vehicle]
+description = "iara_car"
+[route]
+waypoints_m = [[0.0, 0.0], [30.0, 0.0]]
+speed_m_s = 1.0
+[[obstacles]]
+id = "box"
+kind = "box"
+x_m = 10.0
+y_m = 0.0
+size_m = [0.5, 0.5, 0.5]
+expect = "stop"
+"#;
+
+    /// The call made at 20 s after the holds `held`, with the car's front in the box (`touching`)
+    /// or 4 m short of it.
+    fn call_after(held: &[DriverStatus], call: PilotCall, touching: bool) -> PilotCallReport {
+        let s = Scenario::from_str(SCENE, std::path::Path::new("held.toml")).unwrap();
+        let vehicle = &s.vehicle.vehicle;
+        let mut world = World::with_obstacles(&s.full_scene(), vehicle, &Isometry2::identity());
+        // The car's front is about 3.5 m ahead of its origin; the box's near face at 9.75 m.
+        let x = if touching { 6.4 } else { 2.0 };
+        world.set_vehicle_pose(&Isometry2::new(Vector2::new(x, 0.0), 0.0), 19.0);
+        let mut log = HoldLog::default();
+        for (k, status) in held.iter().enumerate() {
+            log.note(19.0 + 0.1 * k as f64, *status);
+        }
+        log.report(20.0, call, &world, None, &[])
+    }
+
+    #[test]
+    fn a_call_made_while_a_strike_holds_the_vehicle_is_never_needless() {
+        let struck = DriverStatus::Struck { at_s: 19.0 };
+        let call = call_after(&[struck], PilotCall::Blocked, true);
+        assert_eq!(call.call, "blocked", "the rule that called is kept");
+        assert!(!call.needless, "{call:?}");
+        assert!(matches!(call.hold, Some(Hold::Struck { .. })), "{call:?}");
+        let (object, d) = call.nearest_object.clone().expect("what struck it");
+        assert_eq!(object, "box");
+        assert!(d <= 0.0, "it still touches: {call:?}");
+    }
+
+    #[test]
+    fn a_call_held_by_a_point_where_nothing_stands_is_needless() {
+        // The same car, held by a point 5 m to its side where nothing stands, 4 m short of the
+        // box: needless; held by the box's face, not.
+        let phantom = DriverStatus::StoppedFor {
+            obstacle: Point2::new(5.0, 5.0),
+            last_seen_s: 19.0,
+        };
+        assert!(call_after(&[phantom], PilotCall::Blocked, false).needless);
+        let the_box = DriverStatus::StoppedFor {
+            obstacle: Point2::new(9.7, 0.0),
+            last_seen_s: 19.0,
+        };
+        assert!(!call_after(&[the_box], PilotCall::Blocked, false).needless);
     }
 }

@@ -1,5 +1,6 @@
 //! The start overlap: whether a solid meets the vehicle at its start pose ([`start_overlap`]),
-//! from the parts' and the solid's ground footprints and height ranges.
+//! or anywhere along a path of poses - a push-back's tow ([`sweep_overlap`]) - from the parts'
+//! and the solid's ground footprints and height ranges.
 
 use aircraft::footprint::{ConvexPolygon, Disc, Footprint};
 use nalgebra::{Isometry2, Point2, Vector2};
@@ -32,6 +33,51 @@ pub fn start_overlap(
             )
         })
     })
+}
+
+/// The first of `poses` at which a solid meets the vehicle, with which part (as
+/// [`start_overlap`]). Poses where the solid's footprint lies beyond the vehicle's reach are
+/// skipped untested.
+pub fn sweep_overlap(
+    vehicle: &aircraft::Vehicle,
+    poses: &[Isometry2<f64>],
+    solid: &Solid,
+) -> Option<(usize, String)> {
+    let reach_m = (vehicle.parts.iter())
+        .map(|p| {
+            let (lo, hi) = p.footprint().bounds();
+            lo.coords.abs().sup(&hi.coords.abs()).norm()
+        })
+        .fold(0.0, f64::max);
+    let (lo, hi) = solid_footprint_in_vehicle(solid, &Isometry2::identity()).bounds();
+    poses.iter().enumerate().find_map(|(i, pose)| {
+        let at = Point2::from(pose.translation.vector);
+        let nearest = at.sup(&lo).inf(&hi);
+        ((nearest - at).norm() < reach_m)
+            .then(|| start_overlap(vehicle, pose, solid))
+            .flatten()
+            .map(|why| (i, why))
+    })
+}
+
+/// Poses `(position, heading)` made at most `step_m` apart: positions in a straight line,
+/// headings turned the shorter way between each two given.
+pub fn densified(poses: &[(Vector2<f64>, f64)], step_m: f64) -> Vec<Isometry2<f64>> {
+    let mut out: Vec<Isometry2<f64>> = poses
+        .first()
+        .map(|(p, yaw)| Isometry2::new(*p, *yaw))
+        .into_iter()
+        .collect();
+    for w in poses.windows(2) {
+        let ((a, ya), (b, yb)) = (w[0], w[1]);
+        let turn = (yb - ya).sin().atan2((yb - ya).cos());
+        let n = ((b - a).norm() / step_m).ceil().max(1.0) as usize;
+        out.extend((1..=n).map(|k| {
+            let f = k as f64 / n as f64;
+            Isometry2::new(a + (b - a) * f, ya + turn * f)
+        }));
+    }
+    out
 }
 
 /// A solid's ground footprint in the vehicle frame.
@@ -126,6 +172,62 @@ fn footprints_intersect(a: &Footprint, b: &Footprint) -> bool {
                 }
             }
             true
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::world::ObjectKind;
+
+    fn block(x_m: f64, y_m: f64, height_m: f64) -> Solid {
+        Solid {
+            id: "block".into(),
+            kind: ObjectKind::Container,
+            shape: SolidShape::Box {
+                size_m: [1.0, 1.0, height_m],
+            },
+            x_m,
+            y_m,
+            z_min_m: 0.0,
+            yaw_rad: 0.0,
+            remission: 0.5,
+            runtime: false,
+        }
+    }
+
+    #[test]
+    fn a_tow_meets_what_its_wing_sweeps_not_what_lies_beyond_the_tip_or_under_the_wing() {
+        let jet = aircraft::Vehicle::shipped("praetor600").unwrap();
+        let half_span = jet.span_m() / 2.0;
+        // Pushed back tail first 30 m along -x, nose east.
+        let tow = densified(
+            &[(Vector2::zeros(), 0.0), (Vector2::new(-30.0, 0.0), 0.0)],
+            0.5,
+        );
+        assert_eq!(tow.len(), 61);
+        // A 3 m block 20 m behind the start, half a span out: the wing meets it on the way.
+        let (i, why) = sweep_overlap(&jet, &tow, &block(-20.0, half_span / 2.0, 3.0)).unwrap();
+        let x = tow[i].translation.x;
+        assert!((-25.0..-15.0).contains(&x), "met at x = {x}: {why}");
+        assert!(start_overlap(&jet, &tow[0], &block(-20.0, half_span / 2.0, 3.0)).is_none());
+        // A metre beyond the tip, or low enough for the wing to pass over: never met.
+        assert!(sweep_overlap(&jet, &tow, &block(-20.0, half_span + 1.5, 3.0)).is_none());
+        assert!(sweep_overlap(&jet, &tow, &block(-20.0, half_span / 2.0, 0.3)).is_none());
+    }
+
+    #[test]
+    fn densified_poses_are_a_step_apart_and_turn_the_shorter_way() {
+        let (a, b) = (170f64.to_radians(), -170f64.to_radians());
+        let poses = densified(&[(Vector2::zeros(), a), (Vector2::new(2.0, 0.0), b)], 0.5);
+        assert_eq!(poses.len(), 5);
+        for w in poses.windows(2) {
+            let step = (w[1].translation.vector - w[0].translation.vector).norm();
+            assert!((step - 0.5).abs() < 1e-9, "{step}");
+            // 20 degrees in four steps of 5, through 180, not 340 back the other way.
+            let turn = w[1].rotation.angle_to(&w[0].rotation).abs().to_degrees();
+            assert!((turn - 5.0).abs() < 1e-6, "{turn}");
         }
     }
 }

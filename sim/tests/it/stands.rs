@@ -3,7 +3,8 @@
 //! first down the stand's axis and turns it onto the taxilane, never sideways; a tie-down facing
 //! its taxilane is left on the aircraft's own power; a route to a stand ends parked on it, on its
 //! heading; and in the closed loop the push-back is towed, the stack localizes through it, and
-//! the report says how near it came to what stands beside the stand. On the shipped XTSM.
+//! the report says how near it came to what stands beside the stand; a stand whose drawn
+//! aircraft the tow would sweep stays empty. On the shipped XTSM.
 
 use std::path::PathBuf;
 
@@ -109,6 +110,51 @@ fn a_tie_down_facing_its_taxilane_is_left_on_the_aircrafts_own_power() {
     let p = &planned.path.points;
     assert!((p[0] - s3.at).norm() < 1.0);
     assert!(apart_deg(heading(p[0], p[1]), s3.yaw_rad) < 2.0);
+}
+
+/// The ids of the parked aircraft drawn (occupancy 1) when the jet leaves S3 for runway 27, with
+/// a stand N added to the airport at `n_east_m` east of S3 and 25 m behind it, on S3's heading.
+fn drawn_when_leaving_s3(n_east_m: f64) -> Vec<String> {
+    let text = std::fs::read_to_string(xtsm_file()).unwrap();
+    // Degrees of latitude and longitude a metre, at 44 degrees north.
+    let (north, east) = (
+        1.0 / 111_320.0,
+        1.0 / (111_320.0 * 44.0027f64.to_radians().cos()),
+    );
+    let n = format!(
+        "1301 B general_aviation\n1300 {:.9} {:.9} 0.00 gate jets|props N\n1301 B general_aviation",
+        44.002699973 - 25.0 * north,
+        10.000935090 + n_east_m * east
+    );
+    let with_n = text.replacen("1301 B general_aviation", &n, 1);
+    assert_ne!(text, with_n);
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("apt.dat"), with_n).unwrap();
+    let file = dir.path().join("leave_s3.toml");
+    let scenario = "name = \"leave S3\"\nseed = 5\n[airport]\nfile = \"apt.dat\"\noccupancy = 1.0\n\
+         [vehicle]\ndescription = \"praetor600\"\n[route]\n\
+         taxi = { from = \"S3\", to = \"runway 27\" }\nspeed_m_s = 6.0\n";
+    std::fs::write(&file, scenario).unwrap();
+    let s = sim::scenario::Scenario::from_file(&file).unwrap_or_else(|e| panic!("{e}"));
+    assert!(s.route.pushback.is_some());
+    let mut ids: Vec<String> = (s.objects.iter())
+        .filter_map(|o| o.id.split('/').next().filter(|id| id.starts_with("stand_")))
+        .map(str::to_owned)
+        .collect();
+    ids.dedup();
+    ids
+}
+
+/// A Praetor parked at N, 12 m west of S3's axis and 25 m behind S3, reaches its right wing
+/// across the axis the departing jet is pushed back along: with every stand drawn occupied, N
+/// stays empty; 40 m west, clear of the tow, it is drawn. The code-C stands S1 and S2 are drawn
+/// either way.
+#[test]
+fn a_stand_whose_aircraft_the_pushback_would_sweep_stays_empty() {
+    let near = drawn_when_leaving_s3(-12.0);
+    assert_eq!(near, ["stand_S1", "stand_S2"], "{near:?}");
+    let far = drawn_when_leaving_s3(-40.0);
+    assert_eq!(far, ["stand_S1", "stand_S2", "stand_N"], "{far:?}");
 }
 
 /// Keeps the vehicle's last pose.

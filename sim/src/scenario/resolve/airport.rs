@@ -146,6 +146,7 @@ impl Resolver<'_> {
         ids: &mut HashMap<String, String>,
         seed: u64,
         route_stands: &[String],
+        tow: Option<&airport::Tow>,
     ) -> Result<AirportObjects, LocatedError> {
         let inside = |x: f64, y: f64| {
             x >= world.min_m[0] && x <= world.max_m[0] && y >= world.min_m[1] && y <= world.max_m[1]
@@ -164,6 +165,10 @@ impl Resolver<'_> {
             solids.push(solid.clone());
         }
         let furniture = solids.len();
+        // The push-back's poses, half a metre apart: the ramp keeps the tow's way clear.
+        let towed = tow.map_or_else(Vec::new, |t| {
+            crate::scenario::overlap::densified(&t.poses, 0.5)
+        });
         for (stand, description, span) in self.occupied_stands(spec, loaded, seed, route_stands)? {
             let id = format!("stand_{}", stand.name.replace(' ', "_"));
             self.claim(
@@ -181,11 +186,13 @@ impl Resolver<'_> {
                 stand.yaw_rad,
                 spec.get_ref().ground_equipment,
             );
-            // A drawn aircraft that would touch the vehicle at its start leaves its stand empty.
-            let start = crate::scenario::overlap::start_overlap;
+            // A drawn aircraft that would touch the vehicle at its start, or anywhere its tug
+            // pushes it back (the ramp's wing walkers would stop the tow), leaves its stand empty.
+            use crate::scenario::overlap::{start_overlap, sweep_overlap};
             if here.iter().any(|s| {
-                start(&vehicle.vehicle, &vehicle.world_from_start, s).is_some()
+                start_overlap(&vehicle.vehicle, &vehicle.world_from_start, s).is_some()
                     || !inside(s.x_m, s.y_m)
+                    || sweep_overlap(&vehicle.vehicle, &towed, s).is_some()
             }) {
                 ids.remove(&id);
                 continue;

@@ -100,9 +100,9 @@ impl Resolver<'_> {
                 let route_stands: Vec<String> = (spec.route.get_ref().taxi.iter())
                     .flat_map(|t| [t.get_ref().from.clone(), t.get_ref().to.clone()])
                     .collect();
-                let (seed, stands) = (spec.seed, &route_stands);
+                let (seed, stands, tow) = (spec.seed, &route_stands, route.pushback.as_ref());
                 let a =
-                    self.airport_objects(a, loaded, &world, &vehicle, &mut ids, seed, stands)?;
+                    self.airport_objects(a, loaded, &world, &vehicle, &mut ids, seed, stands, tow)?;
                 (a.solids, a.survey, a.patches)
             }
             _ => (Vec::new(), None, Vec::new()),
