@@ -60,6 +60,36 @@ pub fn sweep_overlap(
     })
 }
 
+/// The vehicle's way on a taxi route, poses at most `step_m` apart: the push-back's tow, if any,
+/// then the route's waypoints, each facing the next (the last as the one before it); and how
+/// many of the poses are the tow's.
+pub fn taxi_way(
+    route: &super::model::Route,
+    step_m: f64,
+) -> (Vec<Isometry2<f64>>, usize) {
+    let w = &route.waypoints_m;
+    let heading = |i: usize| {
+        let (a, b) = if i + 1 < w.len() {
+            (w[i], w[i + 1])
+        } else {
+            (w[i - 1], w[i])
+        };
+        (b.y - a.y).atan2(b.x - a.x)
+    };
+    let path: Vec<(Vector2<f64>, f64)> = if w.len() < 2 {
+        Vec::new()
+    } else {
+        (0..w.len()).map(|i| (w[i].coords, heading(i))).collect()
+    };
+    let mut way = route
+        .pushback
+        .as_ref()
+        .map_or_else(Vec::new, |t| densified(&t.poses, step_m));
+    let towed = way.len();
+    way.extend(densified(&path, step_m));
+    (way, towed)
+}
+
 /// Poses `(position, heading)` made at most `step_m` apart: positions in a straight line,
 /// headings turned the shorter way between each two given.
 pub fn densified(poses: &[(Vector2<f64>, f64)], step_m: f64) -> Vec<Isometry2<f64>> {

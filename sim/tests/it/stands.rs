@@ -4,7 +4,8 @@
 //! its taxilane is left on the aircraft's own power; a route to a stand ends parked on it, on its
 //! heading; and in the closed loop the push-back is towed, the stack localizes through it, and
 //! the report says how near it came to what stands beside the stand; a stand whose drawn
-//! aircraft the tow would sweep stays empty. On the shipped XTSM.
+//! aircraft would block the vehicle's way - its tow or its taxi in - stays empty. On the
+//! shipped XTSM.
 
 use std::path::PathBuf;
 
@@ -112,9 +113,14 @@ fn a_tie_down_facing_its_taxilane_is_left_on_the_aircrafts_own_power() {
     assert!(apart_deg(heading(p[0], p[1]), s3.yaw_rad) < 2.0);
 }
 
-/// The ids of the parked aircraft drawn (occupancy 1) when the jet leaves S3 for runway 27, with
-/// a stand N added to the airport at `n_east_m` east of S3 and 25 m behind it, on S3's heading.
-fn drawn_when_leaving_s3(n_east_m: f64) -> Vec<String> {
+/// The jet taxiing `from` `to` on XTSM with a stand N added at `n_east_m` east of S3 and 25 m
+/// behind it, on S3's heading; `airport` more lines of its `[airport]` table.
+fn taxiing_by_n(
+    from: &str,
+    to: &str,
+    n_east_m: f64,
+    airport: &str,
+) -> Result<sim::scenario::Scenario, String> {
     let text = std::fs::read_to_string(xtsm_file()).unwrap();
     // Degrees of latitude and longitude a metre, at 44 degrees north.
     let (north, east) = (
@@ -130,13 +136,20 @@ fn drawn_when_leaving_s3(n_east_m: f64) -> Vec<String> {
     assert_ne!(text, with_n);
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("apt.dat"), with_n).unwrap();
-    let file = dir.path().join("leave_s3.toml");
-    let scenario = "name = \"leave S3\"\nseed = 5\n[airport]\nfile = \"apt.dat\"\noccupancy = 1.0\n\
+    let file = dir.path().join("taxi.toml");
+    let scenario = format!(
+        "name = \"taxi\"\nseed = 5\n[airport]\nfile = \"apt.dat\"\n{airport}\n\
          [vehicle]\ndescription = \"praetor600\"\n[route]\n\
-         taxi = { from = \"S3\", to = \"runway 27\" }\nspeed_m_s = 6.0\n";
+         taxi = {{ from = \"{from}\", to = \"{to}\" }}\nspeed_m_s = 6.0\n"
+    );
     std::fs::write(&file, scenario).unwrap();
-    let s = sim::scenario::Scenario::from_file(&file).unwrap_or_else(|e| panic!("{e}"));
-    assert!(s.route.pushback.is_some());
+    sim::scenario::Scenario::from_file(&file).map_err(|e| e.to_string())
+}
+
+/// The ids of the parked aircraft drawn (occupancy 1) when the jet taxis `from` `to` by N.
+fn drawn_taxiing(from: &str, to: &str, n_east_m: f64) -> Vec<String> {
+    let s = taxiing_by_n(from, to, n_east_m, "occupancy = 1.0").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.route.pushback.is_some(), from == "S3");
     let mut ids: Vec<String> = (s.objects.iter())
         .filter_map(|o| o.id.split('/').next().filter(|id| id.starts_with("stand_")))
         .map(str::to_owned)
@@ -145,16 +158,33 @@ fn drawn_when_leaving_s3(n_east_m: f64) -> Vec<String> {
     ids
 }
 
-/// A Praetor parked at N, 12 m west of S3's axis and 25 m behind S3, reaches its right wing
-/// across the axis the departing jet is pushed back along: with every stand drawn occupied, N
-/// stays empty; 40 m west, clear of the tow, it is drawn. The code-C stands S1 and S2 are drawn
-/// either way.
+/// An aircraft the file parks by name at N, across the push-back: an error naming the field and
+/// the tow (the tug would push the jet into it); across the way in of an arrival it is the
+/// scenario's to state (the stack must stop for it), and accepted.
 #[test]
-fn a_stand_whose_aircraft_the_pushback_would_sweep_stays_empty() {
-    let near = drawn_when_leaving_s3(-12.0);
-    assert_eq!(near, ["stand_S1", "stand_S2"], "{near:?}");
-    let far = drawn_when_leaving_s3(-40.0);
-    assert_eq!(far, ["stand_S1", "stand_S2", "stand_N"], "{far:?}");
+fn an_aircraft_parked_by_name_across_the_pushback_is_an_error() {
+    let parked = "parked = [{ stand = \"N\", vehicle = \"praetor600\" }]";
+    let error = taxiing_by_n("S3", "runway 27", -12.0, parked).unwrap_err();
+    assert!(
+        error.contains("airport.parked[0]") && error.contains("push-back"),
+        "{error}"
+    );
+    assert!(taxiing_by_n("S3", "runway 27", -40.0, parked).is_ok());
+    assert!(taxiing_by_n("runway 27", "S3", -12.0, parked).is_ok());
+}
+
+/// A Praetor parked at N, 12 m west of S3's axis and 25 m behind S3, reaches its right wing
+/// across the axis the departing jet is pushed back along, and an arriving jet taxis in along:
+/// with every stand drawn occupied, N stays empty; 40 m west, clear of both, it is drawn. The
+/// code-C stands S1 and S2 are drawn either way.
+#[test]
+fn a_stand_whose_aircraft_would_block_the_vehicles_way_stays_empty() {
+    let leaving = |east| drawn_taxiing("S3", "runway 27", east);
+    assert_eq!(leaving(-12.0), ["stand_S1", "stand_S2"]);
+    assert_eq!(leaving(-40.0), ["stand_S1", "stand_S2", "stand_N"]);
+    let arriving = |east| drawn_taxiing("runway 27", "S3", east);
+    assert_eq!(arriving(-12.0), ["stand_S1", "stand_S2"]);
+    assert_eq!(arriving(-40.0), ["stand_S1", "stand_S2", "stand_N"]);
 }
 
 /// Keeps the vehicle's last pose.

@@ -146,7 +146,7 @@ impl Resolver<'_> {
         ids: &mut HashMap<String, String>,
         seed: u64,
         route_stands: &[String],
-        tow: Option<&airport::Tow>,
+        (way, towed): (&[nalgebra::Isometry2<f64>], usize),
     ) -> Result<AirportObjects, LocatedError> {
         let inside = |x: f64, y: f64| {
             x >= world.min_m[0] && x <= world.max_m[0] && y >= world.min_m[1] && y <= world.max_m[1]
@@ -165,10 +165,6 @@ impl Resolver<'_> {
             solids.push(solid.clone());
         }
         let furniture = solids.len();
-        // The push-back's poses, half a metre apart: the ramp keeps the tow's way clear.
-        let towed = tow.map_or_else(Vec::new, |t| {
-            crate::scenario::overlap::densified(&t.poses, 0.5)
-        });
         for (stand, description, span) in self.occupied_stands(spec, loaded, seed, route_stands)? {
             let id = format!("stand_{}", stand.name.replace(' ', "_"));
             self.claim(
@@ -186,13 +182,15 @@ impl Resolver<'_> {
                 stand.yaw_rad,
                 spec.get_ref().ground_equipment,
             );
-            // A drawn aircraft that would touch the vehicle at its start, or anywhere its tug
-            // pushes it back (the ramp's wing walkers would stop the tow), leaves its stand empty.
+            // A drawn aircraft that would touch the vehicle at its start, or anywhere on its way
+            // - pushed back by its tug, or taxiing its route into a stand - leaves its stand
+            // empty: the ramp parks no aircraft where it blocks another's way (wing walkers would
+            // stop the tow; an arrival would be given another stand).
             use crate::scenario::overlap::{start_overlap, sweep_overlap};
             if here.iter().any(|s| {
                 start_overlap(&vehicle.vehicle, &vehicle.world_from_start, s).is_some()
                     || !inside(s.x_m, s.y_m)
-                    || sweep_overlap(&vehicle.vehicle, &towed, s).is_some()
+                    || sweep_overlap(&vehicle.vehicle, way, s).is_some()
             }) {
                 ids.remove(&id);
                 continue;
@@ -233,6 +231,7 @@ impl Resolver<'_> {
             for solid in here {
                 self.inside_world(world, &field, p.stand.span(), solid.x_m, solid.y_m)?;
                 self.no_start_overlap(vehicle, &solid, &field, p.stand.span())?;
+                self.not_in_the_tow(vehicle, &way[..towed], &solid, &field, p.stand.span())?;
                 solids.push(solid);
             }
         }
@@ -319,6 +318,33 @@ impl Resolver<'_> {
             out.push((stand, vehicle, share.span()));
         }
         Ok(out)
+    }
+
+    /// A parked aircraft named in the file that the vehicle's push-back (`tow`, its poses) would
+    /// meet is an error: the tug would push the vehicle into it, and the tow is the world's, not
+    /// the stack's to avoid.
+    fn not_in_the_tow(
+        &self,
+        vehicle: &ScenarioVehicle,
+        tow: &[nalgebra::Isometry2<f64>],
+        solid: &Solid,
+        field: &str,
+        span: std::ops::Range<usize>,
+    ) -> Result<(), LocatedError> {
+        let Some((i, hit)) = crate::scenario::overlap::sweep_overlap(&vehicle.vehicle, tow, solid)
+        else {
+            return Ok(());
+        };
+        let at = tow[i].translation.vector;
+        Err(self.err(
+            span,
+            field,
+            format!(
+                "`{}` meets the vehicle on its push-back, towed to ({:.1}, {:.1}) m: {hit}; the \
+                 tug would push it into it (park it at another stand, or leave from another)",
+                solid.id, at.x, at.y
+            ),
+        ))
     }
 }
 

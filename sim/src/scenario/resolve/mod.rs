@@ -100,9 +100,12 @@ impl Resolver<'_> {
                 let route_stands: Vec<String> = (spec.route.get_ref().taxi.iter())
                     .flat_map(|t| [t.get_ref().from.clone(), t.get_ref().to.clone()])
                     .collect();
-                let (seed, stands, tow) = (spec.seed, &route_stands, route.pushback.as_ref());
+                // Its way, half a metre a pose: the ramp parks no aircraft across it.
+                let (way, towed) = crate::scenario::overlap::taxi_way(&route, 0.5);
+                let (seed, stands) = (spec.seed, &route_stands);
+                let way = (&way[..], towed);
                 let a =
-                    self.airport_objects(a, loaded, &world, &vehicle, &mut ids, seed, stands, tow)?;
+                    self.airport_objects(a, loaded, &world, &vehicle, &mut ids, seed, stands, way)?;
                 (a.solids, a.survey, a.patches)
             }
             _ => (Vec::new(), None, Vec::new()),
