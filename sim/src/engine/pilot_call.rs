@@ -123,7 +123,8 @@ pub struct PilotCallReport {
     /// last [`NEEDLESS_WINDOW_S`] s (for unseen ground: any cell of it), or - waiting for a
     /// mover believed at the body - to the vehicle's parts of one that struck it (or, one lost
     /// there, of any mover), and how far, metres: of those, the one nearest within what counts
-    /// for it ([`REAL_WITHIN_M`]; a mover at the body, [`AT_BODY_WITHIN_M`]).
+    /// for it ([`REAL_WITHIN_M`]; a mover at the body, [`AT_BODY_WITHIN_M`]). For a strike's
+    /// call: what struck the airframe, and how far it is now.
     pub nearest_object: Option<(String, f64)>,
     /// Nothing stood within what counts of any of them: the call was needless.
     pub needless: bool,
@@ -161,11 +162,8 @@ impl HoldLog {
         movers: &[usize],
     ) -> PilotCallReport {
         let last = self.held.back();
-        // A call made while a strike holds the vehicle (the tow's strike, called at the tug's
-        // release) is the strike's, whichever rule made it: never needless.
-        let held_by_a_strike = matches!(last, Some((_, Hold::Struck { .. }, _)));
-        if matches!(call, PilotCall::Struck) || held_by_a_strike {
-            return struck_report(t_s, call_name(call), last.map(|(_, h, _)| *h), world);
+        if matches!(call, PilotCall::Struck) {
+            return struck_report(t_s, last.map(|(_, h, _)| *h), world);
         }
         let mut points: Vec<Point2<f64>> = self.held.iter().filter_map(|(_, _, p)| *p).collect();
         if matches!(call, PilotCall::WalkAround) {
@@ -229,15 +227,9 @@ fn call_name(call: PilotCall) -> &'static str {
     }
 }
 
-/// A strike's call (`call`: the rule that made it): what struck the airframe first (ground
-/// truth, the contact the sensor felt) and how far it is now. Never needless: the sensor feels
-/// only real contacts.
-fn struck_report(
-    t_s: f64,
-    call: &'static str,
-    hold: Option<Hold>,
-    world: &World,
-) -> PilotCallReport {
+/// A strike's call: what struck the airframe first (ground truth, the contact the sensor felt)
+/// and how far it is now. Never needless: the sensor feels only real contacts.
+fn struck_report(t_s: f64, hold: Option<Hold>, world: &World) -> PilotCallReport {
     let felt = (world.contacts().iter()).find(|c| c.kind.felt_on_contact());
     let nearest = felt.and_then(|c| {
         let i = (world.scene().solids.iter()).position(|s| s.id == c.object)?;
@@ -246,7 +238,7 @@ fn struck_report(
     });
     PilotCallReport {
         t_s,
-        call,
+        call: "struck",
         hold,
         at_m: None,
         needless: false,
@@ -297,10 +289,10 @@ expect = "stop"
     }
 
     #[test]
-    fn a_call_made_while_a_strike_holds_the_vehicle_is_never_needless() {
+    fn a_strikes_call_names_what_struck_and_is_never_needless() {
         let struck = DriverStatus::Struck { at_s: 19.0 };
-        let call = call_after(&[struck], PilotCall::Blocked, true);
-        assert_eq!(call.call, "blocked", "the rule that called is kept");
+        let call = call_after(&[struck], PilotCall::Struck, true);
+        assert_eq!(call.call, "struck");
         assert!(!call.needless, "{call:?}");
         assert!(matches!(call.hold, Some(Hold::Struck { .. })), "{call:?}");
         let (object, d) = call.nearest_object.clone().expect("what struck it");

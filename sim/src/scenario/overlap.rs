@@ -1,6 +1,7 @@
 //! The start overlap: whether a solid meets the vehicle at its start pose ([`start_overlap`]),
-//! or anywhere along a path of poses - a push-back's tow ([`sweep_overlap`]) - from the parts'
-//! and the solid's ground footprints and height ranges.
+//! or anywhere along a path of poses ([`sweep_overlap`]) - its way on a taxi route, the
+//! push-back's tow and the route ([`taxi_way`], poses [`densified`]) - from the parts' and the
+//! solid's ground footprints and height ranges.
 
 use aircraft::footprint::{ConvexPolygon, Disc, Footprint};
 use nalgebra::{Isometry2, Point2, Vector2};
@@ -61,25 +62,21 @@ pub fn sweep_overlap(
 }
 
 /// The vehicle's way on a taxi route, poses at most `step_m` apart: the push-back's tow, if any,
-/// then the route's waypoints, each facing the next (the last as the one before it); and how
-/// many of the poses are the tow's.
-pub fn taxi_way(
-    route: &super::model::Route,
-    step_m: f64,
-) -> (Vec<Isometry2<f64>>, usize) {
+/// then the route's waypoints, each facing along the route there (central differences: the
+/// tangent of an arc of equal chords; an end, its one leg); and how many of the poses are the
+/// tow's.
+pub fn taxi_way(route: &super::model::Route, step_m: f64) -> (Vec<Isometry2<f64>>, usize) {
     let w = &route.waypoints_m;
-    let heading = |i: usize| {
-        let (a, b) = if i + 1 < w.len() {
-            (w[i], w[i + 1])
-        } else {
-            (w[i - 1], w[i])
-        };
-        (b.y - a.y).atan2(b.x - a.x)
-    };
-    let path: Vec<(Vector2<f64>, f64)> = if w.len() < 2 {
+    let n = w.len();
+    let path: Vec<(Vector2<f64>, f64)> = if n < 2 {
         Vec::new()
     } else {
-        (0..w.len()).map(|i| (w[i].coords, heading(i))).collect()
+        (0..n)
+            .map(|i| {
+                let d = w[(i + 1).min(n - 1)] - w[i.saturating_sub(1)];
+                (w[i].coords, d.y.atan2(d.x))
+            })
+            .collect()
     };
     let mut way = route
         .pushback
@@ -245,6 +242,58 @@ mod tests {
         // A metre beyond the tip, or low enough for the wing to pass over: never met.
         assert!(sweep_overlap(&jet, &tow, &block(-20.0, half_span + 1.5, 3.0)).is_none());
         assert!(sweep_overlap(&jet, &tow, &block(-20.0, half_span / 2.0, 0.3)).is_none());
+    }
+
+    /// A route east then north: its poses face east, then north, at the corner half way; ahead
+    /// of the last pose the nose meets a tall block that, facing back the way it came, it would
+    /// not; the tow's poses come first and are counted.
+    #[test]
+    fn the_taxi_way_faces_along_the_route_after_the_tow() {
+        let jet = aircraft::Vehicle::shipped("praetor600").unwrap();
+        let tow = airport::Tow {
+            poses: vec![
+                (Vector2::new(0.0, -10.0), 1.0),
+                (Vector2::new(0.0, -5.0), 1.0),
+            ],
+            radius_m: 5.0,
+            length_m: 5.0,
+        };
+        let route = super::super::model::Route {
+            waypoints_m: vec![
+                Point2::origin(),
+                Point2::new(20.0, 0.0),
+                Point2::new(20.0, 20.0),
+            ],
+            yaws_rad: vec![None; 3],
+            closed: false,
+            speed_m_s: 5.0,
+            speed_limits_m_s: None,
+            pushback: Some(tow),
+        };
+        let (way, towed) = taxi_way(&route, 0.5);
+        assert_eq!(towed, 11);
+        assert!(
+            way[..towed]
+                .iter()
+                .all(|p| (p.rotation.angle() - 1.0).abs() < 1e-9)
+        );
+        let yaw = |i: usize| way[i].rotation.angle().to_degrees();
+        // East at the start, north at the end, 45 degrees at the corner (central differences),
+        // turning evenly between.
+        assert!(yaw(towed).abs() < 1e-9 && (yaw(towed + 20) - 22.5).abs() < 1e-9);
+        assert!((yaw(towed + 40) - 45.0).abs() < 1e-9, "{}", yaw(towed + 40));
+        assert!((yaw(way.len() - 1) - 90.0).abs() < 1e-9);
+        // The nose reaches 11.7 m ahead of the reference point, the tail 8.4 m behind: a block
+        // 11 m beyond the route's end is met by the nose, facing north; one 10.5 m behind the
+        // start - where the nose would reach facing back - never.
+        let (i, why) = sweep_overlap(&jet, &way, &block(20.0, 31.0, 3.0)).unwrap();
+        assert!(
+            way[i].translation.y > 17.0 && yaw(i) > 80.0,
+            "{why} at {}",
+            way[i]
+        );
+        assert!(why.contains("nose"), "{why}");
+        assert!(sweep_overlap(&jet, &way[towed..], &block(-10.5, 0.0, 3.0)).is_none());
     }
 
     #[test]

@@ -173,8 +173,9 @@ fn an_aircraft_parked_by_name_across_the_pushback_is_an_error() {
     assert!(taxiing_by_n("runway 27", "S3", -12.0, parked).is_ok());
 }
 
-/// A Praetor parked at N, 12 m west of S3's axis and 25 m behind S3, reaches its right wing
-/// across the axis the departing jet is pushed back along, and an arriving jet taxis in along:
+/// A Praetor parked at N, 12 m west of S3's axis and 25 m behind S3, reaches its right wing to
+/// 1.25 m short of the axis, where the wing of the jet pushed back along it (or taxiing in along
+/// it) passes:
 /// with every stand drawn occupied, N stays empty; 40 m west, clear of both, it is drawn. The
 /// code-C stands S1 and S2 are drawn either way.
 #[test]

@@ -141,10 +141,11 @@ impl Driver {
 
     /// Whether the driver calls for a pilot at `now_s`, and why: it felt a strike and stands, it
     /// has waited for a hidden obstacle or a walk-around longer than `pilot_call_after_s`, or
-    /// stood for obstacles longer than `blocked_call_after_s`.
+    /// stood for obstacles longer than `blocked_call_after_s`. Once struck, only the strike
+    /// calls - when the vehicle stands - whatever it waited or stood for before.
     pub fn calls_for_pilot(&self, now_s: f64) -> Option<PilotCall> {
-        if self.struck_at_s.is_some() && self.standing() {
-            return Some(PilotCall::Struck);
+        if self.struck_at_s.is_some() {
+            return self.standing().then_some(PilotCall::Struck);
         }
         if matches!(self.status, DriverStatus::WaitingForWalkAround { since_s, .. }
             if now_s - since_s >= self.config.pilot_call_after_s)

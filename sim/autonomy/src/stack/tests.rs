@@ -389,6 +389,30 @@ fn a_felt_strike_stands_the_vehicle_and_calls_a_pilot_once_it_stands() {
     assert_eq!(d.struck_at_s(), Some(1.0));
 }
 
+/// A strike felt rolling by a vehicle that had stood long enough to call its way blocked (the
+/// tow's strike, felt as the tug lets go, the stack's stop counted through the tow): no call
+/// while it rolls - not the blocked way's - then the strike's once it stands.
+#[test]
+fn a_struck_vehicle_makes_only_the_strikes_call() {
+    let mut d = driver();
+    let mut map = empty_map();
+    d.on_pose(at(0.0, 10.0, 0.0, 0.0));
+    d.plan(&mut map).unwrap();
+    d.stopped_since_s = Some(0.0);
+    let t = d.config.blocked_call_after_s + 1.0;
+    assert_eq!(d.calls_for_pilot(t), Some(PilotCall::Blocked));
+    let rolling = |t_s, speed_m_s| Odometry {
+        t_s,
+        speed_m_s,
+        steering_rad: 0.0,
+    };
+    d.on_odometry(rolling(t, 1.0));
+    d.on_strike(t);
+    assert_eq!(d.calls_for_pilot(t), None);
+    d.on_odometry(rolling(t + 1.0, 0.0));
+    assert_eq!(d.calls_for_pilot(t + 1.0), Some(PilotCall::Struck));
+}
+
 /// A strike felt standing (a tug into the standing nose): the call comes at once.
 #[test]
 fn a_strike_felt_standing_calls_a_pilot_at_once() {

@@ -182,16 +182,7 @@ impl Resolver<'_> {
                 stand.yaw_rad,
                 spec.get_ref().ground_equipment,
             );
-            // A drawn aircraft that would touch the vehicle at its start, or anywhere on its way
-            // - pushed back by its tug, or taxiing its route into a stand - leaves its stand
-            // empty: the ramp parks no aircraft where it blocks another's way (wing walkers would
-            // stop the tow; an arrival would be given another stand).
-            use crate::scenario::overlap::{start_overlap, sweep_overlap};
-            if here.iter().any(|s| {
-                start_overlap(&vehicle.vehicle, &vehicle.world_from_start, s).is_some()
-                    || !inside(s.x_m, s.y_m)
-                    || sweep_overlap(&vehicle.vehicle, way, s).is_some()
-            }) {
+            if stays_empty(vehicle, way, &here, &inside) {
                 ids.remove(&id);
                 continue;
             }
@@ -336,16 +327,39 @@ impl Resolver<'_> {
             return Ok(());
         };
         let at = tow[i].translation.vector;
+        let along_m: f64 = (tow[..=i].windows(2))
+            .map(|w| (w[1].translation.vector - w[0].translation.vector).norm())
+            .sum();
         Err(self.err(
             span,
             field,
             format!(
-                "`{}` meets the vehicle on its push-back, towed to ({:.1}, {:.1}) m: {hit}; the \
-                 tug would push it into it (park it at another stand, or leave from another)",
-                solid.id, at.x, at.y
+                "`{}` is in the vehicle's push-back: towed {:.1} m, to ({:.1}, {:.1}) m, {hit}; \
+                 the tug would push the vehicle into it (park it at another stand, or leave \
+                 from another)",
+                solid.id, along_m, at.x, at.y
             ),
         ))
     }
+}
+
+/// Whether a stand `occupancy` draws stays empty (`here`: its aircraft's parts and equipment):
+/// one outside the world, or that would touch the vehicle at its start or anywhere on its `way` -
+/// pushed back by its tug, or taxiing its route into a stand. The ramp parks no aircraft where it
+/// blocks another's way: wing walkers would stop the tow; an arrival would be given another
+/// stand.
+fn stays_empty(
+    vehicle: &ScenarioVehicle,
+    way: &[nalgebra::Isometry2<f64>],
+    here: &[Solid],
+    inside: &dyn Fn(f64, f64) -> bool,
+) -> bool {
+    use crate::scenario::overlap::{start_overlap, sweep_overlap};
+    here.iter().any(|s| {
+        !inside(s.x_m, s.y_m)
+            || start_overlap(&vehicle.vehicle, &vehicle.world_from_start, s).is_some()
+            || sweep_overlap(&vehicle.vehicle, way, s).is_some()
+    })
 }
 
 /// A parked aircraft's collision parts at a stand (its vehicle frame on the stand's point).
