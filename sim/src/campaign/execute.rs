@@ -184,7 +184,7 @@ fn run_variant(
         return Ok(None);
     }
     let rec = record(campaign, v, &scenario, &report);
-    if let Some(f) = &rec.needless_file {
+    for f in rec.needless_file.iter().chain(&rec.called_file) {
         mapper::write_atomically(&dir.join(f), v.text.as_bytes())?;
     }
     if let Some(f) = &rec.failure_file {

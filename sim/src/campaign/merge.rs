@@ -127,9 +127,12 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Merged> {
         serde_json::to_string_pretty(&merged_meta)?.as_bytes(),
     )?;
     for (r, from) in by_index.values() {
-        for f in r.failure_file.iter().chain(&r.needless_file) {
+        for f in (r.failure_file.iter())
+            .chain(&r.needless_file)
+            .chain(&r.called_file)
+        {
             let text = std::fs::read(from.join(f)).map_err(|source| Error::Io {
-                what: "reading a shard's scenario file (a failure's, or a needless call's)",
+                what: "reading a shard's scenario file (a failure's, or a pilot call's)",
                 path: from.join(f),
                 source,
             })?;

@@ -139,6 +139,10 @@ pub struct RunRecord {
     /// directory (`needless/<index>.toml`): to run it alone and read why the stack held.
     #[serde(default)]
     pub needless_file: Option<String>,
+    /// The scenario file of a run that ended with a pilot call, needless or not, relative to the
+    /// campaign directory (`called/<index>.toml`): to run it alone or replay it.
+    #[serde(default)]
+    pub called_file: Option<String>,
 }
 
 impl RunRecord {
@@ -365,6 +369,7 @@ pub fn record(campaign: &Campaign, v: &Variant, scenario: &Scenario, r: &RunRepo
         needless_pilot_call: needless_call,
         pilot_call_object: r.pilot_call.as_ref().and_then(|c| c.nearest_object.clone()),
         needless_file: needless_call.then(|| format!("needless/{}.toml", v.index)),
+        called_file: (r.pilot_call.is_some()).then(|| format!("called/{}.toml", v.index)),
     }
 }
 
@@ -412,6 +417,7 @@ pub(super) fn invalid(campaign: &Campaign, v: &Variant, why: &str) -> RunRecord 
         needless_pilot_call: false,
         pilot_call_object: None,
         needless_file: None,
+        called_file: None,
     }
 }
 

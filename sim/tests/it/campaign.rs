@@ -60,6 +60,20 @@ fn the_smoke_campaign_runs_every_variant_under_every_setting() {
             assert!(dir.path().join(f).exists(), "{f}");
             assert!(summary.contains(&format!("`{f}`")), "{summary}");
         }
+        // Every pilot call's variant, needed or not, is written to be run alone or replayed: a
+        // scenario file, the very text a failure's or a needless call's file holds.
+        assert_eq!(r.called_file.is_some(), called, "{}", r.index);
+        if let Some(f) = &r.called_file {
+            let path = dir.path().join(f);
+            sim::scenario::Scenario::from_file(&path).unwrap_or_else(|e| panic!("{e}"));
+            let text = std::fs::read_to_string(&path).unwrap();
+            for other in r.failure_file.iter().chain(&r.needless_file) {
+                assert_eq!(
+                    std::fs::read_to_string(dir.path().join(other)).unwrap(),
+                    text
+                );
+            }
+        }
     }
     let calls = records.iter().filter(|r| r.pilot_call.is_some()).count();
     assert!(calls > 0, "the smoke campaign's variant 10 calls a pilot");
