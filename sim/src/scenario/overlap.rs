@@ -97,7 +97,7 @@ pub fn densified(poses: &[(Vector2<f64>, f64)], step_m: f64) -> Vec<Isometry2<f6
         .collect();
     for w in poses.windows(2) {
         let ((a, ya), (b, yb)) = (w[0], w[1]);
-        let turn = (yb - ya).sin().atan2((yb - ya).cos());
+        let turn = crate::world::wrap_angle(yb - ya);
         let n = ((b - a).norm() / step_m).ceil().max(1.0) as usize;
         out.extend((1..=n).map(|k| {
             let f = k as f64 / n as f64;
